@@ -1,0 +1,25 @@
+"""coulomb: rigid-body dynamics with Coulomb friction and impact.
+
+Exact where peers approximate, and fast: the solvers run in Rust, every answer comes with its
+error measured on the original data.
+
+Submodules
+----------
+lcp
+    Linear complementarity problems (Lemke, projected Gauss-Seidel, enumeration).
+io
+    Readers for benchmark problem files (Siconos).
+errors
+    The exceptions raised for bad input.
+validate
+    Reproduces the reference figures of the seed chapter (``coulomb validate``).
+"""
+
+from __future__ import annotations
+
+from . import errors, io, lcp
+from ._core import __version__
+from ._result import Result
+from .lcp import LcpResult
+
+__all__ = ["LcpResult", "Result", "__version__", "errors", "io", "lcp"]

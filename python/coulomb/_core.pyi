@@ -1,0 +1,28 @@
+"""Type stub of the Rust extension ``coulomb._core``."""
+
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+__version__: str
+
+def lcp_solve(
+    m: NDArray[np.float64],
+    q: NDArray[np.float64],
+    method: str,
+    tol: float,
+    max_pivots: int | None = None,
+    covering_vector: NDArray[np.float64] | None = None,
+    warm_start: list[int] | None = None,
+    polish: bool = True,
+    restarts: int = 2,
+    max_iter: int = 10000,
+    relaxation: float = 1.0,
+    initial: NDArray[np.float64] | None = None,
+) -> dict[str, Any]: ...
+def lcp_measures(
+    m: NDArray[np.float64], q: NDArray[np.float64], z: NDArray[np.float64]
+) -> dict[str, Any]: ...
+def read_siconos_lcp(path: str) -> tuple[NDArray[np.float64], NDArray[np.float64]]: ...
+def simd_level() -> str: ...

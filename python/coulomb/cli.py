@@ -1,0 +1,61 @@
+"""The ``coulomb`` command line."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from dataclasses import asdict
+from pathlib import Path
+
+from . import __version__
+
+
+def _validate(args: argparse.Namespace) -> int:
+    from .validate import format_table, run
+
+    rows = run(args.data, progress=lambda m: print(m, file=sys.stderr))
+    if args.json:
+        print(json.dumps([asdict(r) for r in rows], indent=2))
+    else:
+        print(format_table(rows))
+    return 0 if all(r.passed for r in rows) else 1
+
+
+def _solve_lcp(args: argparse.Namespace) -> int:
+    from . import lcp
+    from .io import read_siconos_lcp
+
+    p = read_siconos_lcp(args.path)
+    r = lcp.solve(p.M, p.q, method=args.method, tol=args.tol)
+    print(f"{p.name}: n = {p.n}")
+    print(r)
+    return 0 if r.success else 2
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``coulomb`` console script."""
+    parser = argparse.ArgumentParser(
+        prog="coulomb",
+        description="Rigid-body dynamics with Coulomb friction and impact.",
+    )
+    parser.add_argument("--version", action="version", version=f"coulomb {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    v = sub.add_parser("validate", help="reproduce the seed's figures and print them")
+    v.add_argument("--data", type=Path, default=None, help="benchmark data folder")
+    v.add_argument("--json", action="store_true", help="print the rows as JSON")
+    v.set_defaults(func=_validate)
+
+    s = sub.add_parser("solve-lcp", help="solve a Siconos LCP file and print the result")
+    s.add_argument("path", type=Path)
+    s.add_argument("--method", default="lemke", choices=["lemke", "pgs", "enumerate"])
+    s.add_argument("--tol", type=float, default=1e-9)
+    s.set_defaults(func=_solve_lcp)
+
+    args = parser.parse_args(argv)
+    return int(args.func(args))
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,51 @@
+"""Exceptions raised by coulomb.
+
+Bad input is refused before any work with one of the :class:`InvalidInputError` subclasses
+(each is also a :class:`ValueError`). A solver that runs but does not converge does *not*
+raise: its result's ``status`` says what happened and ``success`` is False.
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "CoulombError",
+    "InternalError",
+    "InvalidInputError",
+    "InvalidParameterError",
+    "NonFiniteError",
+    "ProblemFormatError",
+    "ProblemTooLargeError",
+    "ShapeError",
+]
+
+
+class CoulombError(Exception):
+    """Base class of every exception coulomb raises on purpose."""
+
+
+class InvalidInputError(CoulombError, ValueError):
+    """The input cannot be solved as given (checked before any work)."""
+
+
+class ShapeError(InvalidInputError):
+    """Arrays of the wrong dimension or of shapes that do not fit together."""
+
+
+class NonFiniteError(InvalidInputError):
+    """A NaN or an infinity in the data."""
+
+
+class InvalidParameterError(InvalidInputError):
+    """An option outside its domain (for example ``tol <= 0`` or an unknown method)."""
+
+
+class ProblemTooLargeError(InvalidInputError):
+    """The problem is too large for the chosen method (enumeration beyond n = 15)."""
+
+
+class ProblemFormatError(CoulombError, ValueError):
+    """A problem file that does not follow its format."""
+
+
+class InternalError(CoulombError, RuntimeError):
+    """A bug in coulomb (a Rust panic caught at the boundary). Please report it."""

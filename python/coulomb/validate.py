@@ -1,0 +1,130 @@
+"""Reproduce the reference figures of the seed chapter and report each against its value.
+
+``coulomb validate`` prints the table; :func:`run` returns its rows. Each row compares a
+figure computed by coulomb with the figure the chapter states (Satici, *Kinematics and Machine
+Dynamics*, ch. 11, after Stewart, SIAM Review 42(1), 2000), within a stated tolerance.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from . import lcp
+from .io import read_siconos_lcp
+
+__all__ = ["Row", "format_table", "run"]
+
+
+@dataclass(frozen=True)
+class Row:
+    """One reproduced figure."""
+
+    case: str
+    quantity: str
+    expected: float | str
+    computed: float | str
+    tolerance: float | None
+    passed: bool
+
+
+def _num(case: str, quantity: str, expected: float, computed: float, tol: float) -> Row:
+    return Row(case, quantity, expected, computed, tol, abs(computed - expected) <= tol)
+
+
+def _text(case: str, quantity: str, expected: str, computed: str) -> Row:
+    return Row(case, quantity, expected, computed, None, expected == computed)
+
+
+def _seed_rows() -> Iterator[Row]:
+    case = "scalar LCP w = 2z - 6"
+    r = lcp.solve([[2.0]], [-6.0])
+    yield _num(case, "z", 3.0, float(r.z[0]), 1e-12)
+    yield _num(case, "w", 0.0, float(r.w[0]), 1e-12)
+    yield _text(case, "status", "solved", r.status)
+    case = "scalar LCP w = -z - 1"
+    r = lcp.solve([[-1.0]], [-1.0])
+    yield _text(case, "status (no solution)", "ray_termination", r.status)
+    yield _text(case, "success", "False", str(bool(r.success)))
+
+
+def default_data_dir() -> Path | None:
+    """``$COULOMB_DATA``, else ``../shared/data`` beside a source checkout, if present."""
+    env = os.environ.get("COULOMB_DATA")
+    candidates = [Path(env)] if env else []
+    candidates.append(Path.cwd().parent / "shared" / "data")
+    candidates.append(Path(__file__).resolve().parents[3] / "shared" / "data")
+    for c in candidates:
+        if (c / "siconos-lcp").is_dir():
+            return c
+    return None
+
+
+def _data_rows(data: Path) -> Iterator[Row]:
+    folder = data / "siconos-lcp"
+    files = sorted(folder.glob("lcp_*.dat"))
+    # Problems without a solution (enumeration finds none, or Lemke's theory allows a ray):
+    # documented in SOURCE.md and checked by the test suite.
+    no_solution_expected = {"lcp_CPS_3", "lcp_Pang_isolated_sol_perturbed"}
+    solved = 0
+    honest = 0
+    for f in files:
+        p = read_siconos_lcp(f)
+        r = lcp.solve(p.M, p.q)
+        if p.name in no_solution_expected:
+            honest += int(not r.success)
+        else:
+            solved += int(r.success and r.error <= 1e-10)
+    expected = len(files) - len(no_solution_expected)
+    yield _text(
+        "Siconos LCP set", "solved to 1e-10", f"{expected}/{expected}", f"{solved}/{expected}"
+    )
+    yield _text("Siconos LCP set", "no false success", "2/2", f"{honest}/2")
+    murty = read_siconos_lcp(folder / "lcp_exp_murty2.dat")
+    r = lcp.solve(murty.M, murty.q, covering_vector=np.ones(murty.n))
+    yield _num("Murty's example, n = 6", "Lemke pivots (2^n)", 64.0, float(r.pivots), 0.0)
+
+
+def run(data: Path | None = None, progress: Callable[[str], None] | None = None) -> list[Row]:
+    """Every row: the seed's figures, then (if the benchmark data is found) the data set's."""
+    rows = list(_seed_rows())
+    data = data or default_data_dir()
+    if data is not None:
+        if progress:
+            progress(f"benchmark data: {data}")
+        rows.extend(_data_rows(data))
+    elif progress:
+        progress("benchmark data not found (set COULOMB_DATA): seed rows only")
+    return rows
+
+
+def _fmt(v: float | str) -> str:
+    return f"{v:.6g}" if isinstance(v, float) else str(v)
+
+
+def format_table(rows: list[Row]) -> str:
+    """A plain-text table of the rows."""
+    head = ("case", "quantity", "seed", "coulomb", "tolerance", "")
+    body = [
+        (
+            r.case,
+            r.quantity,
+            _fmt(r.expected),
+            _fmt(r.computed),
+            "exact" if r.tolerance in (None, 0.0) else f"{r.tolerance:.0e}",
+            "ok" if r.passed else "FAIL",
+        )
+        for r in rows
+    ]
+    widths = [max(len(str(x[i])) for x in [head, *body]) for i in range(len(head))]
+    lines = ["  ".join(str(c).ljust(w) for c, w in zip(head, widths, strict=True)).rstrip()]
+    lines.append("  ".join("-" * w for w in widths).rstrip())
+    for b in body:
+        lines.append("  ".join(str(c).ljust(w) for c, w in zip(b, widths, strict=True)).rstrip())
+    passed = sum(r.passed for r in rows)
+    lines.append(f"\n{passed} of {len(rows)} figures reproduced")
+    return "\n".join(lines)

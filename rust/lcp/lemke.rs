@@ -1,0 +1,714 @@
+//! Lemke's complementary pivoting method (the seed's "What the LCP solver guarantees").
+//!
+//! With a covering vector d > 0 and an artificial variable z0 >= 0, Lemke follows the
+//! almost-complementary path of
+//!
+//! ```text
+//!     w = q + M z + d z0,    z, w, z0 >= 0,    z_i w_i = 0,
+//! ```
+//!
+//! starting from z = 0, z0 = max_i(-q_i / d_i). Each pivot brings in the complement of the
+//! variable that just left; the path ends when z0 leaves the basis (a solution) or when the
+//! entering column has no blocking row (a secondary ray). For copositive-plus M (for example
+//! positive semidefinite M) a secondary ray proves that the LCP has no solution.
+//!
+//! Implementation notes:
+//!
+//! - The data are equilibrated first (see `scaling`), so the pivot tolerance and the
+//!   tie test are relative to the data's units; the default covering vector is all ones on the
+//!   equilibrated problem.
+//! - The tableau is *condensed*: only the n+1 nonbasic columns and the right-hand side are
+//!   stored, n x (n+2) row-major, and a pivot is one rank-one update of it (about n^2 fused
+//!   multiply-adds, contiguous by rows). It is allocated once per workspace; pivots allocate
+//!   nothing.
+//! - Ties in the minimum-ratio test are broken lexicographically on the rows of
+//!   `[q̄, B^{-1}]`, which makes the method finite on degenerate problems; z0 leaves first
+//!   whenever its row is among the ties (so the path stops at the first solution it meets).
+//! - The final basis is polished: its principal system `M_aa z_a = -q_a` is re-solved on the
+//!   original data by one factorization, and the polished answer is kept if its error is
+//!   smaller.
+
+use super::kernel::{self, RankOneUpdate};
+use super::scaling::Equilibration;
+use super::small::solve_principal;
+use super::{check_tol, passes, LcpMeasures, LcpRef, LcpSolution, LcpStatus, WarmStart};
+use crate::error::{check_finite, CoulombError, Result};
+
+/// Settings of [`solve_lemke`].
+#[derive(Clone, Debug)]
+pub struct LemkeSettings {
+    /// tolerance on the answer's error measures (both `error` and `scaled_error`), on the
+    /// original data.
+    pub tol: f64,
+    /// the pivot limit; `None` means `max(1000, 50 n)`.
+    pub max_pivots: Option<usize>,
+    /// the covering vector d > 0 in the units of q; `None` means all ones on the equilibrated
+    /// problem, which makes the pivot path independent of the rows' units.
+    pub covering_vector: Option<Vec<f64>>,
+    /// a guessed basis: the indices i with z_i > 0 (for example the previous time step's
+    /// active set). If it solves the LCP no pivot is made; otherwise Lemke starts cold.
+    pub warm_start: Option<Vec<usize>>,
+    /// re-solve the final basis's principal system and keep it if better.
+    pub polish: bool,
+    /// after a ray termination, how many other covering vectors to try (only when
+    /// `covering_vector` is `None`). A secondary ray proves infeasibility only for
+    /// copositive-plus M; for other matrices a different path may still find a solution.
+    pub restarts: usize,
+}
+
+impl Default for LemkeSettings {
+    fn default() -> Self {
+        Self {
+            tol: 1e-9,
+            max_pivots: None,
+            covering_vector: None,
+            warm_start: None,
+            polish: true,
+            restarts: 2,
+        }
+    }
+}
+
+/// relative size under which a tableau entry counts as zero in the ratio test.
+const PIVOT_EPS: f64 = 1e-11;
+/// relative gap within which two ratios count as tied.
+const TIE_EPS: f64 = 1e-9;
+/// relative size under which a basic variable's value counts as zero (degenerate).
+const RHS_EPS: f64 = 1e-13;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Loc {
+    Row(usize),
+    Col(usize),
+}
+
+/// How a pivoting run ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Ending {
+    Terminal,
+    Ray,
+    Limit,
+    NonFinite,
+}
+
+/// Storage for Lemke's method, sized once for a problem size and reused across solves (for
+/// example across the time steps of a simulation).
+pub struct LemkeWorkspace {
+    n: usize,
+    width: usize,
+    tableau: Vec<f64>,
+    pivot_row: Vec<f64>,
+    basic: Vec<usize>,
+    nonbasic: Vec<usize>,
+    loc: Vec<Loc>,
+    ties: Vec<usize>,
+    ties_next: Vec<usize>,
+    update: RankOneUpdate,
+}
+
+impl LemkeWorkspace {
+    /// a workspace for problems of size n: one n x (n+2) tableau and O(n) bookkeeping.
+    pub fn new(n: usize) -> Self {
+        let width = n + 2;
+        Self {
+            n,
+            width,
+            tableau: vec![0.0; n * width],
+            pivot_row: vec![0.0; width],
+            basic: vec![0; n],
+            nonbasic: vec![0; n + 1],
+            loc: vec![Loc::Row(0); 2 * n + 1],
+            ties: Vec::with_capacity(n),
+            ties_next: Vec::with_capacity(n),
+            update: kernel::select(),
+        }
+    }
+
+    /// the problem size this workspace holds.
+    pub fn size(&self) -> usize {
+        self.n
+    }
+
+    /// bytes of the tableau (the workspace's dominant memory).
+    pub fn tableau_bytes(&self) -> usize {
+        self.tableau.len() * std::mem::size_of::<f64>()
+    }
+
+    fn z0(&self) -> usize {
+        2 * self.n
+    }
+
+    fn complement(&self, var: usize) -> usize {
+        if var < self.n {
+            var + self.n
+        } else {
+            var - self.n
+        }
+    }
+
+    /// w is basic in every row, z and z0 are the nonbasic columns.
+    fn load(&mut self, lcp: &LcpRef<'_>, eq: &Equilibration, cover: &[f64]) {
+        let n = self.n;
+        let w = self.width;
+        for (i, (row, mrow)) in self
+            .tableau
+            .chunks_exact_mut(w)
+            .zip(lcp.m.chunks_exact(n.max(1)))
+            .enumerate()
+        {
+            let r = eq.row[i];
+            for ((t, m), c) in row.iter_mut().zip(mrow).zip(&eq.col) {
+                *t = r * m * c;
+            }
+            row[n] = cover[i];
+            row[n + 1] = r * lcp.q[i] / eq.sigma;
+            self.basic[i] = i;
+            self.loc[i] = Loc::Row(i);
+        }
+        for j in 0..=n {
+            self.nonbasic[j] = n + j;
+            self.loc[n + j] = Loc::Col(j);
+        }
+    }
+
+    #[inline]
+    fn at(&self, i: usize, j: usize) -> f64 {
+        self.tableau[i * self.width + j]
+    }
+
+    /// `B^{-1}[i, k]`: the coefficient of the original w_k in row i of the full tableau.
+    #[inline]
+    fn inverse_basis(&self, i: usize, k: usize) -> f64 {
+        match self.loc[k] {
+            Loc::Row(r) => {
+                if r == i {
+                    1.0
+                } else {
+                    0.0
+                }
+            }
+            Loc::Col(c) => -self.at(i, c),
+        }
+    }
+
+    /// Keeps, among `self.ties`, the rows whose lexicographic ratio
+    /// `B^{-1}[i, :] / (-T[i, s])` is smallest (the perturbation `q + (ε, ε², …)` argument).
+    /// `sign` is +1 for a minimum-ratio test and -1 for the initial maximum-ratio test.
+    fn lexicographic(&mut self, s: usize, sign: f64) -> usize {
+        let n = self.n;
+        // Rounding leaves ~1e-16 where exact arithmetic has 0, so entries are compared at the
+        // scale of the tied rows' whole lexicographic vectors, not entry by entry.
+        let mut scale: f64 = 0.0;
+        for &i in &self.ties {
+            let a = -self.at(i, s);
+            for k in 0..n {
+                scale = scale.max((self.inverse_basis(i, k) / a).abs());
+            }
+        }
+        let tol = TIE_EPS * scale;
+        for k in 0..n {
+            if self.ties.len() <= 1 {
+                break;
+            }
+            let mut best = f64::INFINITY;
+            for &i in &self.ties {
+                let v = sign * self.inverse_basis(i, k) / (-self.at(i, s));
+                best = best.min(v);
+            }
+            self.ties_next.clear();
+            for &i in &self.ties {
+                let v = sign * self.inverse_basis(i, k) / (-self.at(i, s));
+                if v <= best + tol {
+                    self.ties_next.push(i);
+                }
+            }
+            std::mem::swap(&mut self.ties, &mut self.ties_next);
+        }
+        // Exact arithmetic leaves one row; with rounding, prefer the largest pivot.
+        let mut pick = self.ties[0];
+        for &i in &self.ties {
+            if self.at(i, s).abs() > self.at(pick, s).abs() {
+                pick = i;
+            }
+        }
+        pick
+    }
+
+    /// the blocking row when the variable in column s enters, or `None` on a secondary ray.
+    fn ratio_test(&mut self, s: usize) -> Option<usize> {
+        let n = self.n;
+        let rhs = n + 1;
+        let mut colmax: f64 = 0.0;
+        for i in 0..n {
+            colmax = colmax.max(self.at(i, s).abs());
+        }
+        let piv_tol = PIVOT_EPS * colmax.max(1.0);
+        let zero_rhs = self.rhs_noise();
+        let value = |ws: &Self, i: usize| {
+            let b = ws.at(i, rhs);
+            if b <= zero_rhs {
+                0.0
+            } else {
+                b
+            }
+        };
+        let mut theta = f64::INFINITY;
+        for i in 0..n {
+            let a = self.at(i, s);
+            if a < -piv_tol {
+                let t = value(self, i) / (-a);
+                theta = theta.min(t);
+            }
+        }
+        if !theta.is_finite() {
+            return None;
+        }
+        let tie = TIE_EPS * theta;
+        self.ties.clear();
+        let z0 = self.z0();
+        let mut z0_row = None;
+        for i in 0..n {
+            let a = self.at(i, s);
+            if a < -piv_tol {
+                let t = value(self, i) / (-a);
+                if t <= theta + tie {
+                    if self.basic[i] == z0 {
+                        z0_row = Some(i);
+                    }
+                    self.ties.push(i);
+                }
+            }
+        }
+        if let Some(r) = z0_row {
+            return Some(r);
+        }
+        if self.ties.len() == 1 {
+            return Some(self.ties[0]);
+        }
+        Some(self.lexicographic(s, 1.0))
+    }
+
+    /// basic values at most this are zero up to rounding (degenerate rows).
+    fn rhs_noise(&self) -> f64 {
+        let rhs = self.n + 1;
+        let mut scale: f64 = 1.0;
+        for i in 0..self.n {
+            scale = scale.max(self.at(i, rhs).abs());
+        }
+        RHS_EPS * scale
+    }
+
+    /// the row that leaves when z0 first enters: the one needing the largest z0.
+    fn initial_row(&mut self) -> usize {
+        let n = self.n;
+        let (zc, rhs) = (n, n + 1);
+        let mut theta = f64::NEG_INFINITY;
+        for i in 0..n {
+            theta = theta.max(-self.at(i, rhs) / self.at(i, zc));
+        }
+        let tie = TIE_EPS * theta.abs().max(1e-12);
+        self.ties.clear();
+        for i in 0..n {
+            if -self.at(i, rhs) / self.at(i, zc) >= theta - tie {
+                self.ties.push(i);
+            }
+        }
+        if self.ties.len() == 1 {
+            return self.ties[0];
+        }
+        // maximum ratio: the lexicographic argument with the sign reversed
+        self.lexicographic(zc, -1.0)
+    }
+
+    /// exchanges the basic variable of row r with the nonbasic variable of column s.
+    fn pivot(&mut self, r: usize, s: usize) -> bool {
+        let w = self.width;
+        let piv = self.tableau[r * w + s];
+        {
+            let row = &mut self.tableau[r * w..(r + 1) * w];
+            let inv = 1.0 / piv;
+            for (p, x) in self.pivot_row.iter_mut().zip(row.iter()) {
+                *p = -x * inv;
+            }
+            self.pivot_row[s] = inv;
+            row.copy_from_slice(&self.pivot_row);
+        }
+        (self.update)(&mut self.tableau, w, r, s, &self.pivot_row);
+        let entering = self.nonbasic[s];
+        let leaving = self.basic[r];
+        self.basic[r] = entering;
+        self.nonbasic[s] = leaving;
+        self.loc[entering] = Loc::Row(r);
+        self.loc[leaving] = Loc::Col(s);
+        piv.is_finite() && self.tableau[r * w + w - 1].is_finite()
+    }
+
+    /// Runs the complementary pivots from the all-w basis. Returns how it ended and the pivots.
+    fn run(&mut self, max_pivots: usize) -> (Ending, usize) {
+        let n = self.n;
+        let z0 = self.z0();
+        let r = self.initial_row();
+        let mut leaving = self.basic[r];
+        if !self.pivot(r, n) {
+            return (Ending::NonFinite, 1);
+        }
+        let mut pivots = 1;
+        loop {
+            if leaving == z0 {
+                return (Ending::Terminal, pivots);
+            }
+            if pivots >= max_pivots {
+                return (Ending::Limit, pivots);
+            }
+            let entering = self.complement(leaving);
+            let s = match self.loc[entering] {
+                Loc::Col(c) => c,
+                // cannot happen: a variable that just left is nonbasic, so is its complement
+                Loc::Row(_) => return (Ending::NonFinite, pivots),
+            };
+            let r = match self.ratio_test(s) {
+                Some(r) => r,
+                None => return (Ending::Ray, pivots),
+            };
+            leaving = self.basic[r];
+            pivots += 1;
+            if !self.pivot(r, s) {
+                return (Ending::NonFinite, pivots);
+            }
+        }
+    }
+
+    /// z in original units from the current basis (z0 ignored), and the basic z indices.
+    fn extract(&self, eq: &Equilibration, z: &mut [f64], basis: &mut Vec<usize>) {
+        let n = self.n;
+        z.iter_mut().for_each(|v| *v = 0.0);
+        basis.clear();
+        for i in 0..n {
+            let var = self.basic[i];
+            if var >= n && var < 2 * n {
+                let k = var - n;
+                z[k] = eq.sigma * eq.col[k] * self.at(i, n + 1).max(0.0);
+                basis.push(k);
+            }
+        }
+        basis.sort_unstable();
+    }
+}
+
+/// `a` is better than `b` when its worse relative measure is smaller.
+fn better(a: &LcpMeasures, b: &LcpMeasures) -> bool {
+    a.error.max(a.scaled_error) < b.error.max(b.scaled_error)
+}
+
+struct Candidate {
+    z: Vec<f64>,
+    w: Vec<f64>,
+    measures: LcpMeasures,
+}
+
+fn candidate(lcp: &LcpRef<'_>, eq: &Equilibration, z: Vec<f64>) -> Candidate {
+    let w = lcp.w(&z);
+    let measures = lcp.measures(&z, &w, eq);
+    Candidate { z, w, measures }
+}
+
+/// the principal solution of basis `a` on the original data, clamped to z >= 0.
+fn principal(lcp: &LcpRef<'_>, eq: &Equilibration, a: &[usize]) -> Option<Candidate> {
+    let za = solve_principal(lcp.n, lcp.m, lcp.q, a)?;
+    let mut z = vec![0.0; lcp.n];
+    for (&i, v) in a.iter().zip(za) {
+        z[i] = v.max(0.0);
+    }
+    Some(candidate(lcp, eq, z))
+}
+
+fn validate(lcp: &LcpRef<'_>, s: &LemkeSettings) -> Result<()> {
+    check_tol(s.tol)?;
+    if let Some(d) = &s.covering_vector {
+        if d.len() != lcp.n {
+            return Err(CoulombError::Shape(format!(
+                "covering_vector has length {}, expected {}",
+                d.len(),
+                lcp.n
+            )));
+        }
+        check_finite("covering_vector", d)?;
+        if let Some(k) = d.iter().position(|v| *v <= 0.0) {
+            return Err(CoulombError::InvalidParameter(format!(
+                "covering_vector must be positive, entry {k} is {}",
+                d[k]
+            )));
+        }
+    }
+    if let Some(b) = &s.warm_start {
+        let mut seen = vec![false; lcp.n];
+        for &k in b {
+            if k >= lcp.n {
+                return Err(CoulombError::InvalidParameter(format!(
+                    "warm_start index {k} is out of range for n = {}",
+                    lcp.n
+                )));
+            }
+            if seen[k] {
+                return Err(CoulombError::InvalidParameter(format!(
+                    "warm_start index {k} appears twice"
+                )));
+            }
+            seen[k] = true;
+        }
+    }
+    if s.max_pivots == Some(0) {
+        return Err(CoulombError::InvalidParameter(
+            "max_pivots must be at least 1".into(),
+        ));
+    }
+    Ok(())
+}
+
+/// Solves the LCP by Lemke's method with a fresh workspace. See [`solve_lemke_with`].
+pub fn solve_lemke(lcp: &LcpRef<'_>, settings: &LemkeSettings) -> Result<LcpSolution> {
+    let mut ws = LemkeWorkspace::new(lcp.n);
+    solve_lemke_with(&mut ws, lcp, settings)
+}
+
+/// The i-th covering vector on the equilibrated problem: the user's (scaled), all ones, then
+/// for restarts the user-units ones and deterministic spreads.
+fn covering(k: usize, eq: &Equilibration, user: Option<&[f64]>, out: &mut [f64]) {
+    match (user, k) {
+        (Some(d), _) => {
+            for ((o, r), di) in out.iter_mut().zip(&eq.row).zip(d) {
+                *o = r * di;
+            }
+        }
+        (None, 0) => out.iter_mut().for_each(|v| *v = 1.0),
+        (None, 1) => out.copy_from_slice(&eq.row),
+        (None, _) => {
+            // a fixed low-discrepancy spread in [0.5, 1.5): reproducible, never zero
+            let phi = 0.618_033_988_749_895 * k as f64;
+            for (i, v) in out.iter_mut().enumerate() {
+                *v = 0.5 + ((i as f64 + 1.0) * phi).fract();
+            }
+        }
+    }
+    let dmax = out.iter().fold(0.0f64, |m, v| m.max(*v));
+    if dmax > 0.0 {
+        out.iter_mut().for_each(|v| *v /= dmax);
+    }
+}
+
+/// Solves the LCP by Lemke's method, reusing `ws` (resized if needed).
+///
+/// Never fails on a well-formed problem: a secondary ray, the pivot limit or a numerical
+/// breakdown is reported in the result's status. Errors are for bad input only.
+pub fn solve_lemke_with(
+    ws: &mut LemkeWorkspace,
+    lcp: &LcpRef<'_>,
+    settings: &LemkeSettings,
+) -> Result<LcpSolution> {
+    validate(lcp, settings)?;
+    let n = lcp.n;
+    if ws.size() != n {
+        *ws = LemkeWorkspace::new(n);
+    }
+    let eq = Equilibration::compute(n, lcp.m, lcp.q);
+    let tol = settings.tol;
+    let mut out = LcpSolution {
+        z: vec![0.0; n],
+        w: lcp.q.to_vec(),
+        status: LcpStatus::Solved,
+        message: String::new(),
+        measures: lcp.measures(&vec![0.0; n], lcp.q, &eq),
+        pivots: 0,
+        iterations: 0,
+        basis: Vec::new(),
+        warm_start: WarmStart::None,
+        pivots_saved: 0,
+        polished: false,
+        restarts: 0,
+        solutions: Vec::new(),
+    };
+
+    if let Some(guess) = &settings.warm_start {
+        let mut a = guess.clone();
+        a.sort_unstable();
+        if let Some(c) = principal(lcp, &eq, &a) {
+            if passes(&c.measures, tol) {
+                out.warm_start = WarmStart::Accepted;
+                out.pivots_saved = a.len() + 1;
+                out.basis = a;
+                out.z = c.z;
+                out.w = c.w;
+                out.measures = c.measures;
+                out.message = "solved by the warm-start basis without pivoting".into();
+                return Ok(out);
+            }
+        }
+        out.warm_start = WarmStart::Rejected;
+    }
+
+    if passes(&out.measures, tol) {
+        out.message = "z = 0 solves the problem (q >= 0)".into();
+        return Ok(out);
+    }
+
+    let max_pivots = settings.max_pivots.unwrap_or_else(|| (50 * n).max(1000));
+    let user = settings.covering_vector.as_deref();
+    let tries = if user.is_some() {
+        1
+    } else {
+        1 + settings.restarts
+    };
+    let mut cover = vec![0.0; n];
+    let mut z = vec![0.0; n];
+    let mut basis = Vec::with_capacity(n);
+    for attempt in 0..tries {
+        covering(attempt, &eq, user, &mut cover);
+        ws.load(lcp, &eq, &cover);
+        let (ending, pivots) = ws.run(max_pivots);
+        out.pivots += pivots;
+        out.restarts = attempt;
+        ws.extract(&eq, &mut z, &mut basis);
+        let mut best = candidate(lcp, &eq, z.clone());
+        let mut polished = false;
+        if ending == Ending::Terminal && settings.polish {
+            if let Some(p) = principal(lcp, &eq, &basis) {
+                if better(&p.measures, &best.measures) {
+                    best = p;
+                    polished = true;
+                }
+            }
+        }
+        out.z = best.z;
+        out.w = best.w;
+        out.measures = best.measures;
+        out.basis = basis.clone();
+        out.polished = polished;
+        let m = &out.measures;
+        match ending {
+            Ending::Terminal if passes(m, tol) => {
+                out.status = LcpStatus::Solved;
+                out.message = format!(
+                    "solved in {} pivots (error {:.2e}{})",
+                    out.pivots,
+                    m.error,
+                    if polished { ", polished" } else { "" }
+                );
+                return Ok(out);
+            }
+            Ending::Terminal => {
+                out.status = LcpStatus::NumericalFailure;
+                out.message = format!(
+                    "z0 left the basis but the answer fails tol {tol:.1e}: error {:.2e}, \
+                     scaled error {:.2e} (ill-conditioned basis)",
+                    m.error, m.scaled_error
+                );
+                return Ok(out);
+            }
+            Ending::Ray => {
+                out.status = LcpStatus::RayTermination;
+                out.message = format!(
+                    "ray termination after {} pivots with {} covering vector(s): no solution \
+                     found on Lemke's path (for copositive-plus M, e.g. positive semidefinite, \
+                     this proves there is none)",
+                    out.pivots,
+                    attempt + 1
+                );
+            }
+            Ending::Limit => {
+                out.status = LcpStatus::PivotLimit;
+                out.message = format!(
+                    "stopped at the pivot limit ({max_pivots}) with error {:.2e}",
+                    m.error
+                );
+                return Ok(out);
+            }
+            Ending::NonFinite => {
+                out.status = LcpStatus::NumericalFailure;
+                out.message = format!("the tableau became non-finite after {} pivots", out.pivots);
+                return Ok(out);
+            }
+        }
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lemke(n: usize, m: &[f64], q: &[f64]) -> LcpSolution {
+        let lcp = LcpRef::new(n, m, q).unwrap();
+        solve_lemke(&lcp, &LemkeSettings::default()).unwrap()
+    }
+
+    #[test]
+    fn seed_scalar_lcp_w_equals_2z_minus_6() {
+        let s = lemke(1, &[2.0], &[-6.0]);
+        assert_eq!(s.status, LcpStatus::Solved);
+        assert!((s.z[0] - 3.0).abs() < 1e-14);
+        assert!(s.w[0].abs() < 1e-14);
+    }
+
+    #[test]
+    fn seed_scalar_lcp_w_equals_minus_z_minus_1_has_no_solution() {
+        let s = lemke(1, &[-1.0], &[-1.0]);
+        assert_eq!(s.status, LcpStatus::RayTermination);
+        assert!(!s.success());
+    }
+
+    #[test]
+    fn nonnegative_q_needs_no_pivot() {
+        let s = lemke(2, &[1.0, 0.0, 0.0, 1.0], &[0.0, 3.0]);
+        assert!(s.success());
+        assert_eq!(s.pivots, 0);
+        assert_eq!(s.z, vec![0.0, 0.0]);
+    }
+
+    #[test]
+    fn warm_start_with_the_right_basis_makes_no_pivot() {
+        let m = [2.0, 1.0, 1.0, 2.0];
+        let q = [-3.0, -3.0];
+        let cold = lemke(2, &m, &q);
+        assert!(cold.success());
+        let lcp = LcpRef::new(2, &m, &q).unwrap();
+        let s = LemkeSettings {
+            warm_start: Some(cold.basis.clone()),
+            ..Default::default()
+        };
+        let warm = solve_lemke(&lcp, &s).unwrap();
+        assert_eq!(warm.warm_start, WarmStart::Accepted);
+        assert_eq!(warm.pivots, 0);
+        assert!(warm.pivots_saved >= 3);
+        for (a, b) in warm.z.iter().zip(&cold.z) {
+            assert!((a - b).abs() < 1e-12);
+        }
+        let bad = LemkeSettings {
+            warm_start: Some(vec![]),
+            ..Default::default()
+        };
+        let fallback = solve_lemke(&lcp, &bad).unwrap();
+        assert_eq!(fallback.warm_start, WarmStart::Rejected);
+        assert!(fallback.success());
+    }
+
+    #[test]
+    fn bad_settings_are_refused() {
+        let lcp = LcpRef::new(1, &[1.0], &[-1.0]).unwrap();
+        for s in [
+            LemkeSettings {
+                tol: 0.0,
+                ..Default::default()
+            },
+            LemkeSettings {
+                covering_vector: Some(vec![-1.0]),
+                ..Default::default()
+            },
+            LemkeSettings {
+                warm_start: Some(vec![3]),
+                ..Default::default()
+            },
+        ] {
+            assert!(solve_lemke(&lcp, &s).is_err());
+        }
+    }
+}

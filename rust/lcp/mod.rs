@@ -1,0 +1,316 @@
+//! Linear complementarity problems (the seed's "Linear complementarity problems"):
+//!
+//! ```text
+//!     find z  with  0 <= z  ⊥  w = M z + q >= 0,
+//! ```
+//!
+//! i.e. `z_i >= 0`, `w_i >= 0` and `z_i w_i = 0` for every i.
+//!
+//! Three methods share one result type, [`LcpSolution`]:
+//!
+//! - [`lemke`]: Lemke's complementary pivoting with a lexicographic ratio test (the default,
+//!   and the only one that can certify that its path ends without a solution);
+//! - [`pgs`]: projected Gauss-Seidel / SOR for symmetric M with a positive diagonal;
+//! - [`enumerate`]: every complementary basis, for small n: the test oracle.
+//!
+//! Every answer is checked against the *original* M and q with the error measures the
+//! literature reports (`||min(z, w)||_2 / max(1, ||q||_2)`), so figures compare with peers.
+
+pub mod enumerate;
+mod kernel;
+pub mod lemke;
+pub mod pgs;
+mod scaling;
+mod small;
+
+use crate::error::{check_finite, CoulombError, Result};
+use crate::matrix::DenseMatrix;
+
+pub use enumerate::{solve_enumerate, EnumerateSettings};
+pub use lemke::{solve_lemke, LemkeSettings, LemkeWorkspace};
+pub use pgs::{solve_pgs, PgsSettings};
+
+/// the vector instruction set Lemke's pivot kernel uses on this CPU.
+pub fn simd_level() -> &'static str {
+    kernel::level()
+}
+
+/// How a solve ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum LcpStatus {
+    /// an answer that passes `tol` on the original data.
+    Solved,
+    /// Lemke's path left along a secondary ray: no solution was found. For copositive-plus M
+    /// (for example positive semidefinite M) this proves the LCP has no solution.
+    RayTermination,
+    /// Lemke stopped at its pivot limit.
+    PivotLimit,
+    /// an iterative method stopped at its iteration limit before reaching `tol`.
+    IterationLimit,
+    /// the arithmetic broke down (a non-finite tableau, or a terminal basis whose answer fails
+    /// `tol` even after polishing).
+    NumericalFailure,
+    /// complete enumeration found no complementary solution.
+    NoSolution,
+}
+
+impl LcpStatus {
+    /// the status as the short string the Python API reports.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            LcpStatus::Solved => "solved",
+            LcpStatus::RayTermination => "ray_termination",
+            LcpStatus::PivotLimit => "pivot_limit",
+            LcpStatus::IterationLimit => "iteration_limit",
+            LcpStatus::NumericalFailure => "numerical_failure",
+            LcpStatus::NoSolution => "no_solution",
+        }
+    }
+}
+
+impl std::fmt::Display for LcpStatus {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// What happened to a warm-start basis handed to Lemke.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum WarmStart {
+    /// no basis was given.
+    None,
+    /// the guessed basis solved the LCP directly: no pivots were needed.
+    Accepted,
+    /// the guessed basis was singular or infeasible; Lemke started cold.
+    Rejected,
+}
+
+impl WarmStart {
+    /// the outcome as a short string.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            WarmStart::None => "none",
+            WarmStart::Accepted => "accepted",
+            WarmStart::Rejected => "rejected",
+        }
+    }
+}
+
+/// The error measures of an answer z, always computed from the original M and q.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LcpMeasures {
+    /// `||min(z, w)||_2 / max(1, ||q||_2)` with `w = M z + q` (DESIGN.md, as Siconos reports it).
+    pub error: f64,
+    /// `||min(z', w')||_inf` on the equilibrated problem (rows and columns scaled to unit size,
+    /// q normalised): the same answer judged independently of the data's units.
+    pub scaled_error: f64,
+    /// `min_i z_i` (negative means infeasible).
+    pub min_z: f64,
+    /// `min_i w_i` (negative means infeasible).
+    pub min_w: f64,
+    /// the worst complementarity product `max_i |z_i w_i|`.
+    pub max_complementarity: f64,
+}
+
+/// The answer of any LCP method.
+#[derive(Clone, Debug)]
+pub struct LcpSolution {
+    /// the complementary variable z.
+    pub z: Vec<f64>,
+    /// `w = M z + q`, recomputed from the original data.
+    pub w: Vec<f64>,
+    /// how the solve ended.
+    pub status: LcpStatus,
+    /// a one-line human explanation of the status.
+    pub message: String,
+    /// the error measures of `z`.
+    pub measures: LcpMeasures,
+    /// basis exchanges performed (Lemke), 0 for the other methods.
+    pub pivots: usize,
+    /// sweeps (PGS) or bases examined (enumeration), 0 for Lemke.
+    pub iterations: usize,
+    /// indices i whose z_i is basic at the end (Lemke and enumeration): the active set to pass
+    /// as the next warm start.
+    pub basis: Vec<usize>,
+    /// what became of the warm start.
+    pub warm_start: WarmStart,
+    /// a lower bound on the pivots a warm start saved: a cold start needs at least
+    /// `|basis| + 1` pivots to reach the same basis.
+    pub pivots_saved: usize,
+    /// whether the final polish (re-solving the principal system of the final basis) improved
+    /// the answer and was kept.
+    pub polished: bool,
+    /// covering vectors tried by Lemke (1 unless a ray termination triggered a restart).
+    pub restarts: usize,
+    /// every distinct solution (enumeration only; empty otherwise).
+    pub solutions: Vec<Vec<f64>>,
+}
+
+impl LcpSolution {
+    /// whether the answer passes the tolerance on the original data.
+    pub fn success(&self) -> bool {
+        self.status == LcpStatus::Solved
+    }
+}
+
+/// A checked LCP: square finite M and finite q of matching length.
+#[derive(Clone, Copy, Debug)]
+pub struct LcpRef<'a> {
+    /// problem size.
+    pub n: usize,
+    /// M row-major, n*n entries.
+    pub m: &'a [f64],
+    /// q, n entries.
+    pub q: &'a [f64],
+}
+
+impl<'a> LcpRef<'a> {
+    /// checks shapes and finiteness before any work.
+    pub fn new(n: usize, m: &'a [f64], q: &'a [f64]) -> Result<Self> {
+        if m.len() != n * n {
+            return Err(CoulombError::Shape(format!(
+                "M must be {n} x {n} ({} entries) to match q of length {n}, got {} entries",
+                n * n,
+                m.len()
+            )));
+        }
+        if q.len() != n {
+            return Err(CoulombError::Shape(format!(
+                "q has length {}, expected {n}",
+                q.len()
+            )));
+        }
+        check_finite("M", m)?;
+        check_finite("q", q)?;
+        Ok(Self { n, m, q })
+    }
+
+    /// from a dense matrix and a vector.
+    pub fn from_dense(m: &'a DenseMatrix, q: &'a [f64]) -> Result<Self> {
+        if !m.is_square() {
+            return Err(CoulombError::Shape(format!(
+                "M must be square, got {} x {}",
+                m.nrows, m.ncols
+            )));
+        }
+        Self::new(m.nrows, &m.data, q)
+    }
+
+    /// `w = M z + q` from the original data.
+    pub fn w(&self, z: &[f64]) -> Vec<f64> {
+        let n = self.n;
+        (0..n)
+            .map(|i| {
+                let row = &self.m[i * n..(i + 1) * n];
+                row.iter().zip(z).map(|(a, b)| a * b).sum::<f64>() + self.q[i]
+            })
+            .collect()
+    }
+
+    /// the error measures of z (see [`LcpMeasures`]).
+    pub fn measures(&self, z: &[f64], w: &[f64], scaling: &scaling::Equilibration) -> LcpMeasures {
+        let qnorm = norm2(self.q);
+        let mut sq = 0.0;
+        let mut scaled: f64 = 0.0;
+        let mut min_z = f64::INFINITY;
+        let mut min_w = f64::INFINITY;
+        let mut comp: f64 = 0.0;
+        for i in 0..self.n {
+            let m = z[i].min(w[i]);
+            sq += m * m;
+            let zs = z[i] / (scaling.col[i] * scaling.sigma);
+            let ws = w[i] * scaling.row[i] / scaling.sigma;
+            scaled = scaled.max(zs.min(ws).abs());
+            min_z = min_z.min(z[i]);
+            min_w = min_w.min(w[i]);
+            comp = comp.max((z[i] * w[i]).abs());
+        }
+        if self.n == 0 {
+            min_z = 0.0;
+            min_w = 0.0;
+        }
+        LcpMeasures {
+            error: sq.sqrt() / qnorm.max(1.0),
+            scaled_error: scaled,
+            min_z,
+            min_w,
+            max_complementarity: comp,
+        }
+    }
+}
+
+/// `||x||_2`
+pub(crate) fn norm2(x: &[f64]) -> f64 {
+    x.iter().map(|v| v * v).sum::<f64>().sqrt()
+}
+
+/// the measures of z on `lcp`, equilibrating it first (for callers outside a solve, such as
+/// checking a peer's answer).
+pub fn measure(lcp: &LcpRef<'_>, z: &[f64]) -> (Vec<f64>, LcpMeasures) {
+    let eq = scaling::Equilibration::compute(lcp.n, lcp.m, lcp.q);
+    let w = lcp.w(z);
+    let m = lcp.measures(z, &w, &eq);
+    (w, m)
+}
+
+/// whether an answer's measures pass `tol` (both the literature's error and the unit-free one).
+pub(crate) fn passes(m: &LcpMeasures, tol: f64) -> bool {
+    m.error <= tol && m.scaled_error <= tol
+}
+
+/// Which method [`solve`] runs, with its settings.
+#[derive(Clone, Debug)]
+pub enum Method {
+    /// Lemke's complementary pivoting.
+    Lemke(LemkeSettings),
+    /// projected Gauss-Seidel / SOR.
+    Pgs(PgsSettings),
+    /// complete enumeration of complementary bases.
+    Enumerate(EnumerateSettings),
+}
+
+/// Solves `0 <= z ⊥ M z + q >= 0` with the chosen method.
+pub fn solve(lcp: &LcpRef<'_>, method: &Method) -> Result<LcpSolution> {
+    match method {
+        Method::Lemke(s) => solve_lemke(lcp, s),
+        Method::Pgs(s) => solve_pgs(lcp, s),
+        Method::Enumerate(s) => solve_enumerate(lcp, s),
+    }
+}
+
+pub(crate) fn check_tol(tol: f64) -> Result<()> {
+    if !(tol.is_finite() && tol > 0.0) {
+        return Err(CoulombError::InvalidParameter(format!(
+            "tol must be a positive finite number, got {tol}"
+        )));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shape_errors_are_specific() {
+        let err = LcpRef::new(2, &[1.0, 0.0, 0.0], &[1.0, 2.0]).unwrap_err();
+        assert!(matches!(err, CoulombError::Shape(_)));
+        let err = LcpRef::new(1, &[1.0], &[1.0, 2.0]).unwrap_err();
+        assert!(matches!(err, CoulombError::Shape(_)));
+        let err = LcpRef::new(1, &[f64::NAN], &[1.0]).unwrap_err();
+        assert!(matches!(err, CoulombError::NonFinite(_)));
+    }
+
+    #[test]
+    fn measures_match_the_definition() {
+        // z = (1, 0), w = (0, -2): min = (0, -2), error = 2 / max(1, ||q||)
+        let m = [1.0, 0.0, 0.0, 1.0];
+        let q = [-1.0, -2.0];
+        let lcp = LcpRef::new(2, &m, &q).unwrap();
+        let (w, meas) = measure(&lcp, &[1.0, 0.0]);
+        assert_eq!(w, vec![0.0, -2.0]);
+        assert!((meas.error - 2.0 / 5f64.sqrt()).abs() < 1e-15);
+        assert_eq!(meas.min_w, -2.0);
+        assert_eq!(meas.max_complementarity, 0.0);
+    }
+}

@@ -1,0 +1,22 @@
+//! coulomb: rigid-body dynamics with Coulomb friction and impact.
+//!
+//! The physics and algorithms follow the chapter "Rigid-Body Dynamics with Friction and
+//! Impact" (after D. E. Stewart, SIAM Review 42(1), 2000). This crate is the Rust core:
+//!
+//! - [`lcp`]: linear complementarity problems `0 <= z ⊥ M z + q >= 0` — Lemke's complementary
+//!   pivoting (the certified default), projected Gauss-Seidel, and complete enumeration.
+//! - [`io`]: readers for the standard benchmark formats (Siconos text files).
+//!
+//! The Python bindings (`coulomb._core`) live behind the `python` feature.
+#![allow(non_snake_case)]
+
+pub mod error;
+pub mod io;
+pub mod lcp;
+pub mod matrix;
+
+#[cfg(feature = "python")]
+mod python;
+
+pub use error::{CoulombError, Result};
+pub use matrix::DenseMatrix;

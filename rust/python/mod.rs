@@ -1,0 +1,264 @@
+//! `coulomb._core`: thin PyO3 bindings. They convert and check arrays (zero-copy where the
+//! input is already a C-contiguous float64 array), release the GIL around every solve, turn
+//! each error kind into its own Python exception (defined in `coulomb.errors`), and add no
+//! numerics of their own.
+
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::path::PathBuf;
+
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyRuntimeError};
+use pyo3::prelude::*;
+use pyo3::sync::PyOnceLock;
+use pyo3::types::{PyDict, PyType};
+
+use crate::error::CoulombError;
+use crate::io::ReadError;
+use crate::lcp::{
+    self, EnumerateSettings, LcpRef, LcpSolution, LemkeSettings, Method, PgsSettings,
+};
+
+static SHAPE_ERROR: PyOnceLock<Py<PyType>> = PyOnceLock::new();
+static NON_FINITE_ERROR: PyOnceLock<Py<PyType>> = PyOnceLock::new();
+static INVALID_PARAMETER_ERROR: PyOnceLock<Py<PyType>> = PyOnceLock::new();
+static TOO_LARGE_ERROR: PyOnceLock<Py<PyType>> = PyOnceLock::new();
+static FORMAT_ERROR: PyOnceLock<Py<PyType>> = PyOnceLock::new();
+static INTERNAL_ERROR: PyOnceLock<Py<PyType>> = PyOnceLock::new();
+
+fn raise(py: Python<'_>, cell: &PyOnceLock<Py<PyType>>, name: &str, msg: String) -> PyErr {
+    match cell.import(py, "coulomb.errors", name) {
+        Ok(ty) => PyErr::from_type(ty.clone(), msg),
+        Err(e) => e,
+    }
+}
+
+fn to_py(py: Python<'_>, err: CoulombError) -> PyErr {
+    let msg = err.to_string();
+    match err {
+        CoulombError::Shape(_) => raise(py, &SHAPE_ERROR, "ShapeError", msg),
+        CoulombError::NonFinite(_) => raise(py, &NON_FINITE_ERROR, "NonFiniteError", msg),
+        CoulombError::InvalidParameter(_) => {
+            raise(py, &INVALID_PARAMETER_ERROR, "InvalidParameterError", msg)
+        }
+        CoulombError::TooLarge(_) => raise(py, &TOO_LARGE_ERROR, "ProblemTooLargeError", msg),
+        CoulombError::Read(ReadError::Io { source, .. })
+            if source.kind() == std::io::ErrorKind::NotFound =>
+        {
+            PyFileNotFoundError::new_err(msg)
+        }
+        CoulombError::Read(ReadError::Io { .. }) => PyOSError::new_err(msg),
+        CoulombError::Read(ReadError::Format { .. }) => {
+            raise(py, &FORMAT_ERROR, "ProblemFormatError", msg)
+        }
+    }
+}
+
+/// runs `f` with the GIL released; a Rust panic becomes `coulomb.errors.InternalError`.
+fn guarded<T: Send>(
+    py: Python<'_>,
+    f: impl FnOnce() -> Result<T, CoulombError> + Send,
+) -> PyResult<T> {
+    let out = py.detach(|| catch_unwind(AssertUnwindSafe(f)));
+    match out {
+        Ok(Ok(v)) => Ok(v),
+        Ok(Err(e)) => Err(to_py(py, e)),
+        Err(panic) => {
+            let what = panic
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| panic.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "unknown panic".into());
+            let msg = format!("internal error in coulomb (please report): {what}");
+            let err = raise(py, &INTERNAL_ERROR, "InternalError", msg.clone());
+            if err.is_instance_of::<PyRuntimeError>(py) {
+                Err(err)
+            } else {
+                Err(PyRuntimeError::new_err(msg))
+            }
+        }
+    }
+}
+
+fn slice2<'a>(py: Python<'_>, name: &str, a: &'a PyReadonlyArray2<'_, f64>) -> PyResult<&'a [f64]> {
+    a.as_slice().map_err(|_| {
+        to_py(
+            py,
+            CoulombError::Shape(format!("{name} must be a C-contiguous float64 array")),
+        )
+    })
+}
+
+fn slice1<'a>(py: Python<'_>, name: &str, a: &'a PyReadonlyArray1<'_, f64>) -> PyResult<&'a [f64]> {
+    a.as_slice().map_err(|_| {
+        to_py(
+            py,
+            CoulombError::Shape(format!("{name} must be a contiguous float64 array")),
+        )
+    })
+}
+
+fn solution_dict<'py>(
+    py: Python<'py>,
+    s: LcpSolution,
+    seconds: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let n = s.z.len();
+    let d = PyDict::new(py);
+    d.set_item("success", s.success())?;
+    d.set_item("status", s.status.as_str())?;
+    d.set_item("message", s.message)?;
+    d.set_item("z", PyArray1::from_vec(py, s.z))?;
+    d.set_item("w", PyArray1::from_vec(py, s.w))?;
+    d.set_item("error", s.measures.error)?;
+    d.set_item("scaled_error", s.measures.scaled_error)?;
+    d.set_item("min_z", s.measures.min_z)?;
+    d.set_item("min_w", s.measures.min_w)?;
+    d.set_item("max_complementarity", s.measures.max_complementarity)?;
+    d.set_item("pivots", s.pivots)?;
+    d.set_item("iterations", s.iterations)?;
+    let basis: Vec<i64> = s.basis.iter().map(|&k| k as i64).collect();
+    d.set_item("basis", PyArray1::from_vec(py, basis))?;
+    d.set_item("warm_start", s.warm_start.as_str())?;
+    d.set_item("pivots_saved", s.pivots_saved)?;
+    d.set_item("polished", s.polished)?;
+    d.set_item("restarts", s.restarts)?;
+    let k = s.solutions.len();
+    let flat: Vec<f64> = s.solutions.into_iter().flatten().collect();
+    d.set_item("solutions", PyArray1::from_vec(py, flat).reshape([k, n])?)?;
+    d.set_item("solve_time", seconds)?;
+    Ok(d)
+}
+
+/// Solves `0 <= z ⊥ M z + q >= 0`. The Python wrapper `coulomb.lcp.solve` documents the
+/// arguments; this takes them already converted to float64 arrays.
+#[pyfunction]
+#[pyo3(signature = (m, q, method, tol, max_pivots=None, covering_vector=None, warm_start=None,
+                    polish=true, restarts=2, max_iter=10_000, relaxation=1.0, initial=None))]
+#[allow(clippy::too_many_arguments)]
+fn lcp_solve<'py>(
+    py: Python<'py>,
+    m: PyReadonlyArray2<'py, f64>,
+    q: PyReadonlyArray1<'py, f64>,
+    method: &str,
+    tol: f64,
+    max_pivots: Option<usize>,
+    covering_vector: Option<PyReadonlyArray1<'py, f64>>,
+    warm_start: Option<Vec<usize>>,
+    polish: bool,
+    restarts: usize,
+    max_iter: usize,
+    relaxation: f64,
+    initial: Option<PyReadonlyArray1<'py, f64>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let shape = m.shape();
+    if shape[0] != shape[1] {
+        return Err(to_py(
+            py,
+            CoulombError::Shape(format!("M must be square, got {} x {}", shape[0], shape[1])),
+        ));
+    }
+    let n = shape[0];
+    let ms = slice2(py, "M", &m)?;
+    let qs = slice1(py, "q", &q)?;
+    let cover = match &covering_vector {
+        Some(c) => Some(slice1(py, "covering_vector", c)?.to_vec()),
+        None => None,
+    };
+    let init = match &initial {
+        Some(c) => Some(slice1(py, "initial", c)?.to_vec()),
+        None => None,
+    };
+    let chosen = match method {
+        "lemke" => Method::Lemke(LemkeSettings {
+            tol,
+            max_pivots,
+            covering_vector: cover,
+            warm_start,
+            polish,
+            restarts,
+        }),
+        "pgs" => Method::Pgs(PgsSettings {
+            tol,
+            max_iter,
+            relaxation,
+            initial: init,
+        }),
+        "enumerate" => Method::Enumerate(EnumerateSettings { tol }),
+        other => {
+            return Err(to_py(
+                py,
+                CoulombError::InvalidParameter(format!(
+                    "unknown method {other:?}: expected 'lemke', 'pgs' or 'enumerate'"
+                )),
+            ))
+        }
+    };
+    let (solution, seconds) = guarded(py, || {
+        let start = std::time::Instant::now();
+        let lcp = LcpRef::new(n, ms, qs)?;
+        let s = lcp::solve(&lcp, &chosen)?;
+        Ok((s, start.elapsed().as_secs_f64()))
+    })?;
+    solution_dict(py, solution, seconds)
+}
+
+/// The error measures of a given z on (M, q), as a dict (for judging any solver's answer).
+#[pyfunction]
+fn lcp_measures<'py>(
+    py: Python<'py>,
+    m: PyReadonlyArray2<'py, f64>,
+    q: PyReadonlyArray1<'py, f64>,
+    z: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let n = q.len();
+    let ms = slice2(py, "M", &m)?;
+    let qs = slice1(py, "q", &q)?;
+    let zs = slice1(py, "z", &z)?;
+    let (w, meas) = guarded(py, || {
+        let lcp = LcpRef::new(n, ms, qs)?;
+        if zs.len() != n {
+            return Err(CoulombError::Shape(format!(
+                "z has length {}, expected {n}",
+                zs.len()
+            )));
+        }
+        crate::error::check_finite("z", zs)?;
+        Ok(lcp::measure(&lcp, zs))
+    })?;
+    let d = PyDict::new(py);
+    d.set_item("w", PyArray1::from_vec(py, w))?;
+    d.set_item("error", meas.error)?;
+    d.set_item("scaled_error", meas.scaled_error)?;
+    d.set_item("min_z", meas.min_z)?;
+    d.set_item("min_w", meas.min_w)?;
+    d.set_item("max_complementarity", meas.max_complementarity)?;
+    Ok(d)
+}
+
+/// Reads a Siconos LCP file; returns (M, q) as float64 arrays.
+#[pyfunction]
+fn read_siconos_lcp<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyArray1<f64>>)> {
+    let p = guarded(py, || Ok(crate::io::siconos::read_siconos_lcp(&path)?))?;
+    let (r, c) = (p.m.nrows, p.m.ncols);
+    let m = PyArray1::from_vec(py, p.m.data).reshape([r, c])?.into_any();
+    Ok((m, PyArray1::from_vec(py, p.q)))
+}
+
+/// The vector instruction set the pivot kernel uses on this CPU.
+#[pyfunction]
+fn simd_level() -> &'static str {
+    crate::lcp::simd_level()
+}
+
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(lcp_solve, m)?)?;
+    m.add_function(wrap_pyfunction!(lcp_measures, m)?)?;
+    m.add_function(wrap_pyfunction!(read_siconos_lcp, m)?)?;
+    m.add_function(wrap_pyfunction!(simd_level, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}
