@@ -65,6 +65,7 @@ class Outcome:
     pivots: int | None
     status: str
     reported_error: float | None = None
+    internal_time: float | None = None  # the solver's own timing, if it reports one
 
 
 Call = Callable[[], Outcome]
@@ -93,6 +94,7 @@ def load_coulomb(notes: list[str]) -> Prepare:
                 None if res.pivots is None else int(res.pivots),
                 str(res.status),
                 None if res.error is None else float(res.error),
+                getattr(res, "solve_time", None),
             )
 
         return call
@@ -106,16 +108,12 @@ def load_quantecon(notes: list[str]) -> Prepare:
     warm = lp.small_3x3(seed=12345)
     start = time.perf_counter()
     lcp_lemke(warm.M, warm.q)  # numba JIT compile, excluded from all timings
-    notes.append(
-        f"numba JIT warm-up call {time.perf_counter() - start:.2f} s, excluded"
-    )
+    notes.append(f"numba JIT warm-up call {time.perf_counter() - start:.2f} s, excluded")
 
     def prepare(m: np.ndarray, q: np.ndarray) -> Call:
         def call() -> Outcome:
             res = lcp_lemke(m, q)
-            return Outcome(
-                res.z, bool(res.success), int(res.num_iter), f"status={res.status}"
-            )
+            return Outcome(res.z, bool(res.success), int(res.num_iter), f"status={res.status}")
 
         return call
 
@@ -257,6 +255,7 @@ class Timing:
     median: float
     runs: int
     warmup: float
+    internal_median: float | None = None
 
 
 def measure(call: Call, policy: TimingPolicy) -> tuple[Outcome, Timing]:
@@ -273,17 +272,21 @@ def measure(call: Call, policy: TimingPolicy) -> tuple[Outcome, Timing]:
     if warmup > policy.timeout:
         return outcome, Timing(warmup, 0, warmup)
     samples: list[float] = []
+    internal: list[float] = []
     total = 0.0
     while True:
         start = time.perf_counter()
-        call()
+        repeat = call()
         elapsed = time.perf_counter() - start
         samples.append(elapsed)
+        if repeat.internal_time is not None:
+            internal.append(repeat.internal_time)
         total += elapsed
         enough = len(samples) >= policy.min_runs and total >= policy.min_time
         if enough or total >= policy.max_time:
             break
-    return outcome, Timing(statistics.median(samples), len(samples), warmup)
+    internal_median = statistics.median(internal) if internal else None
+    return outcome, Timing(statistics.median(samples), len(samples), warmup, internal_median)
 
 
 # --------------------------------------------------------------------------
@@ -320,7 +323,7 @@ def load_solvers(specs: Iterable[SolverSpec]) -> list[SolverState]:
         try:
             state.prepare = spec.load(spec.notes)
             log(f"[load] {spec.name}: ok")
-        except Exception as exc:  # noqa: BLE001 - any failure means "n/a"
+        except Exception as exc:  # any failure means "n/a"
             state.unavailable = f"{type(exc).__name__}: {exc}".splitlines()[0]
             log(f"[load] {spec.name}: n/a ({state.unavailable})")
         states.append(state)
@@ -362,18 +365,18 @@ def run_one(state: SolverState, problem: lp.LcpProblem, policy: TimingPolicy) ->
     try:
         call = state.prepare(problem.M, problem.q)
         row.outcome, row.timing = measure(call, policy)
-    except Exception as exc:  # noqa: BLE001 - record and continue
+    except Exception as exc:  # record and continue
         row.note = f"n/a: raised {type(exc).__name__}: {exc}".splitlines()[0]
         return row
     if row.outcome.z is not None:
         row.error = lp.lcp_error(problem.M, problem.q, row.outcome.z)
-    row.note = error_mismatch(row.outcome.reported_error, row.error)
+    notes = [error_mismatch(row.outcome.reported_error, row.error)]
+    if row.timing.internal_median is not None:
+        notes.append(f"own `solve_time` median {format_seconds(row.timing.internal_median)}")
+    row.note = "; ".join(note for note in notes if note)
     state.last_time[problem.family] = (problem.n, row.timing.median)
     if row.timing.median > policy.timeout:
-        took = (
-            f"one solve took {format_seconds(row.timing.median)} "
-            f"> limit {policy.timeout:g} s"
-        )
+        took = f"one solve took {format_seconds(row.timing.median)} > limit {policy.timeout:g} s"
         row.note = "; ".join(part for part in (row.note, took) if part)
         reason = f"skipped: exceeded {policy.timeout:g} s/solve at n={problem.n}"
         state.exceeded[problem.family] = reason
@@ -390,10 +393,8 @@ def build_problems(
     if siconos is not None:
         try:
             problems.append(lp.siconos_problem(siconos))
-        except Exception as exc:  # noqa: BLE001 - optional row
-            notes.append(
-                f"Siconos `{siconos.name}` row skipped: {type(exc).__name__}: {exc}"
-            )
+        except Exception as exc:  # optional row
+            notes.append(f"Siconos `{siconos.name}` row skipped: {type(exc).__name__}: {exc}")
     return problems, notes
 
 
@@ -433,12 +434,23 @@ def format_seconds(seconds: float) -> str:
     return f"{seconds:.2f} s"
 
 
+def solved(row: Row) -> bool:
+    """The solver claimed success and the recomputed error agrees."""
+    ok = row.outcome is not None and row.outcome.success
+    return ok and row.error is not None and row.error <= ERROR_OK
+
+
 def speedup(row: Row, reference: Row | None) -> str:
     if reference is None or reference.timing is None or row.timing is None:
         return "n/a"
     if row is reference:
         return "(ref)"
-    return f"{row.timing.median / reference.timing.median:.1f}x"
+    ratio = f"{row.timing.median / reference.timing.median:.1f}x"
+    if not solved(reference):
+        return f"({ratio}, coulomb failed)"
+    if not solved(row):
+        return f"({ratio}, peer failed)"
+    return ratio
 
 
 def table_row(row: Row, reference: Row | None) -> str:
@@ -451,9 +463,7 @@ def table_row(row: Row, reference: Row | None) -> str:
     pivots = "n/a" if out.pivots is None else str(out.pivots)
     error = "n/a (no z)" if row.error is None else f"{row.error:.1e}"
     success = "yes" if out.success else f"no ({out.status})"
-    error_ok = (
-        "n/a" if row.error is None else ("yes" if row.error <= ERROR_OK else "**NO**")
-    )
+    error_ok = "n/a" if row.error is None else ("yes" if row.error <= ERROR_OK else "**NO**")
     cells = [
         str(row.n),
         row.solver,
@@ -492,13 +502,9 @@ def family_tables(rows: Sequence[Row], problems: Sequence[lp.LcpProblem]) -> lis
         family_rows = [r for r in rows if r.family == family]
         for n in dict.fromkeys(r.n for r in family_rows):
             group = [r for r in family_rows if r.n == n]
-            reference = next(
-                (r for r in group if r.solver == REFERENCE and r.timing), None
-            )
+            reference = next((r for r in group if r.solver == REFERENCE and r.timing), None)
             lines += [table_row(r, reference) for r in group]
-        instances = ", ".join(
-            f"n={n}: {lab}" for (f, n), lab in labels.items() if f == family
-        )
+        instances = ", ".join(f"n={n}: {lab}" for (f, n), lab in labels.items() if f == family)
         lines += ["", f"Instances: {instances}."]
     return lines
 
@@ -550,11 +556,7 @@ def machine_lines() -> list[str]:
         f"{name} {package_version(name)}"
         for name in ("coulomb", "numpy", "numba", "quantecon", "lemkelcp", "drake")
     )
-    affinity = (
-        len(os.sched_getaffinity(0))
-        if hasattr(os, "sched_getaffinity")
-        else os.cpu_count()
-    )
+    affinity = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
     return [
         f"- CPU: {cpu_model()}; {os.cpu_count()} logical cores ({affinity} usable)",
         f"- OS: {platform.system()} {platform.release()}; Python {platform.python_version()}",
@@ -571,8 +573,8 @@ def method_text(policy: TimingPolicy) -> str:
         "total) and the median `time.perf_counter` wall time is reported. "
         "`error = ||min(z, M z + q)||_2 / max(1, ||q||_2)` is recomputed here from the "
         "original `M, q` for every solver; `success` is the solver's own claim. "
-        "`coulomb speed-up` = peer median / coulomb median (>1 means coulomb is faster; "
-        "only meaningful where both succeed). "
+        "`coulomb speed-up` = peer median / coulomb median (>1 means coulomb is faster); "
+        "it is put in parentheses when either side did not solve the problem. "
         f"A solver is skipped at larger n once one solve exceeds {policy.timeout:g} s."
     )
 
@@ -586,7 +588,7 @@ def render_section(
     extra_notes: Sequence[str],
     quick: bool,
 ) -> str:
-    now = dt.datetime.now(dt.UTC).strftime("%Y-%m-%d %H:%M UTC")
+    now = dt.datetime.now(dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     title = "## LCP solvers: coulomb vs peers" + (" (quick smoke run)" if quick else "")
     lines = [
         BEGIN_MARKER,
@@ -626,7 +628,7 @@ DRAKE_NOTES = (
         "them, so no pivot count is available from Python."
     ),
     (
-        "Drake `MobyLcpSolver` called through `MathematicalProgram` runs "
+        "Drake `MobyLcpSolver` called through `MathematicalProgram` runs (per Drake's source) "
         "`SolveLcpLemkeRegularized` (retries on `M + λI` for growing λ), so its `z` may solve "
         "a regularized problem: see the error column."
     ),
@@ -658,9 +660,7 @@ def write_section(section: str, output: Path) -> None:
 def parse_sizes(text: str) -> tuple[int, ...]:
     sizes = tuple(int(part) for part in text.split(",") if part.strip())
     if not sizes or min(sizes) < 1:
-        raise argparse.ArgumentTypeError(
-            "sizes must be positive integers, e.g. 10,30,100"
-        )
+        raise argparse.ArgumentTypeError("sizes must be positive integers, e.g. 10,30,100")
     return sizes
 
 
@@ -670,8 +670,7 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
         "--sizes",
         type=parse_sizes,
         default=DEFAULT_SIZES,
-        help="comma-separated n for the dense and contact families "
-        "(default: 10,30,100,300,1000)",
+        help="comma-separated n for the dense and contact families (default: 10,30,100,300,1000)",
     )
     parser.add_argument(
         "--quick",
@@ -725,20 +724,14 @@ def select_specs(names: str) -> list[SolverSpec]:
         return specs
     chosen = [s for s in specs if s.name in wanted or s.name.split(" (")[0] in wanted]
     if not chosen:
-        raise SystemExit(
-            f"no solver matches {wanted}; known: {[s.name for s in specs]}"
-        )
+        raise SystemExit(f"no solver matches {wanted}; known: {[s.name for s in specs]}")
     return chosen
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     args = parse_args(argv)
-    command = shlex.join(
-        [Path(sys.executable).name, *(sys.argv if argv is None else argv)]
-    )
-    policy = TimingPolicy(
-        args.min_runs, args.min_time, args.max_time, args.timeout_per_solve
-    )
+    command = shlex.join([Path(sys.executable).name, *(sys.argv if argv is None else argv)])
+    policy = TimingPolicy(args.min_runs, args.min_time, args.max_time, args.timeout_per_solve)
     states = load_solvers(select_specs(args.solvers))
     problems, notes = build_problems(args.sizes, args.siconos)
     rows = run_all(problems, states, policy)

@@ -14,6 +14,7 @@ pub mod error;
 pub mod io;
 pub mod lcp;
 pub mod matrix;
+pub mod testing;
 
 #[cfg(feature = "python")]
 mod python;

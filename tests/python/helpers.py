@@ -1,0 +1,72 @@
+"""Problem generators and independent error measures for the tests (numpy only)."""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+Array = NDArray[np.float64]
+
+
+def lcp_error(M: Array, q: Array, z: Array) -> float:
+    """``||min(z, M z + q)||_2 / max(1, ||q||_2)``, recomputed here in numpy."""
+    w = M @ z + q
+    return float(np.linalg.norm(np.minimum(z, w)) / max(1.0, np.linalg.norm(q)))
+
+
+def rel_diff(a: Array, b: Array) -> float:
+    """``||a - b||_inf / ||b||_inf`` (absolute when b = 0)."""
+    scale = float(np.abs(b).max(initial=0.0))
+    diff = float(np.abs(np.asarray(a) - np.asarray(b)).max(initial=0.0))
+    return diff / scale if scale > 0 else diff
+
+
+def pmatrix_spd_plus_skew(rng: np.random.Generator, n: int) -> Array:
+    """S + K with S symmetric positive definite and K skew: M + M^T = 2 S > 0, so M is P."""
+    A = rng.standard_normal((n, n))
+    S = A @ A.T + 0.1 * np.eye(n)
+    B = rng.standard_normal((n, n))
+    return S + (B - B.T)
+
+
+def pmatrix_diagonally_dominant(rng: np.random.Generator, n: int) -> Array:
+    """Strictly row-diagonally-dominant with a positive diagonal: a P-matrix."""
+    A = rng.standard_normal((n, n))
+    np.fill_diagonal(A, 0.0)
+    diag = np.abs(A).sum(axis=1) + 0.1 + rng.random(n)
+    return A + np.diag(diag)
+
+
+def spd(rng: np.random.Generator, n: int, shift: float = 0.1) -> Array:
+    A = rng.standard_normal((n, n))
+    M = A @ A.T / n + shift * np.eye(n)
+    return (M + M.T) / 2
+
+
+def planted(
+    rng: np.random.Generator, M: Array, active_fraction: float = 0.5
+) -> tuple[Array, Array, Array, NDArray[np.bool_]]:
+    """A q whose LCP(M, q) has the solution z* (>= 0 on a random active set) with w* >= 0
+    complementary: ``q = w* - M z*``. Returns q, z*, w*, active."""
+    n = M.shape[0]
+    active = rng.random(n) < active_fraction
+    if n > 1 and active.all():
+        active[rng.integers(n)] = False
+    if n > 1 and not active.any():
+        active[rng.integers(n)] = True
+    z = np.where(active, 0.1 + rng.random(n), 0.0)
+    w = np.where(active, 0.0, 0.1 + rng.random(n))
+    return w - M @ z, z, w, active
+
+
+def planted_psd(
+    rng: np.random.Generator, n: int
+) -> tuple[Array, Array, Array, Array, NDArray[np.bool_]]:
+    """Singular PSD ``M = J J^T`` (J is n x m, m < n) with a planted solution.
+    Returns M, q, z*, w*, active."""
+    m = max(1, n // 3)
+    J = rng.standard_normal((n, m))
+    M = J @ J.T
+    M = (M + M.T) / 2
+    q, z, w, active = planted(rng, M)
+    return M, q, z, w, active
