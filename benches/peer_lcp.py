@@ -538,17 +538,20 @@ def cpu_model() -> str:
     return platform.processor() or "unknown"
 
 
+def git(*args: str) -> str:
+    out = subprocess.run(
+        ["git", "-C", str(REPO_ROOT), *args], capture_output=True, text=True, check=True
+    )
+    return out.stdout.strip()
+
+
 def git_revision() -> str:
     try:
-        out = subprocess.run(
-            ["git", "-C", str(REPO_ROOT), "rev-parse", "--short", "HEAD"],
-            capture_output=True,
-            text=True,
-            check=True,
-        )
-        return out.stdout.strip()
+        revision = git("rev-parse", "--short", "HEAD")
+        dirty = git("status", "--porcelain", "--untracked-files=no")
     except (OSError, subprocess.CalledProcessError):
         return "unknown"
+    return revision + (" (with uncommitted changes)" if dirty else "")
 
 
 def machine_lines() -> list[str]:

@@ -11,7 +11,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let t = std::time::Instant::now();
             let s = solve_lemke(&lcp, &LemkeSettings::default())?;
             let dt = t.elapsed().as_secs_f64();
-            println!("{name} n={n}: {:.3} ms, {} pivots, {} error {:.1e}", dt * 1e3, s.pivots, s.status, s.measures.error);
+            println!(
+                "{name} n={n}: {:.3} ms, {} pivots, {} error {:.1e}",
+                dt * 1e3,
+                s.pivots,
+                s.status,
+                s.measures.error
+            );
         }
     }
     Ok(())

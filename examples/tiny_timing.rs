@@ -11,6 +11,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for _ in 0..reps {
         acc += solve_lemke(&lcp, &s)?.z[0];
     }
-    println!("{:.3} us per solve ({acc})", t.elapsed().as_secs_f64() * 1e6 / reps as f64);
+    println!(
+        "{:.3} us per solve ({acc})",
+        t.elapsed().as_secs_f64() * 1e6 / reps as f64
+    );
     Ok(())
 }

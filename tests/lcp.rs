@@ -72,7 +72,11 @@ fn siconos_lcp_set() {
     paths.sort();
     assert_eq!(paths.len(), 20);
     for p in paths {
-        let name = p.file_stem().and_then(|s| s.to_str()).unwrap_or("?").to_string();
+        let name = p
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .unwrap_or("?")
+            .to_string();
         let prob = read_siconos_lcp(&p).expect("readable problem");
         let s = lemke(&prob.m, &prob.q);
         let has_solution = if prob.m.nrows <= 15 {
@@ -82,7 +86,11 @@ fn siconos_lcp_set() {
         };
         if has_solution && name != "lcp_CPS_3" {
             assert!(s.success(), "{name}: {}", s.message);
-            assert!(s.measures.error <= 1e-10, "{name}: error {}", s.measures.error);
+            assert!(
+                s.measures.error <= 1e-10,
+                "{name}: error {}",
+                s.measures.error
+            );
         } else {
             assert!(!s.success(), "{name}: false success");
             assert_eq!(s.status, LcpStatus::RayTermination, "{name}");
@@ -193,13 +201,15 @@ fn answers_are_invariant_under_scaling() {
         let base = lemke(m, q);
         assert!(base.success());
         let ones = vec![1.0; n];
-        let mut cases: Vec<(Vec<f64>, Vec<f64>)> = vec![
-            (vec![1e-8; n], ones.clone()),
-            (vec![1e8; n], ones.clone()),
-        ];
+        let mut cases: Vec<(Vec<f64>, Vec<f64>)> =
+            vec![(vec![1e-8; n], ones.clone()), (vec![1e8; n], ones.clone())];
         for _ in 0..3 {
-            let r = (0..n).map(|_| 10f64.powi(rng.below(13) as i32 - 6)).collect();
-            let c = (0..n).map(|_| 10f64.powi(rng.below(13) as i32 - 6)).collect();
+            let r = (0..n)
+                .map(|_| 10f64.powi(rng.below(13) as i32 - 6))
+                .collect();
+            let c = (0..n)
+                .map(|_| 10f64.powi(rng.below(13) as i32 - 6))
+                .collect();
             cases.push((r, c));
         }
         for (r, c) in cases {

@@ -9,6 +9,7 @@ from dataclasses import asdict
 from pathlib import Path
 
 from . import __version__
+from .errors import CoulombError
 
 
 def _validate(args: argparse.Namespace) -> int:
@@ -54,7 +55,11 @@ def main(argv: list[str] | None = None) -> int:
     s.set_defaults(func=_solve_lcp)
 
     args = parser.parse_args(argv)
-    return int(args.func(args))
+    try:
+        return int(args.func(args))
+    except (OSError, CoulombError) as exc:
+        print(f"coulomb {args.command}: error: {exc}", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":

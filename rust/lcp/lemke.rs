@@ -91,6 +91,13 @@ enum Ending {
     NonFinite,
 }
 
+/// The outcome of a ratio test.
+enum Blocking {
+    Row(usize),
+    Ray,
+    NonFinite,
+}
+
 /// Storage for Lemke's method, sized once for a problem size and reused across solves (for
 /// example across the time steps of a simulation).
 pub struct LemkeWorkspace {
@@ -101,6 +108,8 @@ pub struct LemkeWorkspace {
     basic: Vec<usize>,
     nonbasic: Vec<usize>,
     loc: Vec<Loc>,
+    column: Vec<f64>,
+    values: Vec<f64>,
     ties: Vec<usize>,
     ties_next: Vec<usize>,
     update: RankOneUpdate,
@@ -118,6 +127,8 @@ impl LemkeWorkspace {
             basic: vec![0; n],
             nonbasic: vec![0; n + 1],
             loc: vec![Loc::Row(0); 2 * n + 1],
+            column: vec![0.0; n],
+            values: vec![0.0; n],
             ties: Vec::with_capacity(n),
             ties_next: Vec::with_capacity(n),
             update: kernel::select(),
@@ -194,7 +205,7 @@ impl LemkeWorkspace {
     /// Keeps, among `self.ties`, the rows whose lexicographic ratio
     /// `B^{-1}[i, :] / (-T[i, s])` is smallest (the perturbation `q + (ε, ε², …)` argument).
     /// `sign` is +1 for a minimum-ratio test and -1 for the initial maximum-ratio test.
-    fn lexicographic(&mut self, s: usize, sign: f64) -> usize {
+    fn lexicographic(&mut self, s: usize, sign: f64) -> Option<usize> {
         let n = self.n;
         // Rounding leaves ~1e-16 where exact arithmetic has 0, so entries are compared at the
         // scale of the tied rows' whole lexicographic vectors, not entry by entry.
@@ -204,6 +215,9 @@ impl LemkeWorkspace {
             for k in 0..n {
                 scale = scale.max((self.inverse_basis(i, k) / a).abs());
             }
+        }
+        if !scale.is_finite() {
+            return None;
         }
         let tol = TIE_EPS * scale;
         for k in 0..n {
@@ -222,89 +236,82 @@ impl LemkeWorkspace {
                     self.ties_next.push(i);
                 }
             }
+            if self.ties_next.is_empty() {
+                return None;
+            }
             std::mem::swap(&mut self.ties, &mut self.ties_next);
         }
         // Exact arithmetic leaves one row; with rounding, prefer the largest pivot.
-        let mut pick = self.ties[0];
+        let mut pick = *self.ties.first()?;
         for &i in &self.ties {
             if self.at(i, s).abs() > self.at(pick, s).abs() {
                 pick = i;
             }
         }
-        pick
+        Some(pick)
     }
 
-    /// the blocking row when the variable in column s enters, or `None` on a secondary ray.
-    fn ratio_test(&mut self, s: usize) -> Option<usize> {
-        let n = self.n;
-        let rhs = n + 1;
+    /// the blocking row when the variable in column s enters.
+    fn ratio_test(&mut self, s: usize) -> Blocking {
+        let w = self.width;
+        // one strided pass gathers the column and the basic values; the rest runs contiguous
         let mut colmax: f64 = 0.0;
-        for i in 0..n {
-            colmax = colmax.max(self.at(i, s).abs());
+        let mut rhsmax: f64 = 1.0;
+        for (i, row) in self.tableau.chunks_exact(w).enumerate() {
+            let a = row[s];
+            let b = row[w - 1];
+            self.column[i] = a;
+            self.values[i] = b;
+            colmax = colmax.max(a.abs());
+            rhsmax = rhsmax.max(b.abs());
+        }
+        if !(colmax.is_finite() && rhsmax.is_finite()) {
+            return Blocking::NonFinite;
         }
         let piv_tol = PIVOT_EPS * colmax.max(1.0);
-        let zero_rhs = self.rhs_noise();
-        let value = |ws: &Self, i: usize| {
-            let b = ws.at(i, rhs);
-            if b <= zero_rhs {
-                0.0
-            } else {
-                b
-            }
-        };
+        let zero_rhs = RHS_EPS * rhsmax;
         let mut theta = f64::INFINITY;
-        for i in 0..n {
-            let a = self.at(i, s);
-            if a < -piv_tol {
-                let t = value(self, i) / (-a);
-                theta = theta.min(t);
+        for (a, b) in self.column.iter().zip(self.values.iter_mut()) {
+            if *b <= zero_rhs {
+                *b = 0.0;
+            }
+            if *a < -piv_tol {
+                theta = theta.min(*b / -*a);
             }
         }
-        if !theta.is_finite() {
-            return None;
+        if theta == f64::INFINITY {
+            return Blocking::Ray;
         }
         let tie = TIE_EPS * theta;
         self.ties.clear();
         let z0 = self.z0();
-        let mut z0_row = None;
-        for i in 0..n {
-            let a = self.at(i, s);
-            if a < -piv_tol {
-                let t = value(self, i) / (-a);
-                if t <= theta + tie {
-                    if self.basic[i] == z0 {
-                        z0_row = Some(i);
-                    }
-                    self.ties.push(i);
+        for (i, (a, b)) in self.column.iter().zip(&self.values).enumerate() {
+            if *a < -piv_tol && *b / -*a <= theta + tie {
+                if self.basic[i] == z0 {
+                    return Blocking::Row(i);
                 }
+                self.ties.push(i);
             }
         }
-        if let Some(r) = z0_row {
-            return Some(r);
+        match self.ties.len() {
+            0 => Blocking::NonFinite,
+            1 => Blocking::Row(self.ties[0]),
+            _ => self
+                .lexicographic(s, 1.0)
+                .map_or(Blocking::NonFinite, Blocking::Row),
         }
-        if self.ties.len() == 1 {
-            return Some(self.ties[0]);
-        }
-        Some(self.lexicographic(s, 1.0))
-    }
-
-    /// basic values at most this are zero up to rounding (degenerate rows).
-    fn rhs_noise(&self) -> f64 {
-        let rhs = self.n + 1;
-        let mut scale: f64 = 1.0;
-        for i in 0..self.n {
-            scale = scale.max(self.at(i, rhs).abs());
-        }
-        RHS_EPS * scale
     }
 
     /// the row that leaves when z0 first enters: the one needing the largest z0.
-    fn initial_row(&mut self) -> usize {
+    fn initial_row(&mut self) -> Option<usize> {
         let n = self.n;
         let (zc, rhs) = (n, n + 1);
         let mut theta = f64::NEG_INFINITY;
         for i in 0..n {
             theta = theta.max(-self.at(i, rhs) / self.at(i, zc));
+        }
+        if !theta.is_finite() {
+            return None;
         }
         let tie = TIE_EPS * theta.abs().max(1e-12);
         self.ties.clear();
@@ -313,11 +320,12 @@ impl LemkeWorkspace {
                 self.ties.push(i);
             }
         }
-        if self.ties.len() == 1 {
-            return self.ties[0];
+        match self.ties.len() {
+            0 => None,
+            1 => Some(self.ties[0]),
+            // maximum ratio: the lexicographic argument with the sign reversed
+            _ => self.lexicographic(zc, -1.0),
         }
-        // maximum ratio: the lexicographic argument with the sign reversed
-        self.lexicographic(zc, -1.0)
     }
 
     /// exchanges the basic variable of row r with the nonbasic variable of column s.
@@ -347,7 +355,9 @@ impl LemkeWorkspace {
     fn run(&mut self, max_pivots: usize) -> (Ending, usize) {
         let n = self.n;
         let z0 = self.z0();
-        let r = self.initial_row();
+        let Some(r) = self.initial_row() else {
+            return (Ending::NonFinite, 0);
+        };
         let mut leaving = self.basic[r];
         if !self.pivot(r, n) {
             return (Ending::NonFinite, 1);
@@ -367,8 +377,9 @@ impl LemkeWorkspace {
                 Loc::Row(_) => return (Ending::NonFinite, pivots),
             };
             let r = match self.ratio_test(s) {
-                Some(r) => r,
-                None => return (Ending::Ray, pivots),
+                Blocking::Row(r) => r,
+                Blocking::Ray => return (Ending::Ray, pivots),
+                Blocking::NonFinite => return (Ending::NonFinite, pivots),
             };
             leaving = self.basic[r];
             pivots += 1;

@@ -27,7 +27,7 @@ use crate::error::{check_finite, CoulombError, Result};
 use crate::matrix::DenseMatrix;
 
 pub use enumerate::{solve_enumerate, EnumerateSettings};
-pub use lemke::{solve_lemke, LemkeSettings, LemkeWorkspace};
+pub use lemke::{solve_lemke, solve_lemke_with, LemkeSettings, LemkeWorkspace};
 pub use pgs::{solve_pgs, PgsSettings};
 
 /// the vector instruction set Lemke's pivot kernel uses on this CPU.
@@ -101,8 +101,12 @@ impl WarmStart {
 pub struct LcpMeasures {
     /// `||min(z, w)||_2 / max(1, ||q||_2)` with `w = M z + q` (DESIGN.md, as Siconos reports it).
     pub error: f64,
-    /// `||min(z', w')||_inf` on the equilibrated problem (rows and columns scaled to unit size,
-    /// q normalised): the same answer judged independently of the data's units.
+    /// the same test judged in each row's and column's own units:
+    /// `max_i |min(z_i / s_z, w_i / s_i)|` where `s_i = |q_i| + Σ_j |M_ij z_j|` is the size of
+    /// the terms that make up w_i (so rounding in w_i counts relative to them) and
+    /// `s_z = max(1, ||C^{-1} z||_inf)` measures z in the equilibrated column units. It does not
+    /// change when rows or columns are rescaled, so a row with tiny data cannot hide a wrong
+    /// answer behind a large `||q||`.
     pub scaled_error: f64,
     /// `min_i z_i` (negative means infeasible).
     pub min_z: f64,
@@ -209,23 +213,31 @@ impl<'a> LcpRef<'a> {
 
     /// the error measures of z (see [`LcpMeasures`]).
     pub fn measures(&self, z: &[f64], w: &[f64], scaling: &scaling::Equilibration) -> LcpMeasures {
+        let n = self.n;
         let qnorm = norm2(self.q);
         let mut sq = 0.0;
-        let mut scaled: f64 = 0.0;
         let mut min_z = f64::INFINITY;
         let mut min_w = f64::INFINITY;
         let mut comp: f64 = 0.0;
-        for i in 0..self.n {
+        let mut zscale: f64 = 1.0;
+        for i in 0..n {
             let m = z[i].min(w[i]);
             sq += m * m;
-            let zs = z[i] / (scaling.col[i] * scaling.sigma);
-            let ws = w[i] * scaling.row[i] / scaling.sigma;
-            scaled = scaled.max(zs.min(ws).abs());
             min_z = min_z.min(z[i]);
             min_w = min_w.min(w[i]);
             comp = comp.max((z[i] * w[i]).abs());
+            zscale = zscale.max((z[i] / (scaling.col[i] * scaling.sigma)).abs());
         }
-        if self.n == 0 {
+        let mut scaled: f64 = 0.0;
+        for i in 0..n {
+            let row = &self.m[i * n..(i + 1) * n];
+            let terms: f64 =
+                row.iter().zip(z).map(|(a, b)| (a * b).abs()).sum::<f64>() + self.q[i].abs();
+            let wi = if terms > 0.0 { w[i] / terms } else { 0.0 };
+            let zi = z[i] / (scaling.col[i] * scaling.sigma) / zscale;
+            scaled = scaled.max(zi.min(wi).abs());
+        }
+        if n == 0 {
             min_z = 0.0;
             min_w = 0.0;
         }

@@ -24,11 +24,20 @@ pub struct Equilibration {
 /// Ruiz sweeps: each halves the log-distance of row and column maxima from 1.
 const RUIZ_SWEEPS: usize = 8;
 
+/// `2^round(log2 x)` from the bits (no transcendental calls: scaling runs on every solve).
 fn pow2(x: f64) -> f64 {
-    if !(x.is_finite() && x > 0.0) {
+    if !(x.is_normal() && x > 0.0) {
         return 1.0;
     }
-    (x.log2().round()).exp2()
+    let bits = x.to_bits();
+    let exponent = ((bits >> 52) & 0x7ff) as i32 - 1023;
+    let mantissa = f64::from_bits((bits & 0x000f_ffff_ffff_ffff) | 0x3ff0_0000_0000_0000);
+    let e = if mantissa >= std::f64::consts::SQRT_2 {
+        exponent + 1
+    } else {
+        exponent
+    };
+    2f64.powi(e)
 }
 
 impl Equilibration {
@@ -95,6 +104,22 @@ impl Equilibration {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn pow2_rounds_in_the_log() {
+        for (x, want) in [
+            (1.0, 1.0),
+            (1.4, 1.0),
+            (1.5, 2.0),
+            (3.0, 4.0),
+            (0.7, 0.5),
+            (1e-300, 2f64.powi(-997)),
+        ] {
+            assert_eq!(pow2(x), want, "x = {x}");
+        }
+        assert_eq!(pow2(0.0), 1.0);
+        assert_eq!(pow2(f64::NAN), 1.0);
+    }
 
     #[test]
     fn factors_are_powers_of_two_and_equilibrate() {

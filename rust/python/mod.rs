@@ -6,8 +6,10 @@
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
 
-use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyRuntimeError};
+use pyo3::intern;
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyDict, PyType};
@@ -53,12 +55,21 @@ fn to_py(py: Python<'_>, err: CoulombError) -> PyErr {
     }
 }
 
-/// runs `f` with the GIL released; a Rust panic becomes `coulomb.errors.InternalError`.
+/// below this many matrix entries a solve is too short for releasing the GIL to pay.
+const DETACH_ENTRIES: usize = 4096;
+
+/// runs `f` (with the GIL released when `work` entries make it worth it); a Rust panic
+/// becomes `coulomb.errors.InternalError`.
 fn guarded<T: Send>(
     py: Python<'_>,
+    work: usize,
     f: impl FnOnce() -> Result<T, CoulombError> + Send,
 ) -> PyResult<T> {
-    let out = py.detach(|| catch_unwind(AssertUnwindSafe(f)));
+    let out = if work >= DETACH_ENTRIES {
+        py.detach(|| catch_unwind(AssertUnwindSafe(f)))
+    } else {
+        catch_unwind(AssertUnwindSafe(f))
+    };
     match out {
         Ok(Ok(v)) => Ok(v),
         Ok(Err(e)) => Err(to_py(py, e)),
@@ -104,28 +115,33 @@ fn solution_dict<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let n = s.z.len();
     let d = PyDict::new(py);
-    d.set_item("success", s.success())?;
-    d.set_item("status", s.status.as_str())?;
-    d.set_item("message", s.message)?;
-    d.set_item("z", PyArray1::from_vec(py, s.z))?;
-    d.set_item("w", PyArray1::from_vec(py, s.w))?;
-    d.set_item("error", s.measures.error)?;
-    d.set_item("scaled_error", s.measures.scaled_error)?;
-    d.set_item("min_z", s.measures.min_z)?;
-    d.set_item("min_w", s.measures.min_w)?;
-    d.set_item("max_complementarity", s.measures.max_complementarity)?;
-    d.set_item("pivots", s.pivots)?;
-    d.set_item("iterations", s.iterations)?;
+    d.set_item(intern!(py, "success"), s.success())?;
+    d.set_item(intern!(py, "status"), s.status.as_str())?;
+    d.set_item(intern!(py, "message"), s.message)?;
+    d.set_item(intern!(py, "z"), PyArray1::from_vec(py, s.z))?;
+    d.set_item(intern!(py, "w"), PyArray1::from_vec(py, s.w))?;
+    d.set_item(intern!(py, "error"), s.measures.error)?;
+    d.set_item(intern!(py, "scaled_error"), s.measures.scaled_error)?;
+    d.set_item(intern!(py, "min_z"), s.measures.min_z)?;
+    d.set_item(intern!(py, "min_w"), s.measures.min_w)?;
+    d.set_item(
+        intern!(py, "max_complementarity"),
+        s.measures.max_complementarity,
+    )?;
+    d.set_item(intern!(py, "pivots"), s.pivots)?;
+    d.set_item(intern!(py, "iterations"), s.iterations)?;
     let basis: Vec<i64> = s.basis.iter().map(|&k| k as i64).collect();
-    d.set_item("basis", PyArray1::from_vec(py, basis))?;
-    d.set_item("warm_start", s.warm_start.as_str())?;
-    d.set_item("pivots_saved", s.pivots_saved)?;
-    d.set_item("polished", s.polished)?;
-    d.set_item("restarts", s.restarts)?;
+    d.set_item(intern!(py, "basis"), PyArray1::from_vec(py, basis))?;
+    d.set_item(intern!(py, "warm_start"), s.warm_start.as_str())?;
+    d.set_item(intern!(py, "pivots_saved"), s.pivots_saved)?;
+    d.set_item(intern!(py, "polished"), s.polished)?;
+    d.set_item(intern!(py, "restarts"), s.restarts)?;
     let k = s.solutions.len();
     let flat: Vec<f64> = s.solutions.into_iter().flatten().collect();
-    d.set_item("solutions", PyArray1::from_vec(py, flat).reshape([k, n])?)?;
-    d.set_item("solve_time", seconds)?;
+    let solutions = Array2::from_shape_vec((k, n), flat)
+        .map_err(|e| PyRuntimeError::new_err(format!("internal shape error: {e}")))?;
+    d.set_item(intern!(py, "solutions"), solutions.into_pyarray(py))?;
+    d.set_item(intern!(py, "solve_time"), seconds)?;
     Ok(d)
 }
 
@@ -193,7 +209,7 @@ fn lcp_solve<'py>(
             ))
         }
     };
-    let (solution, seconds) = guarded(py, || {
+    let (solution, seconds) = guarded(py, n * n, || {
         let start = std::time::Instant::now();
         let lcp = LcpRef::new(n, ms, qs)?;
         let s = lcp::solve(&lcp, &chosen)?;
@@ -214,7 +230,7 @@ fn lcp_measures<'py>(
     let ms = slice2(py, "M", &m)?;
     let qs = slice1(py, "q", &q)?;
     let zs = slice1(py, "z", &z)?;
-    let (w, meas) = guarded(py, || {
+    let (w, meas) = guarded(py, n * n, || {
         let lcp = LcpRef::new(n, ms, qs)?;
         if zs.len() != n {
             return Err(CoulombError::Shape(format!(
@@ -241,9 +257,14 @@ fn read_siconos_lcp<'py>(
     py: Python<'py>,
     path: PathBuf,
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyArray1<f64>>)> {
-    let p = guarded(py, || Ok(crate::io::siconos::read_siconos_lcp(&path)?))?;
+    let p = guarded(py, usize::MAX, || {
+        Ok(crate::io::siconos::read_siconos_lcp(&path)?)
+    })?;
     let (r, c) = (p.m.nrows, p.m.ncols);
-    let m = PyArray1::from_vec(py, p.m.data).reshape([r, c])?.into_any();
+    let m = Array2::from_shape_vec((r, c), p.m.data)
+        .map_err(|e| PyRuntimeError::new_err(format!("internal shape error: {e}")))?
+        .into_pyarray(py)
+        .into_any();
     Ok((m, PyArray1::from_vec(py, p.q)))
 }
 

@@ -1,0 +1,26 @@
+//! Repeats one Lemke solve for profiling: `cargo run --release --example lemke_profile N REPS`.
+use coulomb::lcp::{solve_lemke_with, LcpRef, LemkeSettings, LemkeWorkspace};
+use coulomb::testing::dense_spd;
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let mut args = std::env::args().skip(1);
+    let n: usize = args.next().and_then(|a| a.parse().ok()).unwrap_or(100);
+    let reps: usize = args.next().and_then(|a| a.parse().ok()).unwrap_or(1000);
+    let polish = args.next().is_none_or(|a| a != "nopolish");
+    let (m, q) = dense_spd(n, n as u64);
+    let lcp = LcpRef::new(n, &m.data, &q)?;
+    let s = LemkeSettings {
+        polish,
+        ..Default::default()
+    };
+    let mut ws = LemkeWorkspace::new(n);
+    let t = std::time::Instant::now();
+    let mut piv = 0;
+    for _ in 0..reps {
+        piv = solve_lemke_with(&mut ws, &lcp, &s)?.pivots;
+    }
+    println!(
+        "n={n}: {:.2} us per solve, {piv} pivots",
+        t.elapsed().as_secs_f64() * 1e6 / reps as f64
+    );
+    Ok(())
+}
