@@ -64,8 +64,7 @@ pub fn solve_enumerate(lcp: &LcpRef<'_>, s: &EnumerateSettings) -> Result<LcpSol
         for (r, &i) in a.iter().enumerate() {
             z[i] = rhs[r];
         }
-        let w = lcp.w(&z);
-        let m = lcp.measures(&z, &w, &eq);
+        let (w, m) = lcp.evaluate(&z, &eq);
         if !passes(&m, s.tol) {
             continue;
         }
@@ -102,8 +101,7 @@ pub fn solve_enumerate(lcp: &LcpRef<'_>, s: &EnumerateSettings) -> Result<LcpSol
         },
         None => {
             let z = vec![0.0; n];
-            let w = lcp.w(&z);
-            let measures = lcp.measures(&z, &w, &eq);
+            let (w, measures) = lcp.evaluate(&z, &eq);
             LcpSolution {
                 z,
                 w,

@@ -1,134 +1,127 @@
-//! The pivot's rank-one update, the only O(n^2) loop of Lemke's method, compiled for the
-//! vector units the running CPU has (chosen once per solve at run time, not at build time,
-//! so one wheel is fast everywhere).
+//! Run-time choice of vector instructions. The numerical loops are written once, marked
+//! `#[inline(always)]`, and instantiated inside functions compiled for AVX-512, AVX2+FMA or
+//! the baseline; the running CPU picks one at run time (not at build time), so one wheel is
+//! fast on every machine.
 
-/// `row += a * pivot_row` for every row of the tableau except `skip`, where
-/// `a = row[s]` and `row[s]` is zeroed first (the pivot column of the new tableau is then
-/// `a * pivot_row[s]`).
-pub type RankOneUpdate =
-    fn(tableau: &mut [f64], width: usize, skip: usize, s: usize, pivot_row: &[f64]);
-
-#[inline(always)]
-fn update_body(tableau: &mut [f64], width: usize, skip: usize, s: usize, pivot_row: &[f64]) {
-    for (i, row) in tableau.chunks_exact_mut(width).enumerate() {
-        if i == skip {
-            continue;
-        }
-        let a = row[s];
-        if a == 0.0 {
-            continue;
-        }
-        row[s] = 0.0;
-        for (x, p) in row.iter_mut().zip(pivot_row) {
-            *x = a.mul_add(*p, *x);
-        }
-    }
+/// The instruction sets a hot loop can be compiled for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Isa {
+    /// x86-64 with AVX-512F/VL (and AVX2, FMA).
+    Avx512,
+    /// x86-64 with AVX2 and FMA.
+    Avx2,
+    /// whatever the build targets (SSE2 on x86-64, NEON on aarch64).
+    Baseline,
 }
 
-#[inline(always)]
-fn update_body_nofma(tableau: &mut [f64], width: usize, skip: usize, s: usize, pivot_row: &[f64]) {
-    for (i, row) in tableau.chunks_exact_mut(width).enumerate() {
-        if i == skip {
-            continue;
-        }
-        let a = row[s];
-        if a == 0.0 {
-            continue;
-        }
-        row[s] = 0.0;
-        for (x, p) in row.iter_mut().zip(pivot_row) {
-            *x += a * *p;
-        }
-    }
-}
-
-fn update_portable(tableau: &mut [f64], width: usize, skip: usize, s: usize, pivot_row: &[f64]) {
-    update_body_nofma(tableau, width, skip, s, pivot_row)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-fn update_avx2(tableau: &mut [f64], width: usize, skip: usize, s: usize, pivot_row: &[f64]) {
-    update_body(tableau, width, skip, s, pivot_row)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512vl,avx2,fma")]
-fn update_avx512(tableau: &mut [f64], width: usize, skip: usize, s: usize, pivot_row: &[f64]) {
-    update_body(tableau, width, skip, s, pivot_row)
-}
-
-#[cfg(target_arch = "x86_64")]
-fn update_avx2_checked(
-    tableau: &mut [f64],
-    width: usize,
-    skip: usize,
-    s: usize,
-    pivot_row: &[f64],
-) {
-    // SAFETY: `select` hands out this function only after detecting avx2 and fma.
-    unsafe { update_avx2(tableau, width, skip, s, pivot_row) }
-}
-
-#[cfg(target_arch = "x86_64")]
-fn update_avx512_checked(
-    tableau: &mut [f64],
-    width: usize,
-    skip: usize,
-    s: usize,
-    pivot_row: &[f64],
-) {
-    // SAFETY: `select` hands out this function only after detecting avx512f/vl, avx2 and fma.
-    unsafe { update_avx512(tableau, width, skip, s, pivot_row) }
-}
-
-/// the fastest update the running CPU supports.
-pub fn select() -> RankOneUpdate {
+/// the best instruction set this CPU supports.
+pub fn detect() -> Isa {
     #[cfg(target_arch = "x86_64")]
     {
-        if std::arch::is_x86_feature_detected!("avx512f")
+        let avx2 = std::arch::is_x86_feature_detected!("avx2")
+            && std::arch::is_x86_feature_detected!("fma");
+        if avx2
+            && std::arch::is_x86_feature_detected!("avx512f")
             && std::arch::is_x86_feature_detected!("avx512vl")
-            && std::arch::is_x86_feature_detected!("avx2")
-            && std::arch::is_x86_feature_detected!("fma")
         {
-            return update_avx512_checked;
+            return Isa::Avx512;
         }
-        if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
-        {
-            return update_avx2_checked;
+        if avx2 {
+            return Isa::Avx2;
         }
     }
-    #[cfg(target_arch = "aarch64")]
-    {
-        // NEON with fused multiply-add is part of the aarch64 baseline.
-        return |t, w, k, s, p| update_body(t, w, k, s, p);
-    }
-    #[allow(unreachable_code)]
-    update_portable
+    Isa::Baseline
 }
 
-/// the name of the variant [`select`] picks on this CPU (for benchmark reports).
+/// the name of [`detect`]'s choice (for benchmark reports).
 pub fn level() -> &'static str {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if std::arch::is_x86_feature_detected!("avx512f")
-            && std::arch::is_x86_feature_detected!("avx512vl")
-            && std::arch::is_x86_feature_detected!("avx2")
-            && std::arch::is_x86_feature_detected!("fma")
-        {
-            return "avx512";
-        }
-        if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
-        {
-            return "avx2+fma";
+    match detect() {
+        Isa::Avx512 => "avx512",
+        Isa::Avx2 => "avx2+fma",
+        Isa::Baseline => {
+            if cfg!(target_arch = "aarch64") {
+                "neon"
+            } else {
+                "baseline"
+            }
         }
     }
-    #[cfg(target_arch = "aarch64")]
-    {
-        return "neon";
+}
+
+/// Calls `$body` (an expression) compiled for the instruction set `$isa`. Every function the
+/// body calls must be `#[inline(always)]` to be compiled for it too.
+macro_rules! dispatch {
+    ($isa:expr, $ret:ty, || $body:expr) => {{
+        #[cfg(target_arch = "x86_64")]
+        {
+            #[target_feature(enable = "avx512f,avx512vl,avx2,fma")]
+            #[allow(clippy::unused_unit)]
+            fn avx512<F: FnOnce() -> $ret>(f: F) -> $ret {
+                f()
+            }
+            #[target_feature(enable = "avx2,fma")]
+            #[allow(clippy::unused_unit)]
+            fn avx2<F: FnOnce() -> $ret>(f: F) -> $ret {
+                f()
+            }
+            match $isa {
+                // SAFETY: `kernel::detect` reported these features on the running CPU.
+                $crate::lcp::kernel::Isa::Avx512 => unsafe { avx512(|| $body) },
+                // SAFETY: as above.
+                $crate::lcp::kernel::Isa::Avx2 => unsafe { avx2(|| $body) },
+                $crate::lcp::kernel::Isa::Baseline => $body,
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            let _ = $isa;
+            $body
+        }
+    }};
+}
+pub(crate) use dispatch;
+
+/// `y += a x`
+#[inline(always)]
+pub fn axpy(y: &mut [f64], a: f64, x: &[f64]) {
+    for (yi, xi) in y.iter_mut().zip(x) {
+        *yi += a * xi;
     }
-    #[allow(unreachable_code)]
-    "portable"
+}
+
+/// `(Σ_j a_j b_j, Σ_j |a_j b_j|)` with eight partial sums, so the compiler can keep them in
+/// one vector register (a single running sum forces sequential adds).
+#[inline(always)]
+pub fn dot_and_abs(a: &[f64], b: &[f64]) -> (f64, f64) {
+    let mut dot = [0.0f64; 8];
+    let mut abs = [0.0f64; 8];
+    let split = a.len().min(b.len()) / 8 * 8;
+    for (ca, cb) in a[..split].chunks_exact(8).zip(b[..split].chunks_exact(8)) {
+        for k in 0..8 {
+            let t = ca[k] * cb[k];
+            dot[k] += t;
+            abs[k] += t.abs();
+        }
+    }
+    let mut d: f64 = dot.iter().sum();
+    let mut s: f64 = abs.iter().sum();
+    for (x, y) in a[split..].iter().zip(&b[split..]) {
+        let t = x * y;
+        d += t;
+        s += t.abs();
+    }
+    (d, s)
+}
+
+/// `max_j |x_j s_j|` in a form that compiles to vector max instructions.
+#[inline(always)]
+pub fn max_abs_scaled(x: &[f64], s: &[f64]) -> f64 {
+    let mut m = 0.0f64;
+    for (a, b) in x.iter().zip(s) {
+        let v = (a * b).abs();
+        m = if v > m { v } else { m };
+    }
+    m
 }
 
 #[cfg(test)]
@@ -136,28 +129,20 @@ mod tests {
     use super::*;
 
     #[test]
-    fn every_variant_agrees_with_the_definition() {
-        let width = 5;
-        let base: Vec<f64> = (0..20).map(|k| (k as f64 * 0.37).sin()).collect();
-        let pivot_row: Vec<f64> = (0..5).map(|k| (k as f64 * 1.1).cos()).collect();
-        let mut expect = base.clone();
-        for i in 0..4 {
-            if i == 1 {
-                continue;
-            }
-            let a = expect[i * width + 2];
-            expect[i * width + 2] = 0.0;
-            for j in 0..width {
-                expect[i * width + j] += a * pivot_row[j];
-            }
+    fn dispatched_loops_agree_with_the_definition() {
+        let x: Vec<f64> = (0..37).map(|k| (k as f64 * 0.37).sin()).collect();
+        let s: Vec<f64> = (0..37).map(|k| (k as f64 * 1.1).cos()).collect();
+        let mut y = s.clone();
+        dispatch!(detect(), (), || axpy(&mut y, 0.5, &x));
+        for k in 0..37 {
+            assert!((y[k] - (s[k] + 0.5 * x[k])).abs() < 1e-15);
         }
-        let mut got = base.clone();
-        select()(&mut got, width, 1, 2, &pivot_row);
-        for (g, e) in got.iter().zip(&expect) {
-            assert!((g - e).abs() < 1e-15);
-        }
-        let mut got = base;
-        update_portable(&mut got, width, 1, 2, &pivot_row);
-        assert_eq!(got, expect);
+        let m = dispatch!(detect(), f64, || max_abs_scaled(&x, &s));
+        let want = x
+            .iter()
+            .zip(&s)
+            .map(|(a, b)| (a * b).abs())
+            .fold(0.0, f64::max);
+        assert_eq!(m, want);
     }
 }

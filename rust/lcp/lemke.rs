@@ -28,7 +28,7 @@
 //!   original data by one factorization, and the polished answer is kept if its error is
 //!   smaller.
 
-use super::kernel::{self, RankOneUpdate};
+use super::kernel::{self, axpy, Isa};
 use super::scaling::Equilibration;
 use super::small::solve_principal;
 use super::{check_tol, passes, LcpMeasures, LcpRef, LcpSolution, LcpStatus, WarmStart};
@@ -98,40 +98,71 @@ enum Blocking {
     NonFinite,
 }
 
+/// problems at least this large delay their rank-one updates (see [`LemkeWorkspace`]).
+const BLOCKED_FROM: usize = 64;
+/// how many rank-one updates are gathered before one rank-k update applies them.
+const BLOCK: usize = 16;
+
 /// Storage for Lemke's method, sized once for a problem size and reused across solves (for
 /// example across the time steps of a simulation).
+///
+/// The tableau holds the nonbasic columns of `F = B^{-1} [I, -M, -d | q]` (n x (n+2),
+/// row-major). A pivot on row r and entering column s first makes column s the unit vector e_r
+/// (it now stands for the leaving variable) and then applies the rank-one update
+///
+/// ```text
+///     F <- F + u v^T,   u = -(f - e_r) / f_r,   v = F[r, :],
+/// ```
+///
+/// with f the entering column. For n >= 64 the updates are not applied at once: up to 32 of
+/// them are kept as (u, v) pairs, the few columns and rows a pivot reads are corrected on the
+/// fly (O(n k) each), and one rank-k product applies them together. That reads the tableau
+/// from memory once per k pivots instead of once per pivot, which is what bounds the
+/// unblocked method's speed.
 pub struct LemkeWorkspace {
     n: usize,
     width: usize,
     tableau: Vec<f64>,
-    pivot_row: Vec<f64>,
+    block: usize,
+    pending: usize,
+    pending_u: Vec<f64>,
+    pending_v: Vec<f64>,
+    column: Vec<f64>,
+    values: Vec<f64>,
+    row: Vec<f64>,
+    u: Vec<f64>,
     basic: Vec<usize>,
     nonbasic: Vec<usize>,
     loc: Vec<Loc>,
-    column: Vec<f64>,
-    values: Vec<f64>,
     ties: Vec<usize>,
     ties_next: Vec<usize>,
-    update: RankOneUpdate,
+    isa: Isa,
 }
 
 impl LemkeWorkspace {
-    /// a workspace for problems of size n: one n x (n+2) tableau and O(n) bookkeeping.
+    /// a workspace for problems of size n: one n x (n+2) tableau, 32 pending update pairs
+    /// (for n >= 64) and O(n) bookkeeping.
     pub fn new(n: usize) -> Self {
         let width = n + 2;
+        let block = if n >= BLOCKED_FROM { BLOCK } else { 0 };
         Self {
             n,
             width,
             tableau: vec![0.0; n * width],
-            pivot_row: vec![0.0; width],
+            block,
+            pending: 0,
+            pending_u: vec![0.0; block * n],
+            pending_v: vec![0.0; block * width],
+            column: vec![0.0; n],
+            values: vec![0.0; n],
+            row: vec![0.0; width],
+            u: vec![0.0; n],
             basic: vec![0; n],
             nonbasic: vec![0; n + 1],
             loc: vec![Loc::Row(0); 2 * n + 1],
-            column: vec![0.0; n],
-            values: vec![0.0; n],
             ties: Vec::with_capacity(n),
             ties_next: Vec::with_capacity(n),
-            update: kernel::select(),
+            isa: kernel::detect(),
         }
     }
 
@@ -140,15 +171,18 @@ impl LemkeWorkspace {
         self.n
     }
 
-    /// bytes of the tableau (the workspace's dominant memory).
+    /// bytes of the tableau and the pending updates (the workspace's dominant memory).
     pub fn tableau_bytes(&self) -> usize {
-        self.tableau.len() * std::mem::size_of::<f64>()
+        (self.tableau.len() + self.pending_u.len() + self.pending_v.len())
+            * std::mem::size_of::<f64>()
     }
 
+    #[inline(always)]
     fn z0(&self) -> usize {
         2 * self.n
     }
 
+    #[inline(always)]
     fn complement(&self, var: usize) -> usize {
         if var < self.n {
             var + self.n
@@ -157,7 +191,7 @@ impl LemkeWorkspace {
         }
     }
 
-    /// w is basic in every row, z and z0 are the nonbasic columns.
+    /// w is basic in every row; z and z0 are the nonbasic columns: F = [-M' | -d' | q'].
     fn load(&mut self, lcp: &LcpRef<'_>, eq: &Equilibration, cover: &[f64]) {
         let n = self.n;
         let w = self.width;
@@ -169,10 +203,11 @@ impl LemkeWorkspace {
         {
             let r = eq.row[i];
             for ((t, m), c) in row.iter_mut().zip(mrow).zip(&eq.col) {
-                *t = r * m * c;
+                *t = -(r * m * c);
             }
-            row[n] = cover[i];
+            row[n] = -cover[i];
             row[n + 1] = r * lcp.q[i] / eq.sigma;
+            self.values[i] = row[n + 1];
             self.basic[i] = i;
             self.loc[i] = Loc::Row(i);
         }
@@ -180,15 +215,37 @@ impl LemkeWorkspace {
             self.nonbasic[j] = n + j;
             self.loc[n + j] = Loc::Col(j);
         }
+        self.pending = 0;
     }
 
-    #[inline]
+    /// entry (i, j) of the current tableau.
+    #[inline(always)]
     fn at(&self, i: usize, j: usize) -> f64 {
-        self.tableau[i * self.width + j]
+        let (n, w) = (self.n, self.width);
+        let mut x = self.tableau[i * w + j];
+        for p in 0..self.pending {
+            x += self.pending_u[p * n + i] * self.pending_v[p * w + j];
+        }
+        x
+    }
+
+    /// column j of the current tableau into `out`.
+    #[inline(always)]
+    fn gather_column(&self, j: usize, out: &mut [f64]) {
+        let (n, w) = (self.n, self.width);
+        for (o, row) in out.iter_mut().zip(self.tableau.chunks_exact(w)) {
+            *o = row[j];
+        }
+        for p in 0..self.pending {
+            let a = self.pending_v[p * w + j];
+            if a != 0.0 {
+                axpy(out, a, &self.pending_u[p * n..(p + 1) * n]);
+            }
+        }
     }
 
     /// `B^{-1}[i, k]`: the coefficient of the original w_k in row i of the full tableau.
-    #[inline]
+    #[inline(always)]
     fn inverse_basis(&self, i: usize, k: usize) -> f64 {
         match self.loc[k] {
             Loc::Row(r) => {
@@ -198,22 +255,23 @@ impl LemkeWorkspace {
                     0.0
                 }
             }
-            Loc::Col(c) => -self.at(i, c),
+            Loc::Col(c) => self.at(i, c),
         }
     }
 
-    /// Keeps, among `self.ties`, the rows whose lexicographic ratio
-    /// `B^{-1}[i, :] / (-T[i, s])` is smallest (the perturbation `q + (ε, ε², …)` argument).
+    /// Keeps, among `self.ties`, the rows whose lexicographic ratio `B^{-1}[i, :] / f_i` is
+    /// smallest (the perturbation `q + (ε, ε², …)` argument), f being `self.column`.
     /// `sign` is +1 for a minimum-ratio test and -1 for the initial maximum-ratio test.
-    fn lexicographic(&mut self, s: usize, sign: f64) -> Option<usize> {
+    #[inline(always)]
+    fn lexicographic(&mut self, sign: f64) -> Option<usize> {
         let n = self.n;
         // Rounding leaves ~1e-16 where exact arithmetic has 0, so entries are compared at the
         // scale of the tied rows' whole lexicographic vectors, not entry by entry.
         let mut scale: f64 = 0.0;
         for &i in &self.ties {
-            let a = -self.at(i, s);
+            let f = self.column[i];
             for k in 0..n {
-                scale = scale.max((self.inverse_basis(i, k) / a).abs());
+                scale = scale.max((self.inverse_basis(i, k) / f).abs());
             }
         }
         if !scale.is_finite() {
@@ -226,13 +284,11 @@ impl LemkeWorkspace {
             }
             let mut best = f64::INFINITY;
             for &i in &self.ties {
-                let v = sign * self.inverse_basis(i, k) / (-self.at(i, s));
-                best = best.min(v);
+                best = best.min(sign * self.inverse_basis(i, k) / self.column[i]);
             }
             self.ties_next.clear();
             for &i in &self.ties {
-                let v = sign * self.inverse_basis(i, k) / (-self.at(i, s));
-                if v <= best + tol {
+                if sign * self.inverse_basis(i, k) / self.column[i] <= best + tol {
                     self.ties_next.push(i);
                 }
             }
@@ -244,39 +300,35 @@ impl LemkeWorkspace {
         // Exact arithmetic leaves one row; with rounding, prefer the largest pivot.
         let mut pick = *self.ties.first()?;
         for &i in &self.ties {
-            if self.at(i, s).abs() > self.at(pick, s).abs() {
+            if self.column[i].abs() > self.column[pick].abs() {
                 pick = i;
             }
         }
         Some(pick)
     }
 
-    /// the blocking row when the variable in column s enters.
+    /// the blocking row when the variable in column s enters (its column is left in
+    /// `self.column`, the basic values in `self.values`).
+    #[inline(always)]
     fn ratio_test(&mut self, s: usize) -> Blocking {
-        let w = self.width;
-        // one strided pass gathers the column and the basic values; the rest runs contiguous
-        let mut colmax: f64 = 0.0;
-        let mut rhsmax: f64 = 1.0;
-        for (i, row) in self.tableau.chunks_exact(w).enumerate() {
-            let a = row[s];
-            let b = row[w - 1];
-            self.column[i] = a;
-            self.values[i] = b;
-            colmax = colmax.max(a.abs());
-            rhsmax = rhsmax.max(b.abs());
-        }
+        let mut column = std::mem::take(&mut self.column);
+        self.gather_column(s, &mut column);
+        self.column = column;
+        let colmax = self.column.iter().fold(0.0f64, |m, a| m.max(a.abs()));
+        let rhsmax = self.values.iter().fold(1.0f64, |m, b| m.max(b.abs()));
         if !(colmax.is_finite() && rhsmax.is_finite()) {
             return Blocking::NonFinite;
         }
         let piv_tol = PIVOT_EPS * colmax.max(1.0);
         let zero_rhs = RHS_EPS * rhsmax;
         let mut theta = f64::INFINITY;
-        for (a, b) in self.column.iter().zip(self.values.iter_mut()) {
+        for (f, b) in self.column.iter().zip(self.values.iter_mut()) {
+            // degenerate rows: exact zeros, so ties are ties
             if *b <= zero_rhs {
                 *b = 0.0;
             }
-            if *a < -piv_tol {
-                theta = theta.min(*b / -*a);
+            if *f > piv_tol {
+                theta = theta.min(*b / *f);
             }
         }
         if theta == f64::INFINITY {
@@ -285,8 +337,8 @@ impl LemkeWorkspace {
         let tie = TIE_EPS * theta;
         self.ties.clear();
         let z0 = self.z0();
-        for (i, (a, b)) in self.column.iter().zip(&self.values).enumerate() {
-            if *a < -piv_tol && *b / -*a <= theta + tie {
+        for (i, (f, b)) in self.column.iter().zip(&self.values).enumerate() {
+            if *f > piv_tol && *b / *f <= theta + tie {
                 if self.basic[i] == z0 {
                     return Blocking::Row(i);
                 }
@@ -297,18 +349,22 @@ impl LemkeWorkspace {
             0 => Blocking::NonFinite,
             1 => Blocking::Row(self.ties[0]),
             _ => self
-                .lexicographic(s, 1.0)
+                .lexicographic(1.0)
                 .map_or(Blocking::NonFinite, Blocking::Row),
         }
     }
 
     /// the row that leaves when z0 first enters: the one needing the largest z0.
+    #[inline(always)]
     fn initial_row(&mut self) -> Option<usize> {
         let n = self.n;
-        let (zc, rhs) = (n, n + 1);
+        let mut column = std::mem::take(&mut self.column);
+        self.gather_column(n, &mut column);
+        self.column = column;
+        // x_B = q' + d' z0 >= 0 needs z0 >= -q'_i / d'_i = values_i / column_i
         let mut theta = f64::NEG_INFINITY;
-        for i in 0..n {
-            theta = theta.max(-self.at(i, rhs) / self.at(i, zc));
+        for (b, f) in self.values.iter().zip(&self.column) {
+            theta = theta.max(b / f);
         }
         if !theta.is_finite() {
             return None;
@@ -316,7 +372,7 @@ impl LemkeWorkspace {
         let tie = TIE_EPS * theta.abs().max(1e-12);
         self.ties.clear();
         for i in 0..n {
-            if -self.at(i, rhs) / self.at(i, zc) >= theta - tie {
+            if self.values[i] / self.column[i] >= theta - tie {
                 self.ties.push(i);
             }
         }
@@ -324,35 +380,80 @@ impl LemkeWorkspace {
             0 => None,
             1 => Some(self.ties[0]),
             // maximum ratio: the lexicographic argument with the sign reversed
-            _ => self.lexicographic(zc, -1.0),
+            _ => self.lexicographic(-1.0),
         }
     }
 
-    /// exchanges the basic variable of row r with the nonbasic variable of column s.
-    fn pivot(&mut self, r: usize, s: usize) -> bool {
-        let w = self.width;
-        let piv = self.tableau[r * w + s];
-        {
-            let row = &mut self.tableau[r * w..(r + 1) * w];
-            let inv = 1.0 / piv;
-            for (p, x) in self.pivot_row.iter_mut().zip(row.iter()) {
-                *p = -x * inv;
-            }
-            self.pivot_row[s] = inv;
-            row.copy_from_slice(&self.pivot_row);
+    /// applies the pending updates: `F += U^T V` as one matrix product.
+    fn flush(&mut self) {
+        let k = self.pending;
+        if k == 0 {
+            return;
         }
-        (self.update)(&mut self.tableau, w, r, s, &self.pivot_row);
+        let (n, w) = (self.n, self.width);
+        let dst = faer::MatMut::from_row_major_slice_mut(&mut self.tableau, n, w);
+        let ut = faer::MatRef::from_row_major_slice(&self.pending_u[..k * n], k, n).transpose();
+        let v = faer::MatRef::from_row_major_slice(&self.pending_v[..k * w], k, w);
+        faer::linalg::matmul::matmul(dst, faer::Accum::Add, ut, v, 1.0, faer::Par::Seq);
+        self.pending = 0;
+    }
+
+    /// exchanges the basic variable of row r with the nonbasic variable of column s, whose
+    /// current column is `self.column`. Returns false if the arithmetic broke down.
+    #[inline(always)]
+    fn pivot(&mut self, r: usize, s: usize) -> bool {
+        let (n, w) = (self.n, self.width);
+        let piv = self.column[r];
+        // column s now stands for the leaving variable, whose column is e_r
+        for (i, row) in self.tableau.chunks_exact_mut(w).enumerate() {
+            row[s] += if i == r { 1.0 } else { 0.0 } - self.column[i];
+        }
+        // the pivot row of the current tableau
+        self.row.copy_from_slice(&self.tableau[r * w..(r + 1) * w]);
+        for p in 0..self.pending {
+            let a = self.pending_u[p * n + r];
+            if a != 0.0 {
+                axpy(&mut self.row, a, &self.pending_v[p * w..(p + 1) * w]);
+            }
+        }
+        let inv = 1.0 / piv;
+        for (u, f) in self.u.iter_mut().zip(&self.column) {
+            *u = -f * inv;
+        }
+        self.u[r] = (1.0 - piv) * inv;
+        axpy(&mut self.values, self.row[w - 1], &self.u);
+        if self.block == 0 {
+            for (trow, &a) in self.tableau.chunks_exact_mut(w).zip(&self.u) {
+                if a != 0.0 {
+                    axpy(trow, a, &self.row);
+                }
+            }
+        } else {
+            let p = self.pending;
+            self.pending_u[p * n..(p + 1) * n].copy_from_slice(&self.u);
+            self.pending_v[p * w..(p + 1) * w].copy_from_slice(&self.row);
+            self.pending += 1;
+            if self.pending == self.block {
+                self.flush();
+            }
+        }
         let entering = self.nonbasic[s];
         let leaving = self.basic[r];
         self.basic[r] = entering;
         self.nonbasic[s] = leaving;
         self.loc[entering] = Loc::Row(r);
         self.loc[leaving] = Loc::Col(s);
-        piv.is_finite() && self.tableau[r * w + w - 1].is_finite()
+        inv.is_finite() && self.row[w - 1].is_finite()
     }
 
-    /// Runs the complementary pivots from the all-w basis. Returns how it ended and the pivots.
+    /// Runs the complementary pivots from the all-w basis, compiled for the CPU's vector
+    /// instructions. Returns how it ended and the pivots.
     fn run(&mut self, max_pivots: usize) -> (Ending, usize) {
+        kernel::dispatch!(self.isa, (Ending, usize), || self.run_body(max_pivots))
+    }
+
+    #[inline(always)]
+    fn run_body(&mut self, max_pivots: usize) -> (Ending, usize) {
         let n = self.n;
         let z0 = self.z0();
         let Some(r) = self.initial_row() else {
@@ -398,7 +499,7 @@ impl LemkeWorkspace {
             let var = self.basic[i];
             if var >= n && var < 2 * n {
                 let k = var - n;
-                z[k] = eq.sigma * eq.col[k] * self.at(i, n + 1).max(0.0);
+                z[k] = eq.sigma * eq.col[k] * self.values[i].max(0.0);
                 basis.push(k);
             }
         }
@@ -418,8 +519,7 @@ struct Candidate {
 }
 
 fn candidate(lcp: &LcpRef<'_>, eq: &Equilibration, z: Vec<f64>) -> Candidate {
-    let w = lcp.w(&z);
-    let measures = lcp.measures(&z, &w, eq);
+    let (w, measures) = lcp.evaluate(&z, eq);
     Candidate { z, w, measures }
 }
 
@@ -523,12 +623,13 @@ pub fn solve_lemke_with(
     }
     let eq = Equilibration::compute(n, lcp.m, lcp.q);
     let tol = settings.tol;
+    let (w0, m0) = lcp.evaluate(&vec![0.0; n], &eq);
     let mut out = LcpSolution {
         z: vec![0.0; n],
-        w: lcp.q.to_vec(),
+        w: w0,
         status: LcpStatus::Solved,
         message: String::new(),
-        measures: lcp.measures(&vec![0.0; n], lcp.q, &eq),
+        measures: m0,
         pivots: 0,
         iterations: 0,
         basis: Vec::new(),

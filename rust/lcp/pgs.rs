@@ -73,8 +73,7 @@ pub fn solve_pgs(lcp: &LcpRef<'_>, s: &PgsSettings) -> Result<LcpSolution> {
     let eq = Equilibration::compute(n, lcp.m, lcp.q);
     let omega = s.relaxation;
     let mut sweeps = 0;
-    let mut w = lcp.w(&z);
-    let mut measures = lcp.measures(&z, &w, &eq);
+    let (mut w, mut measures) = lcp.evaluate(&z, &eq);
     while !passes(&measures, s.tol) && sweeps < s.max_iter {
         for i in 0..n {
             let row = &lcp.m[i * n..(i + 1) * n];
@@ -82,8 +81,7 @@ pub fn solve_pgs(lcp: &LcpRef<'_>, s: &PgsSettings) -> Result<LcpSolution> {
             z[i] = (z[i] - omega * wi / row[i]).max(0.0);
         }
         sweeps += 1;
-        w = lcp.w(&z);
-        measures = lcp.measures(&z, &w, &eq);
+        (w, measures) = lcp.evaluate(&z, &eq);
         if !measures.error.is_finite() {
             break;
         }

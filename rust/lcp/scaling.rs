@@ -10,6 +10,8 @@
 //! R and C come from a few sweeps of Ruiz's infinity-norm equilibration, and every factor is
 //! rounded to a power of two so that scaling adds no rounding error of its own.
 
+use super::kernel;
+
 /// Row and column factors and the right-hand side normaliser.
 #[derive(Clone, Debug)]
 pub struct Equilibration {
@@ -52,39 +54,44 @@ impl Equilibration {
 
     /// computes R, C and sigma for the row-major n x n matrix `m` and vector `q`.
     pub fn compute(n: usize, m: &[f64], q: &[f64]) -> Self {
+        let isa = kernel::detect();
+        kernel::dispatch!(isa, Equilibration, || Self::compute_body(n, m, q))
+    }
+
+    /// Ruiz's simultaneous form: both factors of a sweep come from the same scaled matrix,
+    /// so a sweep is one pass over M.
+    #[inline(always)]
+    fn compute_body(n: usize, m: &[f64], q: &[f64]) -> Self {
         let mut row = vec![1.0; n];
         let mut col = vec![1.0; n];
+        let mut rowmax = vec![0.0f64; n];
         let mut colmax = vec![0.0f64; n];
         for _ in 0..RUIZ_SWEEPS {
-            let mut settled = true;
             colmax.iter_mut().for_each(|c| *c = 0.0);
-            for i in 0..n {
-                let mut rmax: f64 = 0.0;
-                for j in 0..n {
-                    rmax = rmax.max((m[i * n + j] * col[j]).abs());
-                }
-                rmax *= row[i];
-                if rmax > 0.0 {
-                    let f = pow2(1.0 / rmax.sqrt());
-                    if f != 1.0 {
-                        settled = false;
-                    }
-                    row[i] *= f;
+            for (i, mrow) in m.chunks_exact(n.max(1)).enumerate() {
+                let r = row[i];
+                rowmax[i] = r * kernel::max_abs_scaled(mrow, &col);
+                for (cm, v) in colmax.iter_mut().zip(mrow) {
+                    let a = (v * r).abs();
+                    *cm = if a > *cm { a } else { *cm };
                 }
             }
-            for i in 0..n {
-                for j in 0..n {
-                    colmax[j] = colmax[j].max((row[i] * m[i * n + j]).abs());
+            let mut settled = true;
+            // only rows and columns off by more than a factor 4 are rescaled: equilibration is
+            // for badly scaled data, and fine-tuning well-scaled data only costs sweeps
+            for (r, rm) in row.iter_mut().zip(&rowmax) {
+                if *rm > 0.0 && !(0.25..=4.0).contains(rm) {
+                    let f = pow2(1.0 / rm.sqrt());
+                    settled &= f == 1.0;
+                    *r *= f;
                 }
             }
-            for j in 0..n {
-                let cm = colmax[j] * col[j];
-                if cm > 0.0 {
+            for (c, cm) in col.iter_mut().zip(&colmax) {
+                let cm = cm * *c;
+                if cm > 0.0 && !(0.25..=4.0).contains(&cm) {
                     let f = pow2(1.0 / cm.sqrt());
-                    if f != 1.0 {
-                        settled = false;
-                    }
-                    col[j] *= f;
+                    settled &= f == 1.0;
+                    *c *= f;
                 }
             }
             if settled {

@@ -39,7 +39,7 @@ pub fn solve_principal(n: usize, m: &[f64], q: &[f64], a: &[usize]) -> Option<Ve
         }
     } else {
         let block = Mat::from_fn(k, k, |r, c| m[a[r] * n + a[c]]);
-        let lu = block.full_piv_lu();
+        let lu = block.partial_piv_lu();
         let u = lu.U();
         let mut dmax: f64 = 0.0;
         let mut dmin = f64::INFINITY;
