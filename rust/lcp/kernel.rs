@@ -113,13 +113,59 @@ pub fn dot_and_abs(a: &[f64], b: &[f64]) -> (f64, f64) {
     (d, s)
 }
 
-/// `max_j |x_j s_j|` in a form that compiles to vector max instructions.
+/// `max_j |x_j s_j|` with eight running maxima (one vector register; a single running
+/// maximum would be a sequential chain).
 #[inline(always)]
 pub fn max_abs_scaled(x: &[f64], s: &[f64]) -> f64 {
-    let mut m = 0.0f64;
-    for (a, b) in x.iter().zip(s) {
+    let mut lanes = [0.0f64; 8];
+    let split = x.len().min(s.len()) / 8 * 8;
+    for (cx, cs) in x[..split].chunks_exact(8).zip(s[..split].chunks_exact(8)) {
+        for k in 0..8 {
+            let v = (cx[k] * cs[k]).abs();
+            lanes[k] = if v > lanes[k] { v } else { lanes[k] };
+        }
+    }
+    let mut m = lanes
+        .iter()
+        .fold(0.0f64, |m, v| if *v > m { *v } else { m });
+    for (a, b) in x[split..].iter().zip(&s[split..]) {
         let v = (a * b).abs();
         m = if v > m { v } else { m };
+    }
+    m
+}
+
+/// The minimum-ratio step of Lemke's ratio test, branch-free so it runs as vector
+/// instructions: zeroes the basic values `b_i <= zero` (degenerate rows), writes
+/// `t_i = b_i / f_i` for the blocking rows `f_i > piv_tol` (infinity for the others) and
+/// returns `min_i t_i`.
+#[inline(always)]
+pub fn min_ratio(f: &[f64], b: &mut [f64], t: &mut [f64], piv_tol: f64, zero: f64) -> f64 {
+    let n = f.len().min(b.len()).min(t.len());
+    let split = n / 8 * 8;
+    let mut lanes = [f64::INFINITY; 8];
+    let step = |fi: f64, bi: &mut f64, ti: &mut f64| {
+        let v = if *bi <= zero { 0.0 } else { *bi };
+        *bi = v;
+        let r = v / fi;
+        *ti = if fi > piv_tol { r } else { f64::INFINITY };
+    };
+    for ((cf, cb), ct) in f[..split]
+        .chunks_exact(8)
+        .zip(b[..split].chunks_exact_mut(8))
+        .zip(t[..split].chunks_exact_mut(8))
+    {
+        for k in 0..8 {
+            step(cf[k], &mut cb[k], &mut ct[k]);
+            lanes[k] = if ct[k] < lanes[k] { ct[k] } else { lanes[k] };
+        }
+    }
+    let mut m = lanes
+        .iter()
+        .fold(f64::INFINITY, |m, v| if *v < m { *v } else { m });
+    for i in split..n {
+        step(f[i], &mut b[i], &mut t[i]);
+        m = if t[i] < m { t[i] } else { m };
     }
     m
 }

@@ -114,7 +114,7 @@ const BLOCK: usize = 16;
 ///     F <- F + u v^T,   u = -(f - e_r) / f_r,   v = F[r, :],
 /// ```
 ///
-/// with f the entering column. For n >= 64 the updates are not applied at once: up to 32 of
+/// with f the entering column. For n >= 64 the updates are not applied at once: up to 16 of
 /// them are kept as (u, v) pairs, the few columns and rows a pivot reads are corrected on the
 /// fly (O(n k) each), and one rank-k product applies them together. That reads the tableau
 /// from memory once per k pivots instead of once per pivot, which is what bounds the
@@ -129,6 +129,7 @@ pub struct LemkeWorkspace {
     pending_v: Vec<f64>,
     column: Vec<f64>,
     values: Vec<f64>,
+    ratios: Vec<f64>,
     row: Vec<f64>,
     u: Vec<f64>,
     basic: Vec<usize>,
@@ -140,7 +141,7 @@ pub struct LemkeWorkspace {
 }
 
 impl LemkeWorkspace {
-    /// a workspace for problems of size n: one n x (n+2) tableau, 32 pending update pairs
+    /// a workspace for problems of size n: one n x (n+2) tableau, 16 pending update pairs
     /// (for n >= 64) and O(n) bookkeeping.
     pub fn new(n: usize) -> Self {
         let width = n + 2;
@@ -155,6 +156,7 @@ impl LemkeWorkspace {
             pending_v: vec![0.0; block * width],
             column: vec![0.0; n],
             values: vec![0.0; n],
+            ratios: vec![0.0; n],
             row: vec![0.0; width],
             u: vec![0.0; n],
             basic: vec![0; n],
@@ -321,24 +323,21 @@ impl LemkeWorkspace {
         }
         let piv_tol = PIVOT_EPS * colmax.max(1.0);
         let zero_rhs = RHS_EPS * rhsmax;
-        let mut theta = f64::INFINITY;
-        for (f, b) in self.column.iter().zip(self.values.iter_mut()) {
-            // degenerate rows: exact zeros, so ties are ties
-            if *b <= zero_rhs {
-                *b = 0.0;
-            }
-            if *f > piv_tol {
-                theta = theta.min(*b / *f);
-            }
-        }
+        let theta = kernel::min_ratio(
+            &self.column,
+            &mut self.values,
+            &mut self.ratios,
+            piv_tol,
+            zero_rhs,
+        );
         if theta == f64::INFINITY {
             return Blocking::Ray;
         }
-        let tie = TIE_EPS * theta;
+        let bound = theta + TIE_EPS * theta;
         self.ties.clear();
         let z0 = self.z0();
-        for (i, (f, b)) in self.column.iter().zip(&self.values).enumerate() {
-            if *f > piv_tol && *b / *f <= theta + tie {
+        for (i, t) in self.ratios.iter().enumerate() {
+            if *t <= bound {
                 if self.basic[i] == z0 {
                     return Blocking::Row(i);
                 }
@@ -623,7 +622,7 @@ pub fn solve_lemke_with(
     }
     let eq = Equilibration::compute(n, lcp.m, lcp.q);
     let tol = settings.tol;
-    let (w0, m0) = lcp.evaluate(&vec![0.0; n], &eq);
+    let (w0, m0) = lcp.evaluate_zero(&eq);
     let mut out = LcpSolution {
         z: vec![0.0; n],
         w: w0,
@@ -680,16 +679,25 @@ pub fn solve_lemke_with(
         out.pivots += pivots;
         out.restarts = attempt;
         ws.extract(&eq, &mut z, &mut basis);
-        let mut best = candidate(lcp, &eq, z.clone());
-        let mut polished = false;
-        if ending == Ending::Terminal && settings.polish {
-            if let Some(p) = principal(lcp, &eq, &basis) {
-                if better(&p.measures, &best.measures) {
-                    best = p;
-                    polished = true;
+        // The polished answer is usually the better one: when it passes, the tableau's answer
+        // need not be evaluated at all.
+        let polished_answer = if ending == Ending::Terminal && settings.polish {
+            principal(lcp, &eq, &basis)
+        } else {
+            None
+        };
+        let (best, polished) = match polished_answer {
+            Some(p) if passes(&p.measures, tol) => (p, true),
+            Some(p) => {
+                let t = candidate(lcp, &eq, z.clone());
+                if better(&p.measures, &t.measures) {
+                    (p, true)
+                } else {
+                    (t, false)
                 }
             }
-        }
+            None => (candidate(lcp, &eq, z.clone()), false),
+        };
         out.z = best.z;
         out.w = best.w;
         out.measures = best.measures;

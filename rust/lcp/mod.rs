@@ -232,6 +232,14 @@ impl<'a> LcpRef<'a> {
         (w, m)
     }
 
+    /// `evaluate` at z = 0 without a pass over M (w = q, and the terms of w_i are |q_i|).
+    pub fn evaluate_zero(&self, scaling: &scaling::Equilibration) -> (Vec<f64>, LcpMeasures) {
+        let z = vec![0.0; self.n];
+        let terms: Vec<f64> = self.q.iter().map(|v| v.abs()).collect();
+        let m = self.measures_with_terms(&z, self.q, &terms, scaling);
+        (self.q.to_vec(), m)
+    }
+
     /// the error measures of z (see [`LcpMeasures`]).
     pub fn measures(&self, z: &[f64], w: &[f64], scaling: &scaling::Equilibration) -> LcpMeasures {
         let (_, terms) = self.evaluate_parts(z);

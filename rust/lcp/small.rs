@@ -8,8 +8,9 @@
 use faer::linalg::solvers::Solve;
 use faer::Mat;
 
-/// systems at most this large are eliminated here; larger ones go to faer.
-const SMALL: usize = 48;
+/// systems at most this large are eliminated here; larger ones go to faer, whose blocked
+/// factorization wins from about this size on.
+const SMALL: usize = 128;
 
 /// relative size under which a pivot counts as zero (singular principal block).
 const SINGULAR: f64 = 1e-13;
@@ -24,19 +25,16 @@ pub fn solve_principal(n: usize, m: &[f64], q: &[f64], a: &[usize]) -> Option<Ve
     if k <= SMALL {
         let mut block = vec![0.0; k * k];
         let mut rhs = vec![0.0; k];
-        let mut perm = vec![0usize; k];
-        let mut work = vec![0.0; k];
         for (r, &i) in a.iter().enumerate() {
-            for (c, &j) in a.iter().enumerate() {
-                block[r * k + c] = m[i * n + j];
+            let mrow = &m[i * n..(i + 1) * n];
+            for (b, &j) in block[r * k..(r + 1) * k].iter_mut().zip(a) {
+                *b = mrow[j];
             }
             rhs[r] = -q[i];
         }
-        if gauss_complete(k, &mut block, &mut rhs, &mut perm, &mut work) {
-            Some(rhs)
-        } else {
-            None
-        }
+        let isa = super::kernel::detect();
+        let ok = super::kernel::dispatch!(isa, bool, || gauss_partial(k, &mut block, &mut rhs));
+        ok.then_some(rhs)
     } else {
         let block = Mat::from_fn(k, k, |r, c| m[a[r] * n + a[c]]);
         let lu = block.partial_piv_lu();
@@ -60,6 +58,55 @@ pub fn solve_principal(n: usize, m: &[f64], q: &[f64], a: &[usize]) -> Option<Ve
             None
         }
     }
+}
+
+/// Solves `A x = b` in place (x overwrites b) by Gaussian elimination with partial (row)
+/// pivoting; the row operations are contiguous, so they vectorize. Returns false if a pivot
+/// is negligible against the matrix's largest entry (numerically singular).
+#[inline(always)]
+pub fn gauss_partial(k: usize, a: &mut [f64], b: &mut [f64]) -> bool {
+    let scale = a.iter().fold(0.0f64, |s, v| s.max(v.abs()));
+    if scale == 0.0 || !scale.is_finite() {
+        return false;
+    }
+    for col in 0..k {
+        let mut pr = col;
+        let mut best = a[col * k + col].abs();
+        for r in col + 1..k {
+            let v = a[r * k + col].abs();
+            if v > best {
+                best = v;
+                pr = r;
+            }
+        }
+        if best.is_nan() || best <= SINGULAR * (k as f64) * scale {
+            return false;
+        }
+        if pr != col {
+            for c in col..k {
+                a.swap(pr * k + c, col * k + c);
+            }
+            b.swap(pr, col);
+        }
+        let (top, rest) = a.split_at_mut((col + 1) * k);
+        let prow = &top[col * k + col..col * k + k];
+        let piv = prow[0];
+        for (off, row) in rest.chunks_exact_mut(k).enumerate() {
+            let f = row[col] / piv;
+            if f != 0.0 {
+                super::kernel::axpy(&mut row[col..], -f, prow);
+                b[col + 1 + off] -= f * b[col];
+            }
+        }
+    }
+    for r in (0..k).rev() {
+        let mut s = b[r];
+        for c in r + 1..k {
+            s -= a[r * k + c] * b[c];
+        }
+        b[r] = s / a[r * k + r];
+    }
+    true
 }
 
 /// Solves `A x = b` in place (x overwrites b) by Gaussian elimination with complete pivoting.
