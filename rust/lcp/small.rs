@@ -10,7 +10,7 @@ use faer::Mat;
 
 /// systems at most this large are eliminated here; larger ones go to faer, whose blocked
 /// factorization wins from about this size on.
-const SMALL: usize = 128;
+const SMALL: usize = 32;
 
 /// relative size under which a pivot counts as zero (singular principal block).
 const SINGULAR: f64 = 1e-13;
