@@ -49,7 +49,8 @@ pub fn level() -> &'static str {
 }
 
 /// Calls `$body` (an expression) compiled for the instruction set `$isa`. Every function the
-/// body calls must be `#[inline(always)]` to be compiled for it too.
+/// body calls must be `#[inline(always)]` to be compiled for it too (the closure itself is
+/// forced inline: left to the optimiser, a large body becomes a separate baseline function).
 macro_rules! dispatch {
     ($isa:expr, $ret:ty, || $body:expr) => {{
         #[cfg(target_arch = "x86_64")]
@@ -66,9 +67,9 @@ macro_rules! dispatch {
             }
             match $isa {
                 // SAFETY: `kernel::detect` reported these features on the running CPU.
-                $crate::lcp::kernel::Isa::Avx512 => unsafe { avx512(|| $body) },
+                $crate::lcp::kernel::Isa::Avx512 => unsafe { avx512(#[inline(always)] || $body) },
                 // SAFETY: as above.
-                $crate::lcp::kernel::Isa::Avx2 => unsafe { avx2(|| $body) },
+                $crate::lcp::kernel::Isa::Avx2 => unsafe { avx2(#[inline(always)] || $body) },
                 $crate::lcp::kernel::Isa::Baseline => $body,
             }
         }
