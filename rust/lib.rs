@@ -10,6 +10,7 @@
 //! The Python bindings (`coulomb._core`) live behind the `python` feature.
 #![allow(non_snake_case)]
 
+pub mod contact;
 pub mod error;
 pub mod io;
 pub mod lcp;

@@ -67,9 +67,19 @@ macro_rules! dispatch {
             }
             match $isa {
                 // SAFETY: `kernel::detect` reported these features on the running CPU.
-                $crate::lcp::kernel::Isa::Avx512 => unsafe { avx512(#[inline(always)] || $body) },
+                $crate::lcp::kernel::Isa::Avx512 => unsafe {
+                    avx512(
+                        #[inline(always)]
+                        || $body,
+                    )
+                },
                 // SAFETY: as above.
-                $crate::lcp::kernel::Isa::Avx2 => unsafe { avx2(#[inline(always)] || $body) },
+                $crate::lcp::kernel::Isa::Avx2 => unsafe {
+                    avx2(
+                        #[inline(always)]
+                        || $body,
+                    )
+                },
                 $crate::lcp::kernel::Isa::Baseline => $body,
             }
         }

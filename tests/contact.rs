@@ -1,0 +1,439 @@
+//! Integration tests of the friction-contact solver (NSGS with the exact friction disk): the
+//! seed's inelastic contact step, sticking, redundant contacts (a box on a floor), a random 3D
+//! problem with every check, and bad input.
+
+use coulomb::contact::{
+    measure, solve_nsgs, ContactProblem, ContactSolution, ContactStatus, NsgsSettings,
+};
+use coulomb::testing::SplitMix64;
+use coulomb::CoulombError;
+
+fn nsgs(dim: usize, w: &[f64], q: &[f64], mu: &[f64], s: &NsgsSettings) -> ContactSolution {
+    let p = ContactProblem::new(dim, w, q, mu).expect("well-formed test problem");
+    solve_nsgs(&p, s).expect("valid settings")
+}
+
+fn identity_over(m: f64, n: usize) -> Vec<f64> {
+    let mut w = vec![0.0; n * n];
+    for i in 0..n {
+        w[i * n + i] = 1.0 / m;
+    }
+    w
+}
+
+/// `W = G^T M^{-1} G` and `q = G^T v_free` for diagonal M; G is ndof x ncols, row-major
+/// (column k is the generalized direction of contact component k).
+fn delassus(g: &[f64], ndof: usize, minv: &[f64], v_free: &[f64]) -> (Vec<f64>, Vec<f64>) {
+    let ncols = g.len() / ndof;
+    let mut w = vec![0.0; ncols * ncols];
+    for i in 0..ncols {
+        for j in 0..ncols {
+            w[i * ncols + j] = (0..ndof)
+                .map(|a| g[a * ncols + i] * minv[a] * g[a * ncols + j])
+                .sum();
+        }
+    }
+    let q = (0..ncols)
+        .map(|i| (0..ndof).map(|a| g[a * ncols + i] * v_free[a]).sum())
+        .collect();
+    (w, q)
+}
+
+/// `v = v_free + M^{-1} G r`.
+fn post_velocity(g: &[f64], ndof: usize, minv: &[f64], v_free: &[f64], r: &[f64]) -> Vec<f64> {
+    let ncols = g.len() / ndof;
+    (0..ndof)
+        .map(|a| v_free[a] + minv[a] * (0..ncols).map(|k| g[a * ncols + k] * r[k]).sum::<f64>())
+        .collect()
+}
+
+/// `G^T v`: the contact velocities.
+fn contact_velocity(g: &[f64], ndof: usize, v: &[f64]) -> Vec<f64> {
+    let ncols = g.len() / ndof;
+    (0..ncols)
+        .map(|k| (0..ndof).map(|a| g[a * ncols + k] * v[a]).sum())
+        .collect()
+}
+
+// --- the seed's inelastic contact step -------------------------------------------------
+
+#[test]
+fn seed_inelastic_step_2d() {
+    let (m, mu) = (2.0, [0.2]);
+    let w = identity_over(m, 2);
+    let q = [-3.0, 1.0];
+    let s = nsgs(2, &w, &q, &mu, &NsgsSettings::default());
+    assert!(s.success(), "{}", s.message);
+    assert!((s.impulse[0] - 6.0).abs() < 1e-10, "P_n = {}", s.impulse[0]);
+    assert!((s.impulse[1] + 1.2).abs() < 1e-10, "P_t = {}", s.impulse[1]);
+    assert!(s.velocity[0].abs() < 1e-10);
+    assert!((s.velocity[1] - 0.4).abs() < 1e-10);
+    let t_before = 0.5 * m * (3.0f64 * 3.0 + 1.0);
+    let t_after = 0.5 * m * (s.velocity[0].powi(2) + s.velocity[1].powi(2));
+    assert!((t_before - 10.0).abs() < 1e-12);
+    assert!((t_after - 0.16).abs() < 1e-10, "T after = {t_after}");
+    assert!(s.measures.error < 1e-12);
+}
+
+#[test]
+fn seed_inelastic_step_3d() {
+    let (m, mu) = (2.0, [0.2]);
+    let w = identity_over(m, 3);
+    let q = [-3.0, 1.0, 0.0];
+    let s = nsgs(3, &w, &q, &mu, &NsgsSettings::default());
+    assert!(s.success(), "{}", s.message);
+    assert!((s.impulse[0] - 6.0).abs() < 1e-10);
+    assert!((s.impulse[1] + 1.2).abs() < 1e-10);
+    assert!(s.impulse[2].abs() < 1e-10);
+    assert!(s.velocity[0].abs() < 1e-10);
+    assert!((s.velocity[1] - 0.4).abs() < 1e-10);
+    assert!(s.velocity[2].abs() < 1e-10);
+    let t_after = 0.5 * m * s.velocity.iter().map(|v| v * v).sum::<f64>();
+    assert!((t_after - 0.16).abs() < 1e-10, "T after = {t_after}");
+}
+
+#[test]
+fn oblique_slip_in_3d_opposes_the_slip_direction() {
+    // v_t^- = (1, 1): the disk answer slides along (1, 1) with ||P_t|| = mu P_n = 1.2
+    let w = identity_over(2.0, 3);
+    let q = [-3.0, 1.0, 1.0];
+    let s = nsgs(3, &w, &q, &[0.2], &NsgsSettings::default());
+    assert!(s.success());
+    let h = 1.2 / 2f64.sqrt();
+    assert!((s.impulse[1] + h).abs() < 1e-10 && (s.impulse[2] + h).abs() < 1e-10);
+    let slip = 1.0 - h / 2.0;
+    assert!((s.velocity[1] - slip).abs() < 1e-10 && (s.velocity[2] - slip).abs() < 1e-10);
+}
+
+#[test]
+fn sticking_with_large_friction() {
+    for dim in [2, 3] {
+        let w = identity_over(2.0, dim);
+        let mut q = vec![-3.0, 1.0];
+        if dim == 3 {
+            q.push(0.0);
+        }
+        let s = nsgs(dim, &w, &q, &[0.6], &NsgsSettings::default());
+        assert!(s.success(), "{}", s.message);
+        let pt = s.impulse[1..].iter().map(|v| v * v).sum::<f64>().sqrt();
+        let ut = s.velocity[1..].iter().map(|v| v * v).sum::<f64>().sqrt();
+        assert!(ut < 1e-10, "u_t = {ut}");
+        assert!((pt - 2.0).abs() < 1e-10, "||P_t|| = {pt}");
+        assert!((s.impulse[0] - 6.0).abs() < 1e-10);
+        assert!(pt < 0.6 * s.impulse[0]);
+    }
+}
+
+#[test]
+fn frictionless_contacts_carry_no_tangential_impulse() {
+    let w = identity_over(2.0, 3);
+    let q = [-3.0, 1.0, -2.0];
+    let s = nsgs(3, &w, &q, &[0.0], &NsgsSettings::default());
+    assert!(s.success());
+    assert_eq!(&s.impulse[1..], &[0.0, 0.0]);
+    assert!((s.impulse[0] - 6.0).abs() < 1e-12);
+}
+
+// --- redundant contacts: a box resting on a floor ----------------------------------------
+
+const GRAVITY: f64 = 9.81;
+const STEP: f64 = 0.01;
+
+/// A unit square (side 1, mass 1, inertia m (w^2 + h^2) / 12 = 1/6) resting on a floor on
+/// its two bottom corners. Generalized velocities (v_x, v_y, ω); a corner at offset ρ from the
+/// centre moves at `(v_x - ω ρ_y, v_y + ω ρ_x)`; contact frame: normal e_y, tangent e_x.
+#[test]
+fn planar_box_on_two_corners() {
+    let ndof = 3;
+    let corners = [(-0.5, -0.5), (0.5, -0.5)];
+    let ncols = 2 * corners.len();
+    let mut g = vec![0.0; ndof * ncols];
+    for (k, &(rx, ry)) in corners.iter().enumerate() {
+        // normal column (0, 1, ρ_x), tangent column (1, 0, -ρ_y)
+        g[ncols + 2 * k] = 1.0;
+        g[2 * ncols + 2 * k] = rx;
+        g[2 * k + 1] = 1.0;
+        g[2 * ncols + 2 * k + 1] = -ry;
+    }
+    let minv = [1.0, 1.0, 6.0];
+    let v_free = [0.0, -GRAVITY * STEP, 0.0];
+    let (w, q) = delassus(&g, ndof, &minv, &v_free);
+    let settings = NsgsSettings {
+        tol: 1e-12,
+        ..Default::default()
+    };
+    let s = nsgs(2, &w, &q, &[0.5, 0.5], &settings);
+    assert!(s.success(), "{}", s.message);
+    let v = post_velocity(&g, ndof, &minv, &v_free, &s.impulse);
+    let uc = contact_velocity(&g, ndof, &v);
+    for k in 0..corners.len() {
+        assert!(uc[2 * k] >= -1e-9, "normal velocity {}", uc[2 * k]);
+    }
+    assert!(v.iter().all(|x| x.abs() <= 1e-8), "v = {v:?}");
+    let total: f64 = (0..corners.len()).map(|k| s.impulse[2 * k]).sum();
+    assert!((total - GRAVITY * STEP).abs() < 1e-9, "sum P_n = {total}");
+    // symmetric: each corner carries half
+    assert!((s.impulse[0] - s.impulse[2]).abs() < 1e-9);
+}
+
+/// A unit cube (mass 1, inertia 1/6 about each principal axis, axes aligned with the world)
+/// on four bottom corners. Generalized velocities (v, ω); a corner at ρ moves at v + ω × ρ, so
+/// the column of contact direction d is (d, ρ × d). G is 6 x 12: W (12 x 12) has rank 6 and is
+/// singular; the normal impulses are not unique, their sum is.
+#[test]
+fn cube_on_four_corners_redundant() {
+    let ndof = 6;
+    let corners = [
+        [-0.5, -0.5, -0.5],
+        [0.5, -0.5, -0.5],
+        [0.5, 0.5, -0.5],
+        [-0.5, 0.5, -0.5],
+    ];
+    let dirs = [[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    let ncols = 3 * corners.len();
+    let mut g = vec![0.0; ndof * ncols];
+    for (k, rho) in corners.iter().enumerate() {
+        for (c, d) in dirs.iter().enumerate() {
+            let col = 3 * k + c;
+            let cross = [
+                rho[1] * d[2] - rho[2] * d[1],
+                rho[2] * d[0] - rho[0] * d[2],
+                rho[0] * d[1] - rho[1] * d[0],
+            ];
+            for a in 0..3 {
+                g[a * ncols + col] = d[a];
+                g[(3 + a) * ncols + col] = cross[a];
+            }
+        }
+    }
+    let minv = [1.0, 1.0, 1.0, 6.0, 6.0, 6.0];
+    let v_free = [0.0, 0.0, -GRAVITY * STEP, 0.0, 0.0, 0.0];
+    let (w, q) = delassus(&g, ndof, &minv, &v_free);
+    let settings = NsgsSettings {
+        tol: 1e-12,
+        ..Default::default()
+    };
+    let s = nsgs(3, &w, &q, &[0.5; 4], &settings);
+    assert!(s.success(), "{}", s.message);
+    println!("cube: {}", s.message);
+    let v = post_velocity(&g, ndof, &minv, &v_free, &s.impulse);
+    let uc = contact_velocity(&g, ndof, &v);
+    for k in 0..corners.len() {
+        assert!(uc[3 * k] >= -1e-9, "normal velocity {}", uc[3 * k]);
+        assert!(s.impulse[3 * k] >= 0.0);
+    }
+    assert!(v.iter().all(|x| x.abs() <= 1e-8), "v = {v:?}");
+    let total: f64 = (0..corners.len()).map(|k| s.impulse[3 * k]).sum();
+    assert!((total - GRAVITY * STEP).abs() < 1e-9, "sum P_n = {total}");
+}
+
+// --- a random 3D problem -----------------------------------------------------------------
+
+/// W = G^T M^{-1} G with a random G (40 generalized coordinates, so W is positive definite),
+/// random masses, and q = G^T v_free with a velocity that pushes most contacts closed.
+fn random_problem(nc: usize, seed: u64) -> (Vec<f64>, Vec<f64>) {
+    let mut rng = SplitMix64::new(seed);
+    let ndof = 40;
+    let ncols = 3 * nc;
+    let g: Vec<f64> = (0..ndof * ncols).map(|_| rng.normal()).collect();
+    let minv: Vec<f64> = (0..ndof).map(|_| 1.0 / rng.range(0.5, 2.0)).collect();
+    let v_free: Vec<f64> = (0..ndof).map(|_| rng.normal()).collect();
+    let (w, mut q) = delassus(&g, ndof, &minv, &v_free);
+    // push most contacts towards each other
+    for i in 0..nc {
+        q[3 * i] -= rng.range(-1.0, 4.0);
+    }
+    (w, q)
+}
+
+#[test]
+fn random_3d_problem_passes_every_check() {
+    let nc = 10;
+    let (w, q) = random_problem(nc, 42);
+    let mu = vec![0.5; nc];
+    let s = nsgs(3, &w, &q, &mu, &NsgsSettings::default());
+    assert!(s.success(), "{}", s.message);
+    println!("random 3D: {}", s.message);
+    let m = s.measures;
+    assert!(m.error <= 1e-8);
+    assert!(m.cone_violation <= 1e-10, "{m:?}");
+    assert!(m.min_normal_impulse >= -1e-12, "{m:?}");
+    let qn = q.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let rn = s.impulse.iter().map(|v| v * v).sum::<f64>().sqrt();
+    assert!(m.max_complementarity <= 1e-7 * qn.max(rn).powi(2), "{m:?}");
+    assert!(
+        m.dissipation_violation <= 1e-7 * qn.max(rn).powi(2),
+        "{m:?}"
+    );
+    // at least one contact is active and one slides, so the test means something
+    let active = (0..nc).filter(|&i| s.impulse[3 * i] > 1e-6).count();
+    assert!(active >= 2, "only {active} active contacts");
+    // measure() agrees with the solver's own numbers
+    let p = ContactProblem::new(3, &w, &q, &mu).unwrap();
+    let (u, again) = measure(&p, &s.impulse).unwrap();
+    assert_eq!(again, m);
+    assert_eq!(u, s.velocity);
+    // warm start from the answer: solved at once
+    let warm = nsgs(
+        3,
+        &w,
+        &q,
+        &mu,
+        &NsgsSettings {
+            initial: Some(s.impulse.clone()),
+            ..Default::default()
+        },
+    );
+    assert!(warm.success() && warm.iterations == 0);
+    // over-relaxation also converges
+    let sor = nsgs(
+        3,
+        &w,
+        &q,
+        &mu,
+        &NsgsSettings {
+            relaxation: 1.3,
+            ..Default::default()
+        },
+    );
+    assert!(sor.success(), "{}", sor.message);
+}
+
+#[test]
+fn random_problem_is_honest_about_the_iteration_limit() {
+    let nc = 10;
+    let (w, q) = random_problem(nc, 42);
+    let mu = vec![0.5; nc];
+    let s = nsgs(
+        3,
+        &w,
+        &q,
+        &mu,
+        &NsgsSettings {
+            max_iter: 2,
+            ..Default::default()
+        },
+    );
+    assert_eq!(s.status, ContactStatus::IterationLimit);
+    assert!(!s.success());
+    assert_eq!(s.iterations, 2);
+    assert!(s.measures.error > 1e-8);
+    assert!(s.message.contains("max_iter"));
+}
+
+#[test]
+fn random_2d_problem_converges() {
+    // the planar version: 10 contacts, blocks 2x2 with normal-tangent coupling
+    let mut rng = SplitMix64::new(9);
+    let (ndof, nc) = (30, 10);
+    let ncols = 2 * nc;
+    let g: Vec<f64> = (0..ndof * ncols).map(|_| rng.normal()).collect();
+    let minv = vec![1.0; ndof];
+    let v_free: Vec<f64> = (0..ndof).map(|_| rng.normal()).collect();
+    let (w, mut q) = delassus(&g, ndof, &minv, &v_free);
+    for i in 0..nc {
+        q[2 * i] -= 2.0;
+    }
+    let mu: Vec<f64> = (0..nc).map(|i| 0.1 * i as f64).collect();
+    let s = nsgs(2, &w, &q, &mu, &NsgsSettings::default());
+    assert!(s.success(), "{}", s.message);
+    println!("random 2D: {}", s.message);
+    assert!(s.measures.cone_violation <= 1e-10);
+    assert!(s.measures.min_normal_impulse >= -1e-12);
+}
+
+// --- bad input -----------------------------------------------------------------------------
+
+#[test]
+fn bad_input_gives_specific_errors() {
+    let w = identity_over(2.0, 3);
+    let q = [-3.0, 1.0, 0.0];
+    let shape = ContactProblem::new(3, &w[..8], &q, &[0.2]);
+    assert!(matches!(shape, Err(CoulombError::Shape(_))));
+    let shape = ContactProblem::new(3, &w, &q[..2], &[0.2]);
+    assert!(matches!(shape, Err(CoulombError::Shape(_))));
+    let shape = ContactProblem::new(2, &w, &q, &[0.2]);
+    assert!(matches!(shape, Err(CoulombError::Shape(_))));
+    let mut wn = w.clone();
+    wn[4] = f64::NAN;
+    assert!(matches!(
+        ContactProblem::new(3, &wn, &q, &[0.2]),
+        Err(CoulombError::NonFinite(_))
+    ));
+    assert!(matches!(
+        ContactProblem::new(3, &w, &[-3.0, f64::INFINITY, 0.0], &[0.2]),
+        Err(CoulombError::NonFinite(_))
+    ));
+    assert!(matches!(
+        ContactProblem::new(3, &w, &q, &[f64::NAN]),
+        Err(CoulombError::NonFinite(_))
+    ));
+    assert!(matches!(
+        ContactProblem::new(3, &w, &q, &[-0.2]),
+        Err(CoulombError::InvalidParameter(_))
+    ));
+    assert!(matches!(
+        ContactProblem::new(4, &w, &q, &[0.2]),
+        Err(CoulombError::InvalidParameter(_))
+    ));
+    let p = ContactProblem::new(3, &w, &q, &[0.2]).unwrap();
+    for bad in [
+        NsgsSettings {
+            relaxation: 2.5,
+            ..Default::default()
+        },
+        NsgsSettings {
+            relaxation: 0.0,
+            ..Default::default()
+        },
+        NsgsSettings {
+            tol: -1.0,
+            ..Default::default()
+        },
+        NsgsSettings {
+            max_iter: 0,
+            ..Default::default()
+        },
+    ] {
+        assert!(matches!(
+            solve_nsgs(&p, &bad),
+            Err(CoulombError::InvalidParameter(_))
+        ));
+    }
+    let short = NsgsSettings {
+        initial: Some(vec![1.0]),
+        ..Default::default()
+    };
+    assert!(matches!(
+        solve_nsgs(&p, &short),
+        Err(CoulombError::Shape(_))
+    ));
+    let nan = NsgsSettings {
+        initial: Some(vec![1.0, f64::NAN, 0.0]),
+        ..Default::default()
+    };
+    assert!(matches!(
+        solve_nsgs(&p, &nan),
+        Err(CoulombError::NonFinite(_))
+    ));
+}
+
+#[test]
+fn a_contact_without_normal_stiffness_is_reported() {
+    // W_nn = 0 for the only contact and q_n < 0: no impulse can help
+    let w = vec![0.0; 4];
+    let q = [-1.0, 0.0];
+    let s = nsgs(2, &w, &q, &[0.3], &NsgsSettings::default());
+    assert_eq!(s.status, ContactStatus::NumericalFailure);
+    assert!(!s.success());
+    // ... but with q_n >= 0 the zero impulse is the answer
+    let s = nsgs(2, &w, &[1.0, 0.0], &[0.3], &NsgsSettings::default());
+    assert!(s.success());
+}
+
+#[test]
+fn no_contacts_is_trivially_solved() {
+    let s = nsgs(3, &[], &[], &[], &NsgsSettings::default());
+    assert!(s.success());
+    assert!(s.impulse.is_empty());
+}
