@@ -7,6 +7,8 @@ Submodules
 ----------
 lcp
     Linear complementarity problems (Lemke, projected Gauss-Seidel, enumeration).
+contact
+    Frictional contact over a frozen Delassus matrix (nonsmooth Gauss-Seidel, exact cone).
 io
     Readers for benchmark problem files (Siconos).
 errors
@@ -17,9 +19,19 @@ validate
 
 from __future__ import annotations
 
-from . import errors, io, lcp
+from . import contact, errors, io, lcp
 from ._core import __version__
 from ._result import Result
+from .contact import ContactResult
 from .lcp import LcpResult
 
-__all__ = ["LcpResult", "Result", "__version__", "errors", "io", "lcp"]
+__all__ = [
+    "ContactResult",
+    "LcpResult",
+    "Result",
+    "__version__",
+    "contact",
+    "errors",
+    "io",
+    "lcp",
+]

@@ -25,4 +25,16 @@ def lcp_measures(
     m: NDArray[np.float64], q: NDArray[np.float64], z: NDArray[np.float64]
 ) -> dict[str, Any]: ...
 def read_siconos_lcp(path: str) -> tuple[NDArray[np.float64], NDArray[np.float64]]: ...
+def contact_solve(
+    w: NDArray[np.float64],
+    q: NDArray[np.float64],
+    mu: NDArray[np.float64],
+    dim: int,
+    method: str,
+    tol: float,
+    max_iter: int = 1000,
+    relaxation: float = 1.0,
+    initial: NDArray[np.float64] | None = None,
+) -> dict[str, Any]: ...
+def read_siconos_fc(path: str) -> dict[str, Any]: ...
 def simd_level() -> str: ...

@@ -14,7 +14,9 @@ use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyDict, PyType};
 
+use crate::contact::{self, ContactProblem, ContactSolution, NsgsSettings};
 use crate::error::CoulombError;
+use crate::io::siconos::{NumericsMatrix, SiconosFcFile};
 use crate::io::ReadError;
 use crate::lcp::{
     self, EnumerateSettings, LcpRef, LcpSolution, LemkeSettings, Method, PgsSettings,
@@ -268,6 +270,201 @@ fn read_siconos_lcp<'py>(
     Ok((m, PyArray1::from_vec(py, p.q)))
 }
 
+/// the contact solution as a dict; `impulse` and `velocity` as (nc, dim) arrays.
+fn contact_dict<'py>(
+    py: Python<'py>,
+    s: ContactSolution,
+    nc: usize,
+    dim: usize,
+    seconds: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let shape_err = |e: numpy::ndarray::ShapeError| {
+        PyRuntimeError::new_err(format!("internal shape error: {e}"))
+    };
+    let success = s.success();
+    let d = PyDict::new(py);
+    let impulse = Array2::from_shape_vec((nc, dim), s.impulse).map_err(shape_err)?;
+    let velocity = Array2::from_shape_vec((nc, dim), s.velocity).map_err(shape_err)?;
+    d.set_item(intern!(py, "impulse"), impulse.into_pyarray(py))?;
+    d.set_item(intern!(py, "velocity"), velocity.into_pyarray(py))?;
+    d.set_item(intern!(py, "success"), success)?;
+    d.set_item(intern!(py, "status"), s.status.as_str())?;
+    d.set_item(intern!(py, "message"), s.message)?;
+    d.set_item(intern!(py, "iterations"), s.iterations)?;
+    let m = s.measures;
+    d.set_item(intern!(py, "error"), m.error)?;
+    d.set_item(intern!(py, "error_q"), m.error_q)?;
+    d.set_item(intern!(py, "min_normal_impulse"), m.min_normal_impulse)?;
+    d.set_item(intern!(py, "max_complementarity"), m.max_complementarity)?;
+    d.set_item(intern!(py, "cone_violation"), m.cone_violation)?;
+    d.set_item(
+        intern!(py, "dissipation_violation"),
+        m.dissipation_violation,
+    )?;
+    d.set_item(intern!(py, "solve_time"), seconds)?;
+    Ok(d)
+}
+
+/// Solves the friction-contact problem `u = W r + q`, per contact
+/// `K ∋ r ⊥ u + mu ||u_t|| n ∈ K^*`. The Python wrapper `coulomb.contact.solve` documents the
+/// arguments; this takes them already converted to float64 arrays (W dense, q and mu flat).
+#[pyfunction]
+#[pyo3(signature = (w, q, mu, dim, method, tol, max_iter=1000, relaxation=1.0, initial=None))]
+#[allow(clippy::too_many_arguments)]
+fn contact_solve<'py>(
+    py: Python<'py>,
+    w: PyReadonlyArray2<'py, f64>,
+    q: PyReadonlyArray1<'py, f64>,
+    mu: PyReadonlyArray1<'py, f64>,
+    dim: usize,
+    method: &str,
+    tol: f64,
+    max_iter: usize,
+    relaxation: f64,
+    initial: Option<PyReadonlyArray1<'py, f64>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let shape = w.shape();
+    if shape[0] != shape[1] {
+        return Err(to_py(
+            py,
+            CoulombError::Shape(format!("W must be square, got {} x {}", shape[0], shape[1])),
+        ));
+    }
+    let n = shape[0];
+    let ws = slice2(py, "W", &w)?;
+    let qs = slice1(py, "q", &q)?;
+    let mus = slice1(py, "mu", &mu)?;
+    let init = match &initial {
+        Some(c) => Some(slice1(py, "initial", c)?.to_vec()),
+        None => None,
+    };
+    let settings = match method {
+        "nsgs" => NsgsSettings {
+            tol,
+            max_iter,
+            relaxation,
+            initial: init,
+        },
+        other => {
+            return Err(to_py(
+                py,
+                CoulombError::InvalidParameter(format!(
+                    "unknown method {other:?}: expected 'nsgs' (the only method available; \
+                     'lemke' (polyhedral cone) is not implemented yet)"
+                )),
+            ))
+        }
+    };
+    let (solution, nc, seconds) = guarded(py, n * n, || {
+        let start = std::time::Instant::now();
+        let problem = ContactProblem::new(dim, ws, qs, mus)?;
+        let s = contact::solve_nsgs(&problem, &settings)?;
+        Ok((s, problem.nc, start.elapsed().as_secs_f64()))
+    })?;
+    contact_dict(py, solution, nc, dim, seconds)
+}
+
+/// the largest matrix side `read_siconos_fc` densifies.
+const MAX_DENSE_SIDE: usize = 5000;
+
+fn densify(name: &str, m: &NumericsMatrix) -> Result<(usize, usize, Vec<f64>), CoulombError> {
+    let (r, c) = (m.nrows(), m.ncols());
+    if r > MAX_DENSE_SIDE || c > MAX_DENSE_SIDE {
+        return Err(CoulombError::TooLarge(format!(
+            "matrix {name} is {r} x {c} ({} stored entries): coulomb densifies Siconos \
+             friction-contact matrices only up to {MAX_DENSE_SIDE} x {MAX_DENSE_SIDE} for now",
+            m.nnz()
+        )));
+    }
+    let d = m.to_dense();
+    Ok((d.nrows, d.ncols, d.data))
+}
+
+fn dense_array<'py>(
+    py: Python<'py>,
+    (r, c, data): (usize, usize, Vec<f64>),
+) -> PyResult<Bound<'py, PyAny>> {
+    Ok(Array2::from_shape_vec((r, c), data)
+        .map_err(|e| PyRuntimeError::new_err(format!("internal shape error: {e}")))?
+        .into_pyarray(py)
+        .into_any())
+}
+
+/// Reads a Siconos friction-contact file. A local problem gives a dict with `kind="local"`,
+/// `dim`, `nc`, `W` (dense), `q`, `mu`; a global one `kind="global"`, `dim`, `nc`, `M`, `H`
+/// (dense), `q`, `b`, `mu`. Matrices larger than 5000 x 5000 raise `ProblemTooLargeError`.
+#[pyfunction]
+fn read_siconos_fc<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyDict>> {
+    enum Dense {
+        Local {
+            dim: usize,
+            nc: usize,
+            w: (usize, usize, Vec<f64>),
+            q: Vec<f64>,
+            mu: Vec<f64>,
+        },
+        Global {
+            dim: usize,
+            nc: usize,
+            m: (usize, usize, Vec<f64>),
+            h: (usize, usize, Vec<f64>),
+            q: Vec<f64>,
+            b: Vec<f64>,
+            mu: Vec<f64>,
+        },
+    }
+    let read = guarded(py, usize::MAX, || {
+        Ok(match crate::io::siconos::read_siconos_fc(&path)? {
+            SiconosFcFile::Local(p) => Dense::Local {
+                dim: p.dim,
+                nc: p.nc,
+                w: densify("W", &p.w)?,
+                q: p.q,
+                mu: p.mu,
+            },
+            SiconosFcFile::Global(p) => Dense::Global {
+                dim: p.dim,
+                nc: p.nc,
+                m: densify("M", &p.m)?,
+                h: densify("H", &p.h)?,
+                q: p.q,
+                b: p.b,
+                mu: p.mu,
+            },
+        })
+    })?;
+    let d = PyDict::new(py);
+    match read {
+        Dense::Local { dim, nc, w, q, mu } => {
+            d.set_item("kind", "local")?;
+            d.set_item("dim", dim)?;
+            d.set_item("nc", nc)?;
+            d.set_item("W", dense_array(py, w)?)?;
+            d.set_item("q", PyArray1::from_vec(py, q))?;
+            d.set_item("mu", PyArray1::from_vec(py, mu))?;
+        }
+        Dense::Global {
+            dim,
+            nc,
+            m,
+            h,
+            q,
+            b,
+            mu,
+        } => {
+            d.set_item("kind", "global")?;
+            d.set_item("dim", dim)?;
+            d.set_item("nc", nc)?;
+            d.set_item("M", dense_array(py, m)?)?;
+            d.set_item("H", dense_array(py, h)?)?;
+            d.set_item("q", PyArray1::from_vec(py, q))?;
+            d.set_item("b", PyArray1::from_vec(py, b))?;
+            d.set_item("mu", PyArray1::from_vec(py, mu))?;
+        }
+    }
+    Ok(d)
+}
+
 /// The vector instruction set the pivot kernel uses on this CPU.
 #[pyfunction]
 fn simd_level() -> &'static str {
@@ -279,6 +476,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(lcp_solve, m)?)?;
     m.add_function(wrap_pyfunction!(lcp_measures, m)?)?;
     m.add_function(wrap_pyfunction!(read_siconos_lcp, m)?)?;
+    m.add_function(wrap_pyfunction!(contact_solve, m)?)?;
+    m.add_function(wrap_pyfunction!(read_siconos_fc, m)?)?;
     m.add_function(wrap_pyfunction!(simd_level, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

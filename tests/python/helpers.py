@@ -70,3 +70,38 @@ def planted_psd(
     M = (M + M.T) / 2
     q, z, w, active = planted(rng, M)
     return M, q, z, w, active
+
+
+def project_coulomb_cone(v: Array, mu: float) -> Array:
+    """The Euclidean projection of one contact's v = (normal, tangents...) on
+    ``{||t|| <= mu n}``, by the textbook three cases (numpy only)."""
+    vn, vt = float(v[0]), np.asarray(v[1:], dtype=float)
+    t = float(np.linalg.norm(vt))
+    if mu * t <= -vn:  # in the polar cone
+        return np.zeros_like(v, dtype=float)
+    if t <= mu * vn:  # already in the cone
+        return np.array(v, dtype=float)
+    a = (vn + mu * t) / (1.0 + mu * mu)
+    return np.concatenate([[a], mu * a * vt / t])
+
+
+def contact_error(W: Array, q: Array, mu: Array, dim: int, r: Array) -> tuple[float, float]:
+    """De Saxce's natural-map residual ``||r - P_K(r - (u + mu ||u_t|| n))||`` of impulses r
+    (any shape with dim nc entries) with ``u = W r + q``, divided by
+    ``max(||q||, ||r||, ||u||)`` and by ``||q||``: the (error, error_q) pair of DESIGN.md,
+    recomputed here in numpy."""
+    r = np.asarray(r, dtype=float).reshape(-1)
+    q = np.asarray(q, dtype=float)
+    u = np.asarray(W, dtype=float) @ r + q
+    res = np.empty_like(r)
+    for i, m in enumerate(np.broadcast_to(mu, (r.size // dim,))):
+        s = slice(i * dim, (i + 1) * dim)
+        ri, ui = r[s], u[s]
+        v = ri - ui
+        v[0] -= m * np.linalg.norm(ui[1:])
+        res[s] = ri - project_coulomb_cone(v, float(m))
+    norm = float(np.linalg.norm(res))
+    denom = max(np.linalg.norm(q), np.linalg.norm(r), np.linalg.norm(u))
+    denom = denom if denom >= 1e-300 else 1.0
+    qn = float(np.linalg.norm(q))
+    return norm / denom, norm / (qn if qn >= 1e-300 else 1.0)

@@ -1,0 +1,220 @@
+r"""Frictional contact over a frozen Delassus matrix W.
+
+Given ``nc`` contacts of dimension ``dim`` (2: normal and one tangent; 3: normal and two
+tangents, normal first in every block), the contact-space matrix W (``(dim nc) x (dim nc)``,
+symmetric positive semidefinite, e.g. ``G^T M^-1 G``) and the free contact velocity q
+(including any restitution term), find impulses r and velocities ``u = W r + q`` such that, per
+contact i,
+
+.. code-block:: text
+
+    K_i ∋ r_i  ⊥  u_i + mu_i ||u_{t,i}|| n  ∈ K_i^*,      K_i = { ||r_t|| <= mu_i r_n }
+
+(De Saxcé's bipotential form). This is Signorini's condition ``0 <= r_n ⊥ u_n >= 0`` together
+with Coulomb's law: either sticking (``u_t = 0``, ``||r_t|| <= mu r_n``) or sliding
+(``r_t = -mu r_n u_t / ||u_t||``, the friction impulse opposing the slip).
+
+>>> import numpy as np, coulomb
+>>> # the seed's inelastic step: m = 2, v_n = -3, v_t = 1, mu = 0.2
+>>> r = coulomb.contact.solve(np.eye(2) / 2, [-3.0, 1.0], 0.2, dim=2)
+>>> r.status, r.impulse.round(12).tolist(), r.velocity.round(12).tolist()
+('solved', [[6.0, -1.2]], [[0.0, 0.4]])
+
+Methods:
+
+``"nsgs"`` (default, and for now the only one)
+    Nonsmooth Gauss-Seidel with the exact friction disk: contact after contact, the one-contact
+    problem with the others frozen is solved exactly (2D by case split, 3D by a normal /
+    tangential block descent whose tangential step is the exact disk-constrained quadratic),
+    with relaxation and warm start. ``"lemke"`` (the polyhedral-cone LCP) is not implemented
+    yet and raises :class:`~coulomb.errors.InvalidParameterError`.
+
+Every answer is measured on the original data (W, q, mu):
+
+``error``
+    The natural-map residual on De Saxcé's form (as ../shared/DESIGN.md defines it),
+    ``||r - P_K(r - (u + mu ||u_t|| n))||_2 / max(||q||, ||r||, ||u||)``, with ``P_K`` the
+    projection on the product of the Coulomb cones (divided by 1 instead when all three norms
+    are below 1e-300). It is zero exactly at a solution. ``success`` means ``error <= tol``.
+``error_q``
+    The same residual divided by ``||q||`` (by 1 when ``||q|| < 1e-300``), as Acary et al.
+    report it for FCLib.
+``min_normal_impulse``
+    ``min_i r_{n,i}``: negative means a contact pulls (infeasible).
+``max_complementarity``
+    ``max_i |r_{n,i} u_{n,i}|``: a contact both pushing and separating.
+``cone_violation``
+    ``max_i max(||r_{t,i}|| - mu_i r_{n,i}, 0)``: friction beyond the Coulomb cone.
+``dissipation_violation``
+    ``max_i max(0, r_{t,i} . u_{t,i})`` over sliding contacts: a sliding friction impulse must
+    oppose the slip (maximal dissipation).
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from . import _core
+from ._result import Result
+from .errors import InvalidParameterError, NonFiniteError, ShapeError
+from .lcp import _as_array
+
+__all__ = ["ContactResult", "solve"]
+
+Method = Literal["nsgs"]
+_METHODS = ("nsgs",)
+
+
+class ContactResult(Result):
+    """The answer of :func:`solve`.
+
+    Attributes
+    ----------
+    impulse : ndarray, shape (nc, dim)
+        The impulses r, contact by contact, normal component first.
+    velocity : ndarray, shape (nc, dim)
+        ``u = W r + q`` recomputed from the original data.
+    success : bool
+        True only if ``error <= tol``.
+    status : str
+        ``"solved"``, ``"iteration_limit"`` or ``"numerical_failure"``.
+    message : str
+        One line for a person.
+    iterations : int
+        Sweeps performed.
+    error : float
+        The natural-map residual divided by ``max(||q||, ||r||, ||u||)`` (see the module
+        documentation).
+    error_q : float
+        The same residual divided by ``||q||``.
+    min_normal_impulse, max_complementarity, cone_violation, dissipation_violation : float
+        The separate checks (see the module documentation).
+    solve_time : float
+        Seconds spent in the Rust core.
+    """
+
+    impulse: NDArray[np.float64]
+    velocity: NDArray[np.float64]
+    success: bool
+    status: str
+    message: str
+    iterations: int
+    error: float
+    error_q: float
+    min_normal_impulse: float
+    max_complementarity: float
+    cone_violation: float
+    dissipation_violation: float
+    solve_time: float
+
+
+def solve(
+    W: ArrayLike,
+    q: ArrayLike,
+    mu: ArrayLike,
+    dim: int = 3,
+    method: Method = "nsgs",
+    *,
+    tol: float = 1e-8,
+    max_iter: int = 1000,
+    relaxation: float = 1.0,
+    initial: ArrayLike | None = None,
+) -> ContactResult:
+    """Solve the friction-contact problem ``u = W r + q`` with Coulomb's law at every contact.
+
+    Parameters
+    ----------
+    W : (dim nc, dim nc) array_like or scipy.sparse matrix
+        The Delassus matrix (symmetric positive semidefinite). A scipy.sparse matrix is
+        densified for now (the solver works on dense W).
+    q : (dim nc,) array_like
+        The free contact velocity, contact by contact, normal first.
+    mu : float or (nc,) array_like
+        The friction coefficient, one for all contacts or one per contact; ``>= 0``. When an
+        array, its length fixes nc; when a scalar, ``nc = len(q) // dim``.
+    dim : {2, 3}
+        Components per contact.
+    method : {"nsgs"}
+        See the module documentation.
+    tol : float
+        Tolerance on ``error`` for ``success``.
+    max_iter : int
+        Sweep limit (at least 1).
+    relaxation : float
+        Relaxation ω in (0, 2); 1 is plain Gauss-Seidel.
+    initial : (nc, dim) or (dim nc,) array_like, optional
+        Warm start impulses (e.g. the previous step's ``impulse``); projected on the cones
+        first.
+
+    Returns
+    -------
+    ContactResult
+
+    Raises
+    ------
+    ShapeError, NonFiniteError, InvalidParameterError
+        Before any work, for bad input (shapes that do not fit, NaN or infinity, ``mu < 0``,
+        ``dim`` not 2 or 3, an unknown method, ``tol <= 0``, ``max_iter < 1``, ``relaxation``
+        outside (0, 2)).
+    """
+    if isinstance(dim, bool) or not isinstance(dim, (int, np.integer)) or dim not in (2, 3):
+        raise InvalidParameterError(f"dim must be 2 (planar) or 3 (spatial), got {dim!r}")
+    dim = int(dim)
+    if method not in _METHODS:
+        raise InvalidParameterError(
+            f"unknown method {method!r}: expected 'nsgs' (the only method available; "
+            "'lemke' (polyhedral cone) is not implemented yet)"
+        )
+    Wa = _as_array(W, "W", 2)
+    qa = _as_array(q, "q", 1)
+    n = qa.shape[0]
+    if n % dim != 0:
+        raise ShapeError(f"q has length {n}, which is not a multiple of dim = {dim}")
+    nc = n // dim
+    mu_in = np.asarray(mu) if not isinstance(mu, np.ndarray) else mu
+    if mu_in.ndim == 0:
+        mua = np.full(nc, float(_as_array(np.atleast_1d(mu_in), "mu", 1)[0]))
+    else:
+        mua = _as_array(mu_in, "mu", 1)
+        if mua.shape[0] != nc:
+            raise ShapeError(
+                f"mu has {mua.shape[0]} entries but q of length {n} holds nc = {n} / {dim} = "
+                f"{nc} contacts"
+            )
+    if Wa.shape != (n, n):
+        raise ShapeError(f"W must have shape ({n}, {n}) to match q of length {n}, got {Wa.shape}")
+    if not np.isfinite(mua).all():
+        raise NonFiniteError("mu contains NaN or infinity")
+    if (mua < 0).any():
+        k = int(np.flatnonzero(mua < 0)[0])
+        raise InvalidParameterError(f"friction coefficients must be >= 0, mu[{k}] = {mua[k]}")
+    # W and q are checked for NaN and infinity by the core, before any work
+    init = None
+    if initial is not None:
+        r0 = _as_array(initial, "initial", np.ndim(initial))
+        if r0.shape not in ((nc, dim), (n,)):
+            raise ShapeError(f"initial must have shape ({nc}, {dim}) or ({n},), got {r0.shape}")
+        init = np.ascontiguousarray(r0.reshape(n))
+        if not np.isfinite(init).all():
+            raise NonFiniteError("initial contains NaN or infinity")
+    if not (np.isfinite(tol) and tol > 0):
+        raise InvalidParameterError(f"tol must be a positive finite number, got {tol}")
+    if max_iter < 1:
+        raise InvalidParameterError(f"max_iter must be at least 1, got {max_iter}")
+    if not 0 < relaxation < 2:
+        raise InvalidParameterError(f"relaxation must lie in (0, 2), got {relaxation}")
+    out = _core.contact_solve(
+        Wa,
+        qa,
+        mua,
+        dim,
+        method,
+        float(tol),
+        int(max_iter),
+        float(relaxation),
+        init,
+    )
+    return ContactResult(out)
