@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import lcp
+from . import contact, lcp
 from .io import read_siconos_lcp
 
 __all__ = ["Row", "format_table", "run"]
@@ -50,6 +50,21 @@ def _seed_rows() -> Iterator[Row]:
     r = lcp.solve([[-1.0]], [-1.0])
     yield _text(case, "status (no solution)", "ray_termination", r.status)
     yield _text(case, "success", "False", str(bool(r.success)))
+
+
+def _contact_rows() -> Iterator[Row]:
+    # the seed's inelastic contact step: a 2 kg particle hits a fixed floor with e = 0,
+    # v_n^- = -3 m/s, v_t^- = 1 m/s, mu = 0.2; W = I/m and q = v^- (no free-flight term)
+    m = 2.0
+    for dim, q in ((2, [-3.0, 1.0]), (3, [-3.0, 1.0, 0.0])):
+        case = f"inelastic contact step ({dim}D)"
+        r = contact.solve(np.eye(dim) / m, q, 0.2, dim=dim, tol=1e-12)
+        p, u = r.impulse[0], r.velocity[0]
+        yield _num(case, "P_n (N s)", 6.0, float(p[0]), 1e-9)
+        yield _num(case, "P_t (N s)", -1.2, float(p[1]), 1e-9)
+        yield _num(case, "v_t^+ (m/s)", 0.4, float(u[1]), 1e-9)
+        yield _num(case, "v_n^+ (m/s)", 0.0, float(u[0]), 1e-9)
+        yield _num(case, "T^+ (J)", 0.16, float(0.5 * m * (u @ u)), 1e-9)
 
 
 def default_data_dir() -> Path | None:
@@ -91,7 +106,7 @@ def _data_rows(data: Path) -> Iterator[Row]:
 
 def run(data: Path | None = None, progress: Callable[[str], None] | None = None) -> list[Row]:
     """Every row: the seed's figures, then (if the benchmark data is found) the data set's."""
-    rows = list(_seed_rows())
+    rows = [*_seed_rows(), *_contact_rows()]
     data = data or default_data_dir()
     if data is not None:
         if progress:

@@ -36,10 +36,11 @@ def test_validate_seed_rows(tmp_path):
     p = run(["validate"], tmp_path)
     assert p.returncode == 0, p.stderr
     ok, total = reproduced(p.stdout)
-    assert ok == total >= 5
-    assert "5 of 5" in p.stdout
+    # 5 scalar-LCP rows and 5 rows for each of the 2D and 3D inelastic contact steps
+    assert ok == total == 15
     assert "FAIL" not in p.stdout
     assert "scalar LCP w = 2z - 6" in p.stdout
+    assert "inelastic contact step (3D)" in p.stdout
     assert "Siconos" not in p.stdout
     assert "benchmark data not found" in p.stderr
 
@@ -55,6 +56,15 @@ def test_validate_json(tmp_path):
     assert abs(z["computed"] - 3.0) <= z["tolerance"]
     ray = [r for r in rows if r["case"] == "scalar LCP w = -z - 1"]
     assert {r["computed"] for r in ray} == {"ray_termination", "False"}
+    step = {
+        (r["case"], r["quantity"]): r
+        for r in rows
+        if r["case"].startswith("inelastic contact step")
+    }
+    for dim in ("2D", "3D"):
+        case = f"inelastic contact step ({dim})"
+        assert abs(step[case, "P_t (N s)"]["computed"] + 1.2) <= 1e-9
+        assert abs(step[case, "T^+ (J)"]["computed"] - 0.16) <= 1e-9
 
 
 def test_validate_with_data(tmp_path, data_dir):
