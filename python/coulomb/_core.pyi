@@ -32,9 +32,10 @@ def contact_solve(
     dim: int,
     method: str,
     tol: float,
-    max_iter: int = 1000,
+    max_iter: int | None = None,
     relaxation: float = 1.0,
     initial: NDArray[np.float64] | None = None,
+    facets: int | None = None,
 ) -> dict[str, Any]: ...
 def read_siconos_fc(path: str) -> dict[str, Any]: ...
 def simd_level() -> str: ...

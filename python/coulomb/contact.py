@@ -22,12 +22,22 @@ with Coulomb's law: either sticking (``u_t = 0``, ``||r_t|| <= mu r_n``) or slid
 
 Methods:
 
-``"nsgs"`` (default, and for now the only one)
+``"nsgs"`` (default)
     Nonsmooth Gauss-Seidel with the exact friction disk: contact after contact, the one-contact
     problem with the others frozen is solved exactly (2D by case split, 3D by a normal /
     tangential block descent whose tangential step is the exact disk-constrained quadratic),
-    with relaxation and warm start. ``"lemke"`` (the polyhedral-cone LCP) is not implemented
-    yet and raises :class:`~coulomb.errors.InvalidParameterError`.
+    with relaxation and warm start.
+``"lemke"``
+    The seed's Stewart-Trinkle LCP: the friction disk of every frictional contact is replaced
+    by the polygon of ``facets`` unit tangent directions in +/- pairs (default 8 in 3D; in 2D
+    only 2, the directions +1 and -1, which is exact), ``z = (P_n, beta, lambda)`` solves
+    ``0 <= z ⊥ A z + b >= 0`` by Lemke's method and the impulses are mapped back
+    (``P_t = D beta``). Frictionless contacts carry only the normal unknown. ``success`` means
+    the polyhedral LCP was solved (to ``tol`` on Lemke's error measures, the LCP's own error is
+    in ``message``); ``iterations`` counts Lemke's pivots and ``max_iter`` (if given) limits
+    them. The measures below are still taken against the exact disk, so in 3D ``error``
+    reflects the facet approximation (it shrinks as ``facets`` grows, not monotonically: a
+    sliding contact's impulse snaps to a facet).
 
 Every answer is measured on the original data (W, q, mu):
 
@@ -35,7 +45,8 @@ Every answer is measured on the original data (W, q, mu):
     The natural-map residual on De Saxcé's form (as ../shared/DESIGN.md defines it),
     ``||r - P_K(r - (u + mu ||u_t|| n))||_2 / max(||q||, ||r||, ||u||)``, with ``P_K`` the
     projection on the product of the Coulomb cones (divided by 1 instead when all three norms
-    are below 1e-300). It is zero exactly at a solution. ``success`` means ``error <= tol``.
+    are below 1e-300). It is zero exactly at a solution. For ``"nsgs"``, ``success`` means
+    ``error <= tol``.
 ``error_q``
     The same residual divided by ``||q||`` (by 1 when ``||q|| < 1e-300``), as Acary et al.
     report it for FCLib.
@@ -64,8 +75,8 @@ from .lcp import _as_array
 
 __all__ = ["ContactResult", "solve"]
 
-Method = Literal["nsgs"]
-_METHODS = ("nsgs",)
+Method = Literal["nsgs", "lemke"]
+_METHODS = ("nsgs", "lemke")
 
 
 class ContactResult(Result):
@@ -78,13 +89,14 @@ class ContactResult(Result):
     velocity : ndarray, shape (nc, dim)
         ``u = W r + q`` recomputed from the original data.
     success : bool
-        True only if ``error <= tol``.
+        ``"nsgs"``: True only if ``error <= tol``; ``"lemke"``: True only if the polyhedral LCP
+        was solved.
     status : str
         ``"solved"``, ``"iteration_limit"`` or ``"numerical_failure"``.
     message : str
         One line for a person.
     iterations : int
-        Sweeps performed.
+        Sweeps performed (``"nsgs"``) or Lemke's pivots (``"lemke"``).
     error : float
         The natural-map residual divided by ``max(||q||, ||r||, ||u||)`` (see the module
         documentation).
@@ -119,9 +131,10 @@ def solve(
     method: Method = "nsgs",
     *,
     tol: float = 1e-8,
-    max_iter: int = 1000,
+    max_iter: int | None = None,
     relaxation: float = 1.0,
     initial: ArrayLike | None = None,
+    facets: int | None = None,
 ) -> ContactResult:
     """Solve the friction-contact problem ``u = W r + q`` with Coulomb's law at every contact.
 
@@ -137,17 +150,22 @@ def solve(
         array, its length fixes nc; when a scalar, ``nc = len(q) // dim``.
     dim : {2, 3}
         Components per contact.
-    method : {"nsgs"}
+    method : {"nsgs", "lemke"}
         See the module documentation.
     tol : float
-        Tolerance on ``error`` for ``success``.
-    max_iter : int
-        Sweep limit (at least 1).
+        Tolerance on ``error`` for ``success`` (``"nsgs"``), or on Lemke's LCP error measures
+        (``"lemke"``).
+    max_iter : int, optional
+        Sweep limit (at least 1; default 1000) for ``"nsgs"``; pivot limit for ``"lemke"``
+        (default Lemke's own, ``max(1000, 50 n)`` for n LCP unknowns).
     relaxation : float
-        Relaxation ω in (0, 2); 1 is plain Gauss-Seidel.
+        Relaxation ω in (0, 2); 1 is plain Gauss-Seidel (``"nsgs"`` only).
     initial : (nc, dim) or (dim nc,) array_like, optional
         Warm start impulses (e.g. the previous step's ``impulse``); projected on the cones
-        first.
+        first (``"nsgs"`` only).
+    facets : int, optional
+        ``"lemke"`` only: tangent directions per frictional contact, in +/- pairs: even and at
+        least 4 in 3D (default 8); exactly 2 in 2D (the default, and exact).
 
     Returns
     -------
@@ -158,16 +176,40 @@ def solve(
     ShapeError, NonFiniteError, InvalidParameterError
         Before any work, for bad input (shapes that do not fit, NaN or infinity, ``mu < 0``,
         ``dim`` not 2 or 3, an unknown method, ``tol <= 0``, ``max_iter < 1``, ``relaxation``
-        outside (0, 2)).
+        outside (0, 2), ``facets`` odd or too small, or an option the method does not take).
     """
     if isinstance(dim, bool) or not isinstance(dim, (int, np.integer)) or dim not in (2, 3):
         raise InvalidParameterError(f"dim must be 2 (planar) or 3 (spatial), got {dim!r}")
     dim = int(dim)
     if method not in _METHODS:
         raise InvalidParameterError(
-            f"unknown method {method!r}: expected 'nsgs' (the only method available; "
-            "'lemke' (polyhedral cone) is not implemented yet)"
+            f"unknown method {method!r}: expected 'nsgs' (exact friction disk) or 'lemke' "
+            "(polyhedral cone)"
         )
+    if method == "lemke":
+        if initial is not None:
+            raise InvalidParameterError(
+                "initial (warm start impulses) applies to method='nsgs' only"
+            )
+        if relaxation != 1.0:
+            raise InvalidParameterError("relaxation applies to method='nsgs' only")
+        if facets is None:
+            facets = 8 if dim == 3 else 2
+        if isinstance(facets, bool) or not isinstance(facets, (int, np.integer)):
+            raise InvalidParameterError(f"facets must be an integer, got {facets!r}")
+        facets = int(facets)
+        if dim == 2 and facets != 2:
+            raise InvalidParameterError(
+                f"facets must be 2 in 2D (the tangent directions +1 and -1, which are exact), "
+                f"got {facets}"
+            )
+        if dim == 3 and (facets < 4 or facets % 2 != 0):
+            raise InvalidParameterError(
+                f"facets must be even and at least 4 in 3D (tangent directions in +/- pairs), "
+                f"got {facets}"
+            )
+    elif facets is not None:
+        raise InvalidParameterError("facets applies to method='lemke' only")
     Wa = _as_array(W, "W", 2)
     qa = _as_array(q, "q", 1)
     n = qa.shape[0]
@@ -202,7 +244,7 @@ def solve(
             raise NonFiniteError("initial contains NaN or infinity")
     if not (np.isfinite(tol) and tol > 0):
         raise InvalidParameterError(f"tol must be a positive finite number, got {tol}")
-    if max_iter < 1:
+    if max_iter is not None and max_iter < 1:
         raise InvalidParameterError(f"max_iter must be at least 1, got {max_iter}")
     if not 0 < relaxation < 2:
         raise InvalidParameterError(f"relaxation must lie in (0, 2), got {relaxation}")
@@ -213,8 +255,9 @@ def solve(
         dim,
         method,
         float(tol),
-        int(max_iter),
+        None if max_iter is None else int(max_iter),
         float(relaxation),
         init,
+        facets,
     )
     return ContactResult(out)

@@ -11,17 +11,20 @@
 //! or sliding (`r_t = -mu r_n u_t / ||u_t||`).
 //!
 //! - [`projection`]: exact projections on the interval, disk, cone and ellipse;
-//! - [`nsgs`]: nonsmooth Gauss-Seidel with the exact friction disk.
+//! - [`nsgs`]: nonsmooth Gauss-Seidel with the exact friction disk;
+//! - [`polyhedral`]: the Stewart-Trinkle polyhedral-cone LCP solved by Lemke's method.
 //!
 //! Every answer is measured with the literature's natural-map error (see [`measure`]).
 
 pub mod nsgs;
+pub mod polyhedral;
 pub mod projection;
 
 use crate::error::{check_finite, CoulombError, Result};
 use projection::{project_cone, tangent_norm};
 
 pub use nsgs::{solve_nsgs, NsgsSettings};
+pub use polyhedral::{solve_polyhedral, PolyhedralSettings};
 
 /// A checked friction-contact problem over a frozen W.
 #[derive(Clone, Copy, Debug)]

@@ -102,8 +102,11 @@ pub struct LcpMeasures {
     /// `||min(z, w)||_2 / max(1, ||q||_2)` with `w = M z + q` (DESIGN.md, as Siconos reports it).
     pub error: f64,
     /// the same test judged in each row's and column's own units:
-    /// `max_i |min(z_i / s_z, w_i / s_i)|` where `s_i = |q_i| + Σ_j |M_ij z_j|` is the size of
-    /// the terms that make up w_i (so rounding in w_i counts relative to them) and
+    /// `max_i |min(z_i / s_z, w_i / s_i)|` where
+    /// `s_i = max(|q_i| + Σ_j |M_ij z_j|, max_j |M_ij c_j| max_k |z_k / c_k|)` is the size of
+    /// the terms that make up w_i (so rounding in w_i counts relative to them), floored by what
+    /// row i would produce from a z of the answer's size (C the equilibration's column
+    /// factors), and
     /// `s_z = max(1, ||C^{-1} z||_inf)` measures z in the equilibrated column units. It does not
     /// change when rows or columns are rescaled, so a row with tiny data cannot hide a wrong
     /// answer behind a large `||q||`.
@@ -202,32 +205,50 @@ impl<'a> LcpRef<'a> {
 
     /// `w = M z + q` from the original data.
     pub fn w(&self, z: &[f64]) -> Vec<f64> {
-        self.evaluate_parts(z).0
+        let n = self.n;
+        self.m
+            .chunks_exact(n.max(1))
+            .zip(self.q)
+            .map(|(mrow, qi)| mrow.iter().zip(z).map(|(a, b)| a * b).sum::<f64>() + qi)
+            .collect()
     }
 
-    /// w and, per row, `s_i = |q_i| + Σ_j |M_ij z_j|` (the size of the terms of w_i), in one
-    /// pass over M compiled for the CPU's vector instructions.
-    fn evaluate_parts(&self, z: &[f64]) -> (Vec<f64>, Vec<f64>) {
+    /// w and, per row, the scale `s_i` against which w_i is judged (see
+    /// [`LcpMeasures::scaled_error`]), in one pass over M compiled for the CPU's vector
+    /// instructions.
+    fn evaluate_parts(&self, z: &[f64], scaling: &scaling::Equilibration) -> (Vec<f64>, Vec<f64>) {
         let isa = kernel::detect();
-        kernel::dispatch!(isa, (Vec<f64>, Vec<f64>), || self.evaluate_body(z))
+        kernel::dispatch!(isa, (Vec<f64>, Vec<f64>), || self.evaluate_body(z, scaling))
     }
 
     #[inline(always)]
-    fn evaluate_body(&self, z: &[f64]) -> (Vec<f64>, Vec<f64>) {
+    fn evaluate_body(&self, z: &[f64], scaling: &scaling::Equilibration) -> (Vec<f64>, Vec<f64>) {
         let n = self.n;
+        // max_k |z_k / c_k|: the size of z in the equilibrated column units
+        let zsize = z
+            .iter()
+            .zip(&scaling.col)
+            .fold(0.0f64, |m, (v, c)| m.max((v / c).abs()));
         let mut w = Vec::with_capacity(n);
-        let mut terms = Vec::with_capacity(n);
+        let mut scale = Vec::with_capacity(n);
         for (mrow, qi) in self.m.chunks_exact(n.max(1)).zip(self.q) {
             let (dot, abs) = kernel::dot_and_abs(mrow, z);
             w.push(dot + qi);
-            terms.push(abs + qi.abs());
+            // the terms of w_i, floored by what row i produces from a z of this size, so a
+            // row whose terms all cancel to rounding is judged at the scale of the answer
+            let floor = if zsize > 0.0 {
+                kernel::max_abs_scaled(mrow, &scaling.col) * zsize
+            } else {
+                0.0
+            };
+            scale.push((abs + qi.abs()).max(floor));
         }
-        (w, terms)
+        (w, scale)
     }
 
     /// w and the error measures of z, computed from the original data.
     pub fn evaluate(&self, z: &[f64], scaling: &scaling::Equilibration) -> (Vec<f64>, LcpMeasures) {
-        let (w, terms) = self.evaluate_parts(z);
+        let (w, terms) = self.evaluate_parts(z, scaling);
         let m = self.measures_with_terms(z, &w, &terms, scaling);
         (w, m)
     }
@@ -242,7 +263,7 @@ impl<'a> LcpRef<'a> {
 
     /// the error measures of z (see [`LcpMeasures`]).
     pub fn measures(&self, z: &[f64], w: &[f64], scaling: &scaling::Equilibration) -> LcpMeasures {
-        let (_, terms) = self.evaluate_parts(z);
+        let (_, terms) = self.evaluate_parts(z, scaling);
         self.measures_with_terms(z, w, &terms, scaling)
     }
 

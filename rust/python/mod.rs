@@ -14,7 +14,7 @@ use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyDict, PyType};
 
-use crate::contact::{self, ContactProblem, ContactSolution, NsgsSettings};
+use crate::contact::{self, ContactProblem, ContactSolution, NsgsSettings, PolyhedralSettings};
 use crate::error::CoulombError;
 use crate::io::siconos::{NumericsMatrix, SiconosFcFile};
 use crate::io::ReadError;
@@ -305,11 +305,17 @@ fn contact_dict<'py>(
     Ok(d)
 }
 
+/// The settings of the contact method `contact_solve` runs.
+enum ContactSettings {
+    Nsgs(NsgsSettings),
+    Lemke(PolyhedralSettings),
+}
+
 /// Solves the friction-contact problem `u = W r + q`, per contact
 /// `K ∋ r ⊥ u + mu ||u_t|| n ∈ K^*`. The Python wrapper `coulomb.contact.solve` documents the
 /// arguments; this takes them already converted to float64 arrays (W dense, q and mu flat).
 #[pyfunction]
-#[pyo3(signature = (w, q, mu, dim, method, tol, max_iter=1000, relaxation=1.0, initial=None))]
+#[pyo3(signature = (w, q, mu, dim, method, tol, max_iter=None, relaxation=1.0, initial=None, facets=None))]
 #[allow(clippy::too_many_arguments)]
 fn contact_solve<'py>(
     py: Python<'py>,
@@ -319,9 +325,10 @@ fn contact_solve<'py>(
     dim: usize,
     method: &str,
     tol: f64,
-    max_iter: usize,
+    max_iter: Option<usize>,
     relaxation: f64,
     initial: Option<PyReadonlyArray1<'py, f64>>,
+    facets: Option<usize>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let shape = w.shape();
     if shape[0] != shape[1] {
@@ -339,18 +346,27 @@ fn contact_solve<'py>(
         None => None,
     };
     let settings = match method {
-        "nsgs" => NsgsSettings {
+        "nsgs" => ContactSettings::Nsgs(NsgsSettings {
             tol,
-            max_iter,
+            max_iter: max_iter.unwrap_or(1000),
             relaxation,
             initial: init,
-        },
+        }),
+        "lemke" => {
+            let mut s = PolyhedralSettings::for_dim(dim);
+            if let Some(f) = facets {
+                s.facets = f;
+            }
+            s.lemke.tol = tol;
+            s.lemke.max_pivots = max_iter;
+            ContactSettings::Lemke(s)
+        }
         other => {
             return Err(to_py(
                 py,
                 CoulombError::InvalidParameter(format!(
-                    "unknown method {other:?}: expected 'nsgs' (the only method available; \
-                     'lemke' (polyhedral cone) is not implemented yet)"
+                    "unknown method {other:?}: expected 'nsgs' (exact friction disk) or 'lemke' \
+                     (polyhedral cone)"
                 )),
             ))
         }
@@ -358,7 +374,10 @@ fn contact_solve<'py>(
     let (solution, nc, seconds) = guarded(py, n * n, || {
         let start = std::time::Instant::now();
         let problem = ContactProblem::new(dim, ws, qs, mus)?;
-        let s = contact::solve_nsgs(&problem, &settings)?;
+        let s = match &settings {
+            ContactSettings::Nsgs(s) => contact::solve_nsgs(&problem, s)?,
+            ContactSettings::Lemke(s) => contact::solve_polyhedral(&problem, s)?,
+        };
         Ok((s, problem.nc, start.elapsed().as_secs_f64()))
     })?;
     contact_dict(py, solution, nc, dim, seconds)

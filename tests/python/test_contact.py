@@ -154,7 +154,7 @@ def test_relaxation_changes_the_path_not_the_answer():
         ({"W": np.full((3, 3), np.inf)}, errors.NonFiniteError, "W"),
         ({"dim": 4}, errors.InvalidParameterError, "dim must be 2"),
         ({"dim": 3.0}, errors.InvalidParameterError, "dim must be 2"),
-        ({"method": "lemke"}, errors.InvalidParameterError, "not implemented yet"),
+        ({"method": "lemke", "facets": 3}, errors.InvalidParameterError, "facets"),
         ({"method": "pgs"}, errors.InvalidParameterError, "'nsgs'"),
         ({"tol": 0.0}, errors.InvalidParameterError, "tol"),
         ({"max_iter": 0}, errors.InvalidParameterError, "max_iter"),
@@ -177,7 +177,10 @@ def test_core_refuses_unknown_method_and_ragged_w():
     from coulomb import _core
 
     with pytest.raises(errors.InvalidParameterError, match="lemke"):
-        _core.contact_solve(np.eye(3), np.zeros(3), np.zeros(1), 3, "lemke", 1e-8)
+        _core.contact_solve(np.eye(3), np.zeros(3), np.zeros(1), 3, "pgs", 1e-8)
+    # "lemke" is a method now
+    out = _core.contact_solve(np.eye(3), np.zeros(3), np.zeros(1), 3, "lemke", 1e-8)
+    assert out["success"]
     with pytest.raises(errors.ShapeError):
         _core.contact_solve(np.eye(3)[:2], np.zeros(3), np.zeros(1), 3, "nsgs", 1e-8)
     with pytest.raises(errors.ShapeError):

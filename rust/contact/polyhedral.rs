@@ -1,0 +1,341 @@
+//! The polyhedral-cone (Stewart-Trinkle) contact LCP, solved by Lemke's method (the seed's
+//! "Polyhedral approximation of the friction cone", "Friction selection as complementarity"
+//! and "The inelastic step as an LCP").
+//!
+//! Per frictional contact i (`mu_i > 0`) the friction disk is replaced by the polygon spanned
+//! by `s` unit tangent directions in ± pairs, `D_i = [d_1 … d_s]`, with
+//! `d_k = (cos 2πk/s, sin 2πk/s)` in 3D (`s` even, `>= 4`) and `D_i = [1, -1]` in 2D (`s = 2`,
+//! where the polygon *is* the interval, so the answer is exact):
+//!
+//! ```text
+//!     r_t = D β,   β >= 0,   1^T β <= mu r_n,
+//!     0 <= β ⊥ D^T u_t + λ 1 >= 0,     0 <= λ ⊥ mu r_n - 1^T β >= 0.
+//! ```
+//!
+//! With `z = (r_n (nc), β (Σ s_i), λ (one per frictional contact))` and W split into its
+//! normal and tangential rows this is `0 <= z ⊥ A z + b >= 0` with
+//!
+//! ```text
+//!     A = [ W_nn      W_nt D      0 ]        b = [ q_n     ]
+//!         [ D^T W_tn  D^T W_tt D  E ]            [ D^T q_t ]
+//!         [ mu        -E^T        0 ]            [ 0       ]
+//! ```
+//!
+//! (E: each contact's β block to its λ). A is copositive but not positive semidefinite, so
+//! the LCP is solved by [`crate::lcp::solve_lemke`], not by PGS. Frictionless contacts carry
+//! only their normal unknown. The impulses are mapped back (`r_i = (r_n, D_i β_i)`) and the
+//! velocity `u = W r + q` is recomputed from the original W and q.
+//!
+//! The reported [`super::ContactMeasures`] are the same natural-map measures as NSGS, i.e.
+//! measured against the *exact* friction disk. In 3D the polyhedral answer is an
+//! approximation: a sliding contact's impulse snaps to a facet, so `error` there reflects the
+//! facet error (it shrinks as `s` grows, not monotonically). Success therefore means only that
+//! the polyhedral LCP was solved to the Lemke tolerance; the LCP's own error is in the message.
+
+use super::{measure_into, ContactProblem, ContactSolution, ContactStatus};
+use crate::error::{CoulombError, Result};
+use crate::lcp::{solve_lemke, LcpRef, LcpSolution, LcpStatus, LemkeSettings};
+
+/// Settings of [`solve_polyhedral`].
+#[derive(Clone, Debug)]
+pub struct PolyhedralSettings {
+    /// tangent directions per frictional contact, in ± pairs: even and `>= 4` in 3D; exactly 2
+    /// in 2D (the only meaningful choice there, and exact).
+    pub facets: usize,
+    /// the settings of the Lemke solve of the LCP.
+    pub lemke: LemkeSettings,
+}
+
+impl PolyhedralSettings {
+    /// the default for a dimension: 8 facets in 3D, 2 in 2D, default Lemke settings.
+    pub fn for_dim(dim: usize) -> Self {
+        Self {
+            facets: if dim == 2 { 2 } else { 8 },
+            lemke: LemkeSettings::default(),
+        }
+    }
+}
+
+/// The assembled polyhedral LCP `0 <= z ⊥ m z + q >= 0` of a contact problem, with the layout
+/// of z (see the module notes).
+#[derive(Clone, Debug)]
+pub struct PolyhedralLcp {
+    /// the number of LCP unknowns, `nc + Σ s_i + (frictional contacts)`.
+    pub n: usize,
+    /// A, row-major, `n * n` entries.
+    pub m: Vec<f64>,
+    /// b, `n` entries.
+    pub q: Vec<f64>,
+    /// contact components (`dim`).
+    dim: usize,
+    /// the tangent directions, `facets` pairs `(d_x, d_y)` (`d_y = 0` in 2D).
+    directions: Vec<[f64; 2]>,
+    /// per contact, the index of its first β in z (`None` when frictionless).
+    beta: Vec<Option<usize>>,
+    /// per contact, the index of its λ in z (`None` when frictionless).
+    lambda: Vec<Option<usize>>,
+}
+
+impl PolyhedralLcp {
+    /// Assembles the LCP of `problem` with `facets` directions per frictional contact.
+    pub fn new(problem: &ContactProblem<'_>, facets: usize) -> Result<Self> {
+        let dim = problem.dim;
+        check_facets(dim, facets)?;
+        let directions: Vec<[f64; 2]> = if dim == 2 {
+            vec![[1.0, 0.0], [-1.0, 0.0]]
+        } else {
+            // the first half, with the axis directions exact (a rounding residue such as
+            // cos(π/2) = 6e-17 would make a row of tiny data that Lemke's unit-free error
+            // measure judges against itself), then their exact negatives
+            let half: Vec<[f64; 2]> = (0..facets / 2)
+                .map(|k| {
+                    let a = std::f64::consts::TAU * k as f64 / facets as f64;
+                    let snap = |v: f64| if v.abs() < 1e-15 { 0.0 } else { v };
+                    [snap(a.cos()), snap(a.sin())]
+                })
+                .collect();
+            half.iter()
+                .copied()
+                .chain(half.iter().map(|d| [-d[0], -d[1]]))
+                .collect()
+        };
+        let nc = problem.nc;
+        let nw = problem.size();
+        // the columns of B (contact space -> [r_n, β]): at most 2 entries each
+        let mut cols: Vec<([usize; 2], [f64; 2])> = Vec::new();
+        for i in 0..nc {
+            cols.push(([i * dim, 0], [1.0, 0.0]));
+        }
+        let mut beta = vec![None; nc];
+        let mut lambda = vec![None; nc];
+        for (i, b) in beta.iter_mut().enumerate() {
+            if problem.mu[i] > 0.0 {
+                *b = Some(cols.len());
+                for d in &directions {
+                    let o = i * dim + 1;
+                    if dim == 2 {
+                        cols.push(([o, o], [d[0], 0.0]));
+                    } else {
+                        cols.push(([o, o + 1], [d[0], d[1]]));
+                    }
+                }
+            }
+        }
+        let p = cols.len();
+        let mut nl = p;
+        for l in lambda.iter_mut().zip(&beta) {
+            if l.1.is_some() {
+                *l.0 = Some(nl);
+                nl += 1;
+            }
+        }
+        let n = nl;
+        // WB (nw x p), column by column, then A_top = B^T (W B)
+        let mut wb = vec![0.0; nw * p];
+        for (c, (idx, cf)) in cols.iter().enumerate() {
+            for row in 0..nw {
+                let wr = &problem.w[row * nw..(row + 1) * nw];
+                wb[row * p + c] = cf[0] * wr[idx[0]] + cf[1] * wr[idx[1]];
+            }
+        }
+        let mut m = vec![0.0; n * n];
+        let mut q = vec![0.0; n];
+        for (r, (idx, cf)) in cols.iter().enumerate() {
+            let a = &wb[idx[0] * p..(idx[0] + 1) * p];
+            let b = &wb[idx[1] * p..(idx[1] + 1) * p];
+            let out = &mut m[r * n..r * n + p];
+            for c in 0..p {
+                out[c] = cf[0] * a[c] + cf[1] * b[c];
+            }
+            q[r] = cf[0] * problem.q[idx[0]] + cf[1] * problem.q[idx[1]];
+        }
+        let s = directions.len();
+        for i in 0..nc {
+            if let (Some(b0), Some(l)) = (beta[i], lambda[i]) {
+                m[l * n + i] = problem.mu[i];
+                for k in b0..b0 + s {
+                    m[k * n + l] = 1.0;
+                    m[l * n + k] = -1.0;
+                }
+            }
+        }
+        Ok(Self {
+            n,
+            m,
+            q,
+            dim,
+            directions,
+            beta,
+            lambda,
+        })
+    }
+
+    /// the index of contact i's normal impulse in z.
+    pub fn normal_index(&self, i: usize) -> usize {
+        i
+    }
+
+    /// the indices of contact i's β in z (empty when frictionless).
+    pub fn beta_range(&self, i: usize) -> std::ops::Range<usize> {
+        match self.beta[i] {
+            Some(b) => b..b + self.directions.len(),
+            None => 0..0,
+        }
+    }
+
+    /// the index of contact i's λ in z (`None` when frictionless).
+    pub fn lambda_index(&self, i: usize) -> Option<usize> {
+        self.lambda[i]
+    }
+
+    /// the tangent directions `d_k` (`(±1, 0)` in 2D).
+    pub fn directions(&self) -> &[[f64; 2]] {
+        &self.directions
+    }
+
+    /// the contact impulses `r_i = (r_n, D_i β_i)` (`dim nc` entries) of an LCP answer z.
+    pub fn impulses(&self, z: &[f64]) -> Vec<f64> {
+        let dim = self.dim;
+        let nc = self.beta.len();
+        let mut r = vec![0.0; dim * nc];
+        for i in 0..nc {
+            r[i * dim] = z[i];
+            for (k, zk) in self.beta_range(i).enumerate() {
+                let d = self.directions[k];
+                for t in 0..dim - 1 {
+                    r[i * dim + 1 + t] += d[t] * z[zk];
+                }
+            }
+        }
+        r
+    }
+}
+
+fn check_facets(dim: usize, facets: usize) -> Result<()> {
+    if dim == 2 && facets != 2 {
+        return Err(CoulombError::InvalidParameter(format!(
+            "facets must be 2 in 2D (the tangent directions +1 and -1, which are exact), got \
+             {facets}"
+        )));
+    }
+    if dim == 3 && (facets < 4 || facets % 2 != 0) {
+        return Err(CoulombError::InvalidParameter(format!(
+            "facets must be even and at least 4 in 3D (tangent directions in +/- pairs), got \
+             {facets}"
+        )));
+    }
+    Ok(())
+}
+
+/// Solves the friction-contact problem on the polyhedral cone by Lemke's method (see the
+/// module notes), returning the impulses together with the LCP answer itself.
+pub fn solve_polyhedral_lcp(
+    problem: &ContactProblem<'_>,
+    settings: &PolyhedralSettings,
+) -> Result<(ContactSolution, PolyhedralLcp, LcpSolution)> {
+    let lcp = PolyhedralLcp::new(problem, settings.facets)?;
+    let lref = LcpRef::new(lcp.n, &lcp.m, &lcp.q)?;
+    let ls = solve_lemke(&lref, &settings.lemke)?;
+    let r = lcp.impulses(&ls.z);
+    let mut u = vec![0.0; problem.size()];
+    let measures = measure_into(problem, &r, &mut u);
+    let lm = &ls.measures;
+    let what = format!(
+        "polyhedral LCP ({} facets, {} unknowns)",
+        lcp.directions.len(),
+        lcp.n
+    );
+    let (status, message) = match ls.status {
+        LcpStatus::Solved => (
+            ContactStatus::Solved,
+            format!(
+                "{what} solved by Lemke in {} pivots (LCP error {:.2e}; error against the \
+                 exact disk {:.2e})",
+                ls.pivots, lm.error, measures.error
+            ),
+        ),
+        LcpStatus::PivotLimit => (
+            ContactStatus::IterationLimit,
+            format!("{what}: Lemke {}: {}", ls.status, ls.message),
+        ),
+        _ => (
+            ContactStatus::NumericalFailure,
+            format!("{what}: Lemke {}: {}", ls.status, ls.message),
+        ),
+    };
+    let sol = ContactSolution {
+        impulse: r,
+        velocity: u,
+        status,
+        message,
+        iterations: ls.pivots,
+        measures,
+    };
+    Ok((sol, lcp, ls))
+}
+
+/// Solves the friction-contact problem on the polyhedral cone by Lemke's method (see the
+/// module notes). `iterations` counts Lemke's pivots; success means the LCP was solved.
+pub fn solve_polyhedral(
+    problem: &ContactProblem<'_>,
+    settings: &PolyhedralSettings,
+) -> Result<ContactSolution> {
+    solve_polyhedral_lcp(problem, settings).map(|(s, _, _)| s)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_seed_lcp_is_assembled_as_on_the_slide() {
+        let w = [0.5, 0.0, 0.0, 0.5];
+        let q = [-3.0, 1.0];
+        let p = ContactProblem::new(2, &w, &q, &[0.2]).unwrap();
+        let lcp = PolyhedralLcp::new(&p, 2).unwrap();
+        assert_eq!(lcp.n, 4);
+        #[rustfmt::skip]
+        let a = [
+            0.5, 0.0, 0.0, 0.0,
+            0.0, 0.5, -0.5, 1.0,
+            0.0, -0.5, 0.5, 1.0,
+            0.2, -1.0, -1.0, 0.0,
+        ];
+        assert_eq!(lcp.m, a);
+        assert_eq!(lcp.q, [-3.0, 1.0, -1.0, 0.0]);
+        assert_eq!(lcp.lambda_index(0), Some(3));
+        assert_eq!(lcp.impulses(&[6.0, 0.0, 1.2, 0.4]), vec![6.0, -1.2]);
+    }
+
+    #[test]
+    fn frictionless_contacts_have_only_a_normal_unknown() {
+        let w: Vec<f64> = (0..36)
+            .map(|k| if k % 7 == 0 { 1.0 } else { 0.0 })
+            .collect();
+        let q = [-1.0, 0.5, 0.0, -1.0, 0.5, 0.0];
+        let p = ContactProblem::new(3, &w, &q, &[0.0, 0.3]).unwrap();
+        let lcp = PolyhedralLcp::new(&p, 4).unwrap();
+        assert_eq!(lcp.n, 2 + 4 + 1);
+        assert!(lcp.beta_range(0).is_empty() && lcp.lambda_index(0).is_none());
+        assert_eq!(lcp.beta_range(1), 2..6);
+    }
+
+    #[test]
+    fn bad_facets_are_refused() {
+        let w = [0.5, 0.0, 0.0, 0.5];
+        let p = ContactProblem::new(2, &w, &[-3.0, 1.0], &[0.2]).unwrap();
+        assert!(matches!(
+            PolyhedralLcp::new(&p, 4),
+            Err(CoulombError::InvalidParameter(_))
+        ));
+        let w3: Vec<f64> = (0..9).map(|k| if k % 4 == 0 { 0.5 } else { 0.0 }).collect();
+        let p = ContactProblem::new(3, &w3, &[-3.0, 1.0, 0.0], &[0.2]).unwrap();
+        for s in [0, 2, 5, 7] {
+            assert!(matches!(
+                PolyhedralLcp::new(&p, s),
+                Err(CoulombError::InvalidParameter(_))
+            ));
+        }
+        assert!(PolyhedralLcp::new(&p, 6).is_ok());
+    }
+}
