@@ -8,6 +8,9 @@ use coulomb::contact::{
 use coulomb::testing::SplitMix64;
 use coulomb::CoulombError;
 
+mod common;
+use common::{delassus, post_velocity};
+
 fn nsgs(dim: usize, w: &[f64], q: &[f64], mu: &[f64], s: &NsgsSettings) -> ContactSolution {
     let p = ContactProblem::new(dim, w, q, mu).expect("well-formed test problem");
     solve_nsgs(&p, s).expect("valid settings")
@@ -19,32 +22,6 @@ fn identity_over(m: f64, n: usize) -> Vec<f64> {
         w[i * n + i] = 1.0 / m;
     }
     w
-}
-
-/// `W = G^T M^{-1} G` and `q = G^T v_free` for diagonal M; G is ndof x ncols, row-major
-/// (column k is the generalized direction of contact component k).
-fn delassus(g: &[f64], ndof: usize, minv: &[f64], v_free: &[f64]) -> (Vec<f64>, Vec<f64>) {
-    let ncols = g.len() / ndof;
-    let mut w = vec![0.0; ncols * ncols];
-    for i in 0..ncols {
-        for j in 0..ncols {
-            w[i * ncols + j] = (0..ndof)
-                .map(|a| g[a * ncols + i] * minv[a] * g[a * ncols + j])
-                .sum();
-        }
-    }
-    let q = (0..ncols)
-        .map(|i| (0..ndof).map(|a| g[a * ncols + i] * v_free[a]).sum())
-        .collect();
-    (w, q)
-}
-
-/// `v = v_free + M^{-1} G r`.
-fn post_velocity(g: &[f64], ndof: usize, minv: &[f64], v_free: &[f64], r: &[f64]) -> Vec<f64> {
-    let ncols = g.len() / ndof;
-    (0..ndof)
-        .map(|a| v_free[a] + minv[a] * (0..ncols).map(|k| g[a * ncols + k] * r[k]).sum::<f64>())
-        .collect()
 }
 
 /// `G^T v`: the contact velocities.

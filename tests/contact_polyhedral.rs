@@ -9,6 +9,9 @@ use coulomb::contact::{
 };
 use coulomb::CoulombError;
 
+mod common;
+use common::{delassus, post_velocity};
+
 fn settings(facets: usize) -> PolyhedralSettings {
     PolyhedralSettings {
         facets,
@@ -201,31 +204,6 @@ fn oblique_slip_converges_to_the_disk_as_facets_grow() {
 
 const GRAVITY: f64 = 9.81;
 const STEP: f64 = 0.01;
-
-/// `W = G^T M^{-1} G` and `q = G^T v_free` for diagonal M; G is ndof x ncols, row-major.
-fn delassus(g: &[f64], ndof: usize, minv: &[f64], v_free: &[f64]) -> (Vec<f64>, Vec<f64>) {
-    let ncols = g.len() / ndof;
-    let mut w = vec![0.0; ncols * ncols];
-    for i in 0..ncols {
-        for j in 0..ncols {
-            w[i * ncols + j] = (0..ndof)
-                .map(|a| g[a * ncols + i] * minv[a] * g[a * ncols + j])
-                .sum();
-        }
-    }
-    let q = (0..ncols)
-        .map(|i| (0..ndof).map(|a| g[a * ncols + i] * v_free[a]).sum())
-        .collect();
-    (w, q)
-}
-
-/// `v = v_free + M^{-1} G r`.
-fn post_velocity(g: &[f64], ndof: usize, minv: &[f64], v_free: &[f64], r: &[f64]) -> Vec<f64> {
-    let ncols = g.len() / ndof;
-    (0..ndof)
-        .map(|a| v_free[a] + minv[a] * (0..ncols).map(|k| g[a * ncols + k] * r[k]).sum::<f64>())
-        .collect()
-}
 
 /// The unit cube of tests/contact.rs (mass 1, inertia 1/6) on four bottom corners: G is
 /// 6 x 12, W (12 x 12) has rank 6.
