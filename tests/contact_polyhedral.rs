@@ -10,7 +10,7 @@ use coulomb::contact::{
 use coulomb::CoulombError;
 
 mod common;
-use common::{delassus, post_velocity};
+use common::{cube_g, delassus, post_velocity};
 
 fn settings(facets: usize) -> PolyhedralSettings {
     PolyhedralSettings {
@@ -204,36 +204,6 @@ fn oblique_slip_converges_to_the_disk_as_facets_grow() {
 
 const GRAVITY: f64 = 9.81;
 const STEP: f64 = 0.01;
-
-/// The unit cube of tests/contact.rs (mass 1, inertia 1/6) on four bottom corners: G is
-/// 6 x 12, W (12 x 12) has rank 6.
-fn cube_g() -> Vec<f64> {
-    let ndof = 6;
-    let corners = [
-        [-0.5, -0.5, -0.5],
-        [0.5, -0.5, -0.5],
-        [0.5, 0.5, -0.5],
-        [-0.5, 0.5, -0.5],
-    ];
-    let dirs = [[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
-    let ncols = 3 * corners.len();
-    let mut g = vec![0.0; ndof * ncols];
-    for (k, rho) in corners.iter().enumerate() {
-        for (c, d) in dirs.iter().enumerate() {
-            let col = 3 * k + c;
-            let cross = [
-                rho[1] * d[2] - rho[2] * d[1],
-                rho[2] * d[0] - rho[0] * d[2],
-                rho[0] * d[1] - rho[1] * d[0],
-            ];
-            for a in 0..3 {
-                g[a * ncols + col] = d[a];
-                g[(3 + a) * ncols + col] = cross[a];
-            }
-        }
-    }
-    g
-}
 
 #[test]
 fn cube_on_four_corners_matches_nsgs() {

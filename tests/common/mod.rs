@@ -27,3 +27,35 @@ pub fn post_velocity(g: &[f64], ndof: usize, minv: &[f64], v_free: &[f64], r: &[
         .map(|a| v_free[a] + minv[a] * (0..ncols).map(|k| g[a * ncols + k] * r[k]).sum::<f64>())
         .collect()
 }
+
+/// A unit cube (mass 1, inertia 1/6 about each principal axis, axes aligned with the world)
+/// on four bottom corners, generalized velocities (v, ω): a corner at ρ moves at v + ω × ρ, so
+/// the column of contact direction d is (d, ρ × d). G is 6 x 12 (normal, then two tangents per
+/// corner); W = G^T M^-1 G (12 x 12) has rank 6.
+pub fn cube_g() -> Vec<f64> {
+    let ndof = 6;
+    let corners = [
+        [-0.5, -0.5, -0.5],
+        [0.5, -0.5, -0.5],
+        [0.5, 0.5, -0.5],
+        [-0.5, 0.5, -0.5],
+    ];
+    let dirs = [[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    let ncols = 3 * corners.len();
+    let mut g = vec![0.0; ndof * ncols];
+    for (k, rho) in corners.iter().enumerate() {
+        for (c, d) in dirs.iter().enumerate() {
+            let col = 3 * k + c;
+            let cross = [
+                rho[1] * d[2] - rho[2] * d[1],
+                rho[2] * d[0] - rho[0] * d[2],
+                rho[0] * d[1] - rho[1] * d[0],
+            ];
+            for a in 0..3 {
+                g[a * ncols + col] = d[a];
+                g[(3 + a) * ncols + col] = cross[a];
+            }
+        }
+    }
+    g
+}
