@@ -81,6 +81,53 @@ impl<'a> ContactProblem<'a> {
     pub fn size(&self) -> usize {
         self.dim * self.nc
     }
+
+    /// `out = W x` (both `dim nc` long). Solvers reach W only through this and the block
+    /// accessors below, so the storage of W (dense or block-sparse) stays this type's choice.
+    pub fn mul_w(&self, x: &[f64], out: &mut [f64]) {
+        let n = self.size();
+        for (i, oi) in out.iter_mut().enumerate().take(n) {
+            let row = &self.w[i * n..(i + 1) * n];
+            *oi = row.iter().zip(x).map(|(a, b)| a * b).sum::<f64>();
+        }
+    }
+
+    /// the `dim x dim` block `W_ij` of contacts i and j, zero-padded to 3 x 3.
+    pub fn w_block(&self, i: usize, j: usize) -> [[f64; 3]; 3] {
+        let n = self.size();
+        let d = self.dim;
+        let mut b = [[0.0; 3]; 3];
+        for (a, row) in b.iter_mut().enumerate().take(d) {
+            for (c, v) in row.iter_mut().enumerate().take(d) {
+                *v = self.w[(i * d + a) * n + j * d + c];
+            }
+        }
+        b
+    }
+
+    /// `(W x)_i`, the `dim` components of contact i, zero-padded to 3.
+    pub fn block_row_mul(&self, i: usize, x: &[f64]) -> [f64; 3] {
+        let n = self.size();
+        let d = self.dim;
+        let mut out = [0.0; 3];
+        for (a, o) in out.iter_mut().enumerate().take(d) {
+            let row = &self.w[(i * d + a) * n..(i * d + a + 1) * n];
+            *o = row.iter().zip(x).map(|(p, q)| p * q).sum::<f64>();
+        }
+        out
+    }
+
+    /// calls `f(i, j, W_ij)` for every block that is not identically zero, row by row.
+    pub fn for_each_block(&self, mut f: impl FnMut(usize, usize, &[[f64; 3]; 3])) {
+        for i in 0..self.nc {
+            for j in 0..self.nc {
+                let b = self.w_block(i, j);
+                if b.iter().flatten().any(|&v| v != 0.0) {
+                    f(i, j, &b);
+                }
+            }
+        }
+    }
 }
 
 /// How a contact solve ended.
@@ -180,11 +227,10 @@ pub(crate) fn measure_into(
     r: &[f64],
     u: &mut [f64],
 ) -> ContactMeasures {
-    let n = problem.size();
     let dim = problem.dim;
-    for (i, ui) in u.iter_mut().enumerate() {
-        let row = &problem.w[i * n..(i + 1) * n];
-        *ui = row.iter().zip(r).map(|(a, b)| a * b).sum::<f64>() + problem.q[i];
+    problem.mul_w(r, u);
+    for (ui, qi) in u.iter_mut().zip(problem.q) {
+        *ui += qi;
     }
     let unorm = norm2(u);
     let rnorm = norm2(r);
