@@ -11,6 +11,10 @@ contact
     Frictional contact over a frozen Delassus matrix (nonsmooth Gauss-Seidel, exact cone).
 io
     Readers for benchmark problem files (Siconos).
+painleve
+    Painleve's sliding rod: the seed's A(theta), b and which smooth contact modes exist.
+regularized
+    The tanh-smoothed friction law on a ramp (stiff ODE), to compare with exact Coulomb friction.
 errors
     The exceptions raised for bad input.
 validate
@@ -19,7 +23,7 @@ validate
 
 from __future__ import annotations
 
-from . import contact, errors, io, lcp
+from . import contact, errors, io, lcp, painleve, regularized
 from ._core import __version__
 from ._result import Result
 from .contact import ContactResult
@@ -34,4 +38,6 @@ __all__ = [
     "errors",
     "io",
     "lcp",
+    "painleve",
+    "regularized",
 ]

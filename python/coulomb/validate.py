@@ -16,6 +16,7 @@ import numpy as np
 
 from . import contact, lcp
 from .io import read_siconos_lcp
+from .painleve import PainleveRod
 
 __all__ = ["Row", "format_table", "run"]
 
@@ -67,6 +68,16 @@ def _contact_rows() -> Iterator[Row]:
         yield _num(case, "T^+ (J)", 0.16, float(0.5 * m * (u @ u)), 1e-9)
 
 
+def _painleve_rows() -> Iterator[Row]:
+    # the seed's rod: m = 1 kg, l = 1 m, J = 1/12 kg m^2, mu = 2, theta = 45 deg, sliding left
+    case = "Painleve rod, theta = 45 deg"
+    rod = PainleveRod(m=1.0, l=1.0, J=1.0 / 12.0, mu=2.0)
+    res = rod.analyze(np.radians(45.0), 0.0, slip=-1.0)
+    yield _num(case, "A (1/kg)", -0.5, float(res.A), 1e-12)
+    yield _num(case, "b (m/s^2)", -9.81, float(res.b), 1e-12)
+    yield _text(case, "sliding mode with N >= 0", "none", ", ".join(res.modes) or "none")
+
+
 def default_data_dir() -> Path | None:
     """``$COULOMB_DATA``, else ``../shared/data`` beside a source checkout, if present."""
     env = os.environ.get("COULOMB_DATA")
@@ -106,7 +117,7 @@ def _data_rows(data: Path) -> Iterator[Row]:
 
 def run(data: Path | None = None, progress: Callable[[str], None] | None = None) -> list[Row]:
     """Every row: the seed's figures, then (if the benchmark data is found) the data set's."""
-    rows = [*_seed_rows(), *_contact_rows()]
+    rows = [*_seed_rows(), *_contact_rows(), *_painleve_rows()]
     data = data or default_data_dir()
     if data is not None:
         if progress:
