@@ -231,16 +231,17 @@ impl<'a> LcpRef<'a> {
             .fold(0.0f64, |m, (v, c)| m.max((v / c).abs()));
         let mut w = Vec::with_capacity(n);
         let mut scale = Vec::with_capacity(n);
-        for (mrow, qi) in self.m.chunks_exact(n.max(1)).zip(self.q) {
+        for ((mrow, qi), reach) in self
+            .m
+            .chunks_exact(n.max(1))
+            .zip(self.q)
+            .zip(&scaling.row_reach)
+        {
             let (dot, abs) = kernel::dot_and_abs(mrow, z);
             w.push(dot + qi);
             // the terms of w_i, floored by what row i produces from a z of this size, so a
             // row whose terms all cancel to rounding is judged at the scale of the answer
-            let floor = if zsize > 0.0 {
-                kernel::max_abs_scaled(mrow, &scaling.col) * zsize
-            } else {
-                0.0
-            };
+            let floor = reach * zsize;
             scale.push((abs + qi.abs()).max(floor));
         }
         (w, scale)

@@ -21,6 +21,9 @@ pub struct Equilibration {
     pub col: Vec<f64>,
     /// sigma: `||R q||_inf`, so that `||q'||_inf = 1` (1 when q = 0).
     pub sigma: f64,
+    /// `max_j |M_ij c_j|` per row with the final C: what row i can produce from a z of unit
+    /// size in the equilibrated column units (the floor of the scaled error's row scale).
+    pub row_reach: Vec<f64>,
 }
 
 /// Ruiz sweeps: each halves the log-distance of row and column maxima from 1.
@@ -43,15 +46,6 @@ fn pow2(x: f64) -> f64 {
 }
 
 impl Equilibration {
-    /// the identity scaling of size n.
-    pub fn identity(n: usize) -> Self {
-        Self {
-            row: vec![1.0; n],
-            col: vec![1.0; n],
-            sigma: 1.0,
-        }
-    }
-
     /// computes R, C and sigma for the row-major n x n matrix `m` and vector `q`.
     pub fn compute(n: usize, m: &[f64], q: &[f64]) -> Self {
         let isa = kernel::detect();
@@ -66,6 +60,7 @@ impl Equilibration {
         let mut col = vec![1.0; n];
         let mut rowmax = vec![0.0f64; n];
         let mut colmax = vec![0.0f64; n];
+        let mut settled = false;
         for _ in 0..RUIZ_SWEEPS {
             colmax.iter_mut().for_each(|c| *c = 0.0);
             for (i, mrow) in m.chunks_exact(n.max(1)).enumerate() {
@@ -76,7 +71,7 @@ impl Equilibration {
                     *cm = if a > *cm { a } else { *cm };
                 }
             }
-            let mut settled = true;
+            settled = true;
             // only rows and columns off by more than a factor 4 are rescaled: equilibration is
             // for badly scaled data, and fine-tuning well-scaled data only costs sweeps
             for (r, rm) in row.iter_mut().zip(&rowmax) {
@@ -104,7 +99,20 @@ impl Equilibration {
             .map(|(qi, ri)| (qi * ri).abs())
             .fold(0.0f64, f64::max);
         let sigma = if qmax > 0.0 { pow2(qmax) } else { 1.0 };
-        Self { row, col, sigma }
+        // a settled sweep changed no factor, so its row maxima already use the final C
+        let row_reach: Vec<f64> = if settled {
+            rowmax.iter().zip(&row).map(|(rm, r)| rm / r).collect()
+        } else {
+            m.chunks_exact(n.max(1))
+                .map(|mrow| kernel::max_abs_scaled(mrow, &col))
+                .collect()
+        };
+        Self {
+            row,
+            col,
+            sigma,
+            row_reach,
+        }
     }
 }
 
