@@ -1,0 +1,182 @@
+"""The stepper benchmark's scenes built in MuJoCo (the peer), with the figures they produce.
+
+Each function builds one scene of issue 4 with the seed's data, runs it with
+``mujoco.rollout`` (the stepping loop in C++, no Python per step), and returns the steps per
+second and the scene's figures, so ``benches/peer_step.py`` can put them beside coulomb's.
+MuJoCo's contacts are soft (solref/solimp) and its friction cone is pyramidal by default; its
+defaults are used unless a scene says otherwise, as a user would.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+G0 = 9.81
+
+
+@dataclass
+class PeerRun:
+    """One scene run by the peer."""
+
+    scene: str
+    h: float
+    steps: int
+    seconds: float
+    figures: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def steps_per_second(self) -> float:
+        return self.steps / self.seconds if self.seconds > 0 else math.inf
+
+
+def _rollout(xml: str, qvel0: dict[int, float] | None, t_end: float, h: float, repeats: int = 3):
+    import mujoco
+    from mujoco import rollout
+
+    model = mujoco.MjModel.from_xml_string(xml)
+    model.opt.timestep = h
+    data = mujoco.MjData(model)
+    if qvel0:
+        for k, v in qvel0.items():
+            data.qvel[k] = v
+    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    state0 = np.empty(mujoco.mj_stateSize(model, spec))
+    mujoco.mj_getState(model, data, state0, spec)
+    nstep = round(t_end / h)
+    best = math.inf
+    states = None
+    for _ in range(repeats):
+        start = time.perf_counter()
+        states, _ = rollout.rollout(model, data, state0[None, :], nstep=nstep)
+        best = min(best, time.perf_counter() - start)
+    # full-physics state: [time, qpos, qvel, act, ...]
+    nq, nv = model.nq, model.nv
+    qpos = states[0, :, 1 : 1 + nq]
+    qvel = states[0, :, 1 + nq : 1 + nq + nv]
+    times = h * np.arange(1, nstep + 1)
+    return times, qpos, qvel, nstep, best
+
+
+def ramp(h: float = 1e-3, t_end: float = 10.0, mu: float = 0.4, theta_deg: float = 20.0) -> PeerRun:
+    """A 1 kg block sent down a 20 deg ramp at 1 m/s with mu = 0.4 (gravity tilted instead of
+    the plane). Figures: where it stops, and how far it creeps from t = 5 s to t_end."""
+    th = math.radians(theta_deg)
+    xml = f"""
+<mujoco>
+  <option gravity="{G0 * math.sin(th)} 0 {-G0 * math.cos(th)}"/>
+  <worldbody>
+    <geom type="plane" size="50 5 0.1" friction="{mu} 0.005 0.0001"/>
+    <body pos="0 0 0.05">
+      <freejoint/>
+      <geom type="box" size="0.05 0.05 0.05" mass="1" friction="{mu} 0.005 0.0001"/>
+    </body>
+  </worldbody>
+</mujoco>"""
+    t, qpos, qvel, n, sec = _rollout(xml, {0: 1.0}, t_end, h)
+    x = qpos[:, 0] - 0.0
+    i5 = int(np.searchsorted(t, 5.0))
+    return PeerRun(
+        "ramp",
+        h,
+        n,
+        sec,
+        {
+            "distance at 3.011 s (m)": float(np.interp(3.011, t, x)),
+            f"creep 5 s..{t_end:g} s (m)": float(x[-1] - x[i5]),
+            "speed at t_end (m/s)": float(qvel[-1, 0]),
+        },
+    )
+
+
+def floor_impact(
+    h: float = 1e-3, v_impact: float = 3.0, radius: float = 0.1, t_end: float = 0.2
+) -> PeerRun:
+    """A 0.5 kg sphere hits the floor at 3 m/s (e = 0.6 asked; MuJoCo has no coefficient, so
+    its default soft contact decides). Figure: rebound speed / impact speed."""
+    xml = f"""
+<mujoco>
+  <option gravity="0 0 0"/>
+  <worldbody>
+    <geom type="plane" size="5 5 0.1"/>
+    <body pos="0 0 {radius + 0.01}">
+      <freejoint/>
+      <geom type="sphere" size="{radius}" mass="0.5"/>
+    </body>
+  </worldbody>
+</mujoco>"""
+    _t, _qpos, qvel, n, sec = _rollout(xml, {2: -v_impact}, t_end, h)
+    return PeerRun(
+        "floor impact",
+        h,
+        n,
+        sec,
+        {"rebound ratio (e asked 0.6)": float(qvel[-1, 2] / v_impact)},
+    )
+
+
+def resting_box(h: float = 1e-3, t_end: float = 10.0) -> PeerRun:
+    """A box resting on the floor for 10 s. Figures: how far it moved and its penetration."""
+    xml = """
+<mujoco>
+  <worldbody>
+    <geom type="plane" size="5 5 0.1"/>
+    <body pos="0 0 0.05">
+      <freejoint/>
+      <geom type="box" size="0.1 0.1 0.05" mass="1"/>
+    </body>
+  </worldbody>
+</mujoco>"""
+    _t, qpos, _qvel, n, sec = _rollout(xml, None, t_end, h)
+    drift = float(np.max(np.abs(qpos[:, :2] - qpos[0, :2])))
+    return PeerRun(
+        "resting box",
+        h,
+        n,
+        sec,
+        {"horizontal drift (m)": drift, "penetration (m)": float(0.05 - qpos[-1, 2])},
+    )
+
+
+def sphere_pile(count: int, h: float = 1e-3, t_end: float = 1.0, radius: float = 0.05) -> PeerRun:
+    """`count` spheres dropped on a grid into a box (floor and four walls), mu = 0.5."""
+    side = math.ceil(count ** (1 / 3))
+    spacing = 2.2 * radius
+    half = side * spacing / 2 + radius
+    bodies = []
+    for k in range(count):
+        i, j, l = k % side, (k // side) % side, k // (side * side)
+        x = -half + radius + spacing * (i + 0.5)
+        y = -half + radius + spacing * (j + 0.5)
+        z = radius + 0.01 + spacing * l
+        bodies.append(
+            f'<body pos="{x:.4f} {y:.4f} {z:.4f}"><freejoint/>'
+            f'<geom type="sphere" size="{radius}" mass="0.1" friction="0.5 0.005 0.0001"/></body>'
+        )
+    walls = "".join(
+        f'<geom type="plane" size="{half} 1 0.1" pos="{px} {py} 1" zaxis="{nx} {ny} 0"/>'
+        for px, py, nx, ny in (
+            (-half, 0, 1, 0),
+            (half, 0, -1, 0),
+            (0, -half, 0, 1),
+            (0, half, 0, -1),
+        )
+    )
+    xml = f"""
+<mujoco>
+  <worldbody>
+    <geom type="plane" size="{half} {half} 0.1" friction="0.5 0.005 0.0001"/>
+    {walls}
+    {"".join(bodies)}
+  </worldbody>
+</mujoco>"""
+    _t, _qpos, _qvel, n, sec = _rollout(xml, None, t_end, h, repeats=1)
+    return PeerRun(f"pile of {count} spheres", h, n, sec, {})
+
+
+if __name__ == "__main__":
+    for run in (ramp(), floor_impact(), resting_box(), sphere_pile(100)):
+        print(f"{run.scene:24s} h={run.h:g}  {run.steps_per_second:10.0f} steps/s  {run.figures}")
