@@ -15,6 +15,8 @@ painleve
     Painleve's sliding rod: the seed's A(theta), b and which smooth contact modes exist.
 regularized
     The tanh-smoothed friction law on a ramp (stiff ODE), to compare with exact Coulomb friction.
+study
+    Sweeps of the settings a user trades (error against cost, Pareto fronts, orders).
 errors
     The exceptions raised for bad input.
 validate
@@ -23,7 +25,7 @@ validate
 
 from __future__ import annotations
 
-from . import contact, errors, io, lcp, painleve, regularized
+from . import contact, errors, io, lcp, painleve, regularized, study
 from ._core import __version__
 from ._result import Result
 from .contact import ContactResult
@@ -40,4 +42,5 @@ __all__ = [
     "lcp",
     "painleve",
     "regularized",
+    "study",
 ]

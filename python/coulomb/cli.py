@@ -34,6 +34,41 @@ def _solve_lcp(args: argparse.Namespace) -> int:
     return 0 if r.success else 2
 
 
+def _study(args: argparse.Namespace) -> int:
+    from . import study
+
+    if args.list:
+        for name, p in study.PRESETS.items():
+            print(f"{name:18s} {p['about']}")
+        return 0
+    if args.name is None:
+        print("coulomb study: give a study name (see --list)", file=sys.stderr)
+        return 2
+    executor = None
+    if args.processes > 1:
+        from concurrent.futures import ProcessPoolExecutor
+
+        executor = ProcessPoolExecutor(max_workers=args.processes)
+    try:
+        s = study.run_preset(args.name, executor=executor, progress=not args.quiet)
+    finally:
+        if executor is not None:
+            executor.shutdown()
+    preset = study.PRESETS[args.name]
+    print(s)
+    order = s.order(preset["order"], where=preset.get("order_where"))
+    print(f"measured order of the error in {preset['order']}: {order:.3f}")
+    if args.csv:
+        print(f"wrote {s.to_csv(args.csv)}")
+    if args.json:
+        s.to_json(args.json)
+        print(f"wrote {args.json}")
+    if args.plot:
+        s.plot(path=args.plot)
+        print(f"wrote {args.plot}")
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``coulomb`` console script."""
     parser = argparse.ArgumentParser(
@@ -53,6 +88,16 @@ def main(argv: list[str] | None = None) -> int:
     s.add_argument("--method", default="lemke", choices=["lemke", "pgs", "enumerate"])
     s.add_argument("--tol", type=float, default=1e-9)
     s.set_defaults(func=_solve_lcp)
+
+    st = sub.add_parser("study", help="measure the speed-accuracy trade of a named study")
+    st.add_argument("name", nargs="?", help="the study (see --list)")
+    st.add_argument("--list", action="store_true", help="list the named studies")
+    st.add_argument("--processes", type=int, default=1, help="run the points in N processes")
+    st.add_argument("--csv", type=Path, default=None, help="write the records as CSV")
+    st.add_argument("--json", type=Path, default=None, help="write the records as JSON")
+    st.add_argument("--plot", type=Path, default=None, help="write error against time (PNG)")
+    st.add_argument("--quiet", action="store_true", help="no progress lines")
+    st.set_defaults(func=_study)
 
     args = parser.parse_args(argv)
     try:
