@@ -51,6 +51,7 @@ use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::{SparseColMat, Triplet};
 
+use super::nsgs::{solve_nsgs, NsgsSettings};
 use super::projection::{project_cone, tangent_norm};
 use super::{measure_into, ContactMeasures, ContactProblem, ContactSolution, ContactStatus};
 use crate::error::{check_finite, CoulombError, Result};
@@ -85,6 +86,12 @@ impl Default for ProxSettings {
 const ETA_MIN: f64 = 1e-12;
 /// beyond this relative eta no step length decreases ||F||: the method has stalled.
 const ETA_MAX: f64 = 1e10;
+/// Newton steps without a tenfold decrease of `||F||` before a restart from NSGS sweeps.
+const STALL_WINDOW: usize = 25;
+/// NSGS sweeps of one restart.
+const RESTART_SWEEPS: usize = 100;
+/// restarts at most.
+const MAX_RESTARTS: usize = 10;
 /// step halvings in the line search.
 const MAX_HALVINGS: usize = 30;
 
@@ -337,7 +344,35 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
     let mut iterations = 0;
     let mut stalled = false;
     let mut factor_failures = 0usize;
+    let mut restarts = 0usize;
+    // progress mark: the last time ||F|| fell below a tenth of its value at the previous mark
+    let (mut phi_mark, mut iter_mark) = (phi, 0usize);
     while measures.error_q > s.tol && iterations < s.max_iter {
+        if stalled || iterations - iter_mark >= STALL_WINDOW {
+            // restart from NSGS sweeps (see the module notes)
+            if restarts >= MAX_RESTARTS {
+                stalled = true;
+                break;
+            }
+            restarts += 1;
+            let sweep = NsgsSettings {
+                tol: s.tol,
+                max_iter: RESTART_SWEEPS,
+                relaxation: 1.0,
+                initial: Some(r.clone()),
+            };
+            let out = solve_nsgs(problem, &sweep)?;
+            if out.impulse.iter().all(|v| v.is_finite()) {
+                r = out.impulse;
+                measures = measure_into(problem, &r, &mut u);
+                phi = natural_map(dim, problem.mu, &rho, &r, &u, &mut f);
+            }
+            stalled = false;
+            eta = s.eta;
+            phi_mark = phi;
+            iter_mark = iterations;
+            continue;
+        }
         iterations += 1;
         // the generalized Jacobian at r
         for i in 0..nc {
@@ -381,7 +416,6 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
             eta *= 10.0;
             if eta > ETA_MAX || factor_failures > 50 {
                 stalled = true;
-                break;
             }
             continue;
         }
@@ -405,6 +439,10 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
             std::mem::swap(&mut r, &mut r_try);
             std::mem::swap(&mut f, &mut f_try);
             measures = measure_into(problem, &r, &mut u);
+            if phi < 0.1 * phi_mark {
+                phi_mark = phi;
+                iter_mark = iterations;
+            }
             if t == 1.0 {
                 eta = (eta * 0.1).max(ETA_MIN);
             }
@@ -412,7 +450,6 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
             eta *= 10.0;
             if eta > ETA_MAX {
                 stalled = true;
-                break;
             }
         }
     }
