@@ -16,9 +16,11 @@
 //!
 //! Every answer is measured with the literature's natural-map error (see [`measure`]).
 
+pub mod assembly;
 pub mod nsgs;
 pub mod polyhedral;
 pub mod projection;
+pub mod prox;
 
 use crate::error::{check_finite, CoulombError, Result};
 use projection::{project_cone, tangent_norm};

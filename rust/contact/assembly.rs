@@ -1,0 +1,452 @@
+//! From a mechanism to its contact problem: the Delassus matrix and the free contact velocity
+//! (DESIGN.md conventions; the seed's "inelastic step"):
+//!
+//! ```text
+//!     W = G^T M^{-1} G,        q = G^T v_free + w,        v = v_free + M^{-1} G r,
+//! ```
+//!
+//! with M the (symmetric positive definite) mass matrix, `ndof x ndof`, G the contact Jacobian
+//! transposed, `ndof x (dim nc)` (column k is the generalized direction of contact component k,
+//! normal first per contact), v_free the velocity the step reaches without contact impulses,
+//! w an optional extra contact-space term (restitution, or FCLib's `w`) and r the impulses.
+//! For FCLib's global problems `M v = H r + f` the free velocity is `v_free = M^{-1} f`
+//! ([`MassFactor::solve_in_place`]).
+//!
+//! M is given as triplets (summed when repeated). Its block-diagonal structure is found first
+//! (the finest partition of the dofs into consecutive ranges with no entry between ranges):
+//! when every block has at most [`DENSE_BLOCK_MAX`] dofs (rigid bodies: 6 x 6 or diagonal) each
+//! block is factored by a dense Cholesky `M_b = L_b L_b^T`; otherwise faer's sparse Cholesky
+//! factors the whole of M. Either way a pivot at most `1e-14` times the largest diagonal
+//! entry, an asymmetric M, or a non-positive pivot refuses M with an
+//! [`CoulombError::InvalidParameter`] naming it.
+
+use faer::linalg::solvers::Solve;
+use faer::sparse::linalg::solvers::Llt;
+use faer::sparse::{SparseColMat, Triplet};
+use faer::Side;
+
+use crate::error::{check_finite, CoulombError, Result};
+
+/// blocks of M up to this many dofs are factored densely, block by block.
+pub const DENSE_BLOCK_MAX: usize = 256;
+
+/// relative symmetry tolerance on M: `|M_ij - M_ji| <= SYM_TOL max |M|`.
+const SYM_TOL: f64 = 1e-10;
+
+/// relative pivot floor of the dense Cholesky: pivots at most this times the largest diagonal
+/// entry of M mean M is (numerically) not positive definite.
+const PIVOT_TOL: f64 = 1e-14;
+
+/// A sparse matrix given by triplets `(row, col, value)`, repeated entries summed.
+#[derive(Clone, Copy, Debug)]
+pub struct Triplets<'a> {
+    /// rows.
+    pub nrows: usize,
+    /// columns.
+    pub ncols: usize,
+    /// row index of each entry.
+    pub rows: &'a [usize],
+    /// column index of each entry.
+    pub cols: &'a [usize],
+    /// value of each entry.
+    pub vals: &'a [f64],
+}
+
+impl<'a> Triplets<'a> {
+    fn check(&self, name: &str) -> Result<()> {
+        let k = self.vals.len();
+        if self.rows.len() != k || self.cols.len() != k {
+            return Err(CoulombError::Shape(format!(
+                "{name}: rows, cols and values must have the same length, got {}, {} and {k}",
+                self.rows.len(),
+                self.cols.len()
+            )));
+        }
+        if let Some(e) = (0..k).find(|&e| self.rows[e] >= self.nrows || self.cols[e] >= self.ncols)
+        {
+            return Err(CoulombError::Shape(format!(
+                "{name}: entry {e} at ({}, {}) lies outside the {} x {} matrix",
+                self.rows[e], self.cols[e], self.nrows, self.ncols
+            )));
+        }
+        check_finite(name, self.vals)
+    }
+
+    /// the entries sorted by (col, row) with repeats summed.
+    fn canonical(&self) -> Vec<(usize, usize, f64)> {
+        let mut e: Vec<(usize, usize, f64)> = (0..self.vals.len())
+            .map(|k| (self.cols[k], self.rows[k], self.vals[k]))
+            .collect();
+        e.sort_by_key(|a| (a.0, a.1));
+        let mut out: Vec<(usize, usize, f64)> = Vec::with_capacity(e.len());
+        for (c, r, v) in e {
+            match out.last_mut() {
+                Some(last) if last.0 == c && last.1 == r => last.2 += v,
+                _ => out.push((c, r, v)),
+            }
+        }
+        out
+    }
+}
+
+/// The factor of a mass matrix M (see the module notes).
+#[derive(Clone, Debug)]
+pub enum MassFactor {
+    /// M block diagonal with small blocks: `(offset, size, L_b row-major)` per block.
+    Blocks(Vec<(usize, usize, Vec<f64>)>),
+    /// faer's sparse Cholesky of the whole of M.
+    Sparse(Llt<usize, f64>),
+}
+
+impl MassFactor {
+    /// factors M (`ndof x ndof`, triplets); refuses a non-square, asymmetric, non-finite or
+    /// not positive definite M.
+    pub fn new(m: &Triplets<'_>) -> Result<Self> {
+        if m.nrows != m.ncols {
+            return Err(CoulombError::Shape(format!(
+                "the mass matrix M must be square, got {} x {}",
+                m.nrows, m.ncols
+            )));
+        }
+        m.check("the mass matrix M")?;
+        let n = m.nrows;
+        let entries = m.canonical();
+        let scale = entries.iter().fold(0.0f64, |a, e| a.max(e.2.abs()));
+        // symmetry: every entry against its mirror (absent mirror = 0)
+        for &(c, r, v) in &entries {
+            if r == c {
+                continue;
+            }
+            let mirror = entries
+                .binary_search_by(|e| (e.0, e.1).cmp(&(r, c)))
+                .map(|k| entries[k].2)
+                .unwrap_or(0.0);
+            if (v - mirror).abs() > SYM_TOL * scale {
+                return Err(CoulombError::InvalidParameter(format!(
+                    "the mass matrix M must be symmetric: M[{r}, {c}] = {v} but M[{c}, {r}] = \
+                     {mirror}"
+                )));
+            }
+        }
+        let mut diag = vec![0.0; n];
+        for &(c, r, v) in &entries {
+            if r == c {
+                diag[r] = v;
+            }
+        }
+        if let Some(k) = diag.iter().position(|&d| d <= 0.0) {
+            return Err(CoulombError::InvalidParameter(format!(
+                "the mass matrix M is not positive definite: M[{k}, {k}] = {} <= 0",
+                diag[k]
+            )));
+        }
+        let dmax = diag.iter().fold(0.0f64, |a, &d| a.max(d));
+        // the finest block-diagonal partition: reach[k] = the largest index coupled to k
+        let mut reach: Vec<usize> = (0..n).collect();
+        for &(c, r, _) in &entries {
+            let (lo, hi) = if r < c { (r, c) } else { (c, r) };
+            reach[lo] = reach[lo].max(hi);
+        }
+        let mut blocks = Vec::new();
+        let mut start = 0;
+        let mut end = 0;
+        for (k, &rk) in reach.iter().enumerate() {
+            end = end.max(rk);
+            if end == k {
+                blocks.push((start, k + 1 - start));
+                start = k + 1;
+            }
+        }
+        let largest = blocks.iter().map(|b| b.1).max().unwrap_or(0);
+        if largest <= DENSE_BLOCK_MAX {
+            let mut out = Vec::with_capacity(blocks.len());
+            let mut block_of = vec![0usize; n];
+            for (b, &(o, s)) in blocks.iter().enumerate() {
+                block_of[o..o + s].fill(b);
+            }
+            let mut dense: Vec<Vec<f64>> = blocks.iter().map(|&(_, s)| vec![0.0; s * s]).collect();
+            for &(c, r, v) in &entries {
+                let b = block_of[r];
+                let (o, s) = blocks[b];
+                dense[b][(r - o) * s + (c - o)] = v;
+            }
+            for (&(o, s), mut a) in blocks.iter().zip(dense) {
+                if let Err(k) = cholesky_in_place(&mut a, s, PIVOT_TOL * dmax) {
+                    return Err(CoulombError::InvalidParameter(format!(
+                        "the mass matrix M is not positive definite (Cholesky pivot {} of the \
+                         diagonal block of dofs {o}..{} is not positive)",
+                        o + k,
+                        o + s
+                    )));
+                }
+                out.push((o, s, a));
+            }
+            return Ok(MassFactor::Blocks(out));
+        }
+        let lower: Vec<Triplet<usize, usize, f64>> = entries
+            .iter()
+            .filter(|e| e.1 >= e.0)
+            .map(|&(c, r, v)| Triplet::new(r, c, v))
+            .collect();
+        let mat = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &lower)
+            .map_err(|e| CoulombError::InvalidParameter(format!("the mass matrix M: {e:?}")))?;
+        let llt = mat.sp_cholesky(Side::Lower).map_err(|e| {
+            CoulombError::InvalidParameter(format!(
+                "the mass matrix M is not positive definite (sparse Cholesky: {e:?})"
+            ))
+        })?;
+        Ok(MassFactor::Sparse(llt))
+    }
+
+    /// `x <- M^{-1} x`.
+    pub fn solve_in_place(&self, x: &mut [f64]) {
+        match self {
+            MassFactor::Blocks(blocks) => {
+                for (o, s, l) in blocks {
+                    let xb = &mut x[*o..*o + *s];
+                    let s = *s;
+                    // L y = x, then L^T z = y
+                    for i in 0..s {
+                        let mut v = xb[i];
+                        for k in 0..i {
+                            v -= l[i * s + k] * xb[k];
+                        }
+                        xb[i] = v / l[i * s + i];
+                    }
+                    for i in (0..s).rev() {
+                        let mut v = xb[i];
+                        for k in i + 1..s {
+                            v -= l[k * s + i] * xb[k];
+                        }
+                        xb[i] = v / l[i * s + i];
+                    }
+                }
+            }
+            MassFactor::Sparse(llt) => {
+                let n = x.len();
+                llt.solve_in_place(faer::MatMut::from_column_major_slice_mut(x, n, 1));
+            }
+        }
+    }
+}
+
+/// dense Cholesky `A = L L^T` in place (row-major s x s, L in the lower triangle, the upper
+/// triangle zeroed); `Err(k)` when pivot k is at most `floor`.
+fn cholesky_in_place(a: &mut [f64], s: usize, floor: f64) -> std::result::Result<(), usize> {
+    for j in 0..s {
+        let mut d = a[j * s + j];
+        for k in 0..j {
+            d -= a[j * s + k] * a[j * s + k];
+        }
+        if d.is_nan() || d <= floor {
+            return Err(j);
+        }
+        let ljj = d.sqrt();
+        a[j * s + j] = ljj;
+        for i in j + 1..s {
+            let mut v = a[i * s + j];
+            for k in 0..j {
+                v -= a[i * s + k] * a[j * s + k];
+            }
+            a[i * s + j] = v / ljj;
+        }
+        for c in j + 1..s {
+            a[j * s + c] = 0.0;
+        }
+    }
+    Ok(())
+}
+
+/// G by columns: `(row, value)` lists, one per column.
+fn columns(g: &Triplets<'_>) -> Vec<Vec<(usize, f64)>> {
+    let mut cols = vec![Vec::new(); g.ncols];
+    for (c, r, v) in g.canonical() {
+        if v != 0.0 {
+            cols[c].push((r, v));
+        }
+    }
+    cols
+}
+
+/// The contact problem of a mechanism (see the module notes).
+#[derive(Clone, Debug)]
+pub struct Assembled {
+    /// `W = G^T M^{-1} G`, row-major `(dim nc)^2`, symmetrized (`(W + W^T) / 2`).
+    pub w: Vec<f64>,
+    /// `q = G^T v_free + w`.
+    pub q: Vec<f64>,
+    /// the free velocity used (`M^{-1} f` when a force impulse was given).
+    pub v_free: Vec<f64>,
+}
+
+/// Where the free velocity comes from.
+#[derive(Clone, Copy, Debug)]
+pub enum FreeMotion<'a> {
+    /// the free velocity v_free itself.
+    Velocity(&'a [f64]),
+    /// a force impulse f with `v_free = M^{-1} f` (FCLib's global form `M v = H r + f`).
+    Force(&'a [f64]),
+}
+
+/// `W = G^T M^{-1} G`, `q = G^T v_free + extra` (see the module notes); `extra` has
+/// `G.ncols` entries when given.
+pub fn assemble(
+    m: &Triplets<'_>,
+    g: &Triplets<'_>,
+    free: FreeMotion<'_>,
+    extra: Option<&[f64]>,
+) -> Result<Assembled> {
+    let factor = MassFactor::new(m)?;
+    assemble_with(&factor, m.nrows, g, free, extra)
+}
+
+/// [`assemble`] with M already factored (`ndof` its size).
+pub fn assemble_with(
+    factor: &MassFactor,
+    ndof: usize,
+    g: &Triplets<'_>,
+    free: FreeMotion<'_>,
+    extra: Option<&[f64]>,
+) -> Result<Assembled> {
+    if g.nrows != ndof {
+        return Err(CoulombError::Shape(format!(
+            "G must have ndof = {ndof} rows (one per generalized velocity), got {}",
+            g.nrows
+        )));
+    }
+    g.check("the contact Jacobian G")?;
+    let n = g.ncols;
+    let v_free = match free {
+        FreeMotion::Velocity(v) | FreeMotion::Force(v) if v.len() != ndof => {
+            return Err(CoulombError::Shape(format!(
+                "the free velocity (or force) must have ndof = {ndof} entries, got {}",
+                v.len()
+            )));
+        }
+        FreeMotion::Velocity(v) => {
+            check_finite("v_free", v)?;
+            v.to_vec()
+        }
+        FreeMotion::Force(f) => {
+            check_finite("f", f)?;
+            let mut v = f.to_vec();
+            factor.solve_in_place(&mut v);
+            v
+        }
+    };
+    if let Some(e) = extra {
+        if e.len() != n {
+            return Err(CoulombError::Shape(format!(
+                "the extra contact term must have dim nc = {n} entries (one per column of G), \
+                 got {}",
+                e.len()
+            )));
+        }
+        check_finite("the extra contact term", e)?;
+    }
+    let cols = columns(g);
+    let mut w = vec![0.0; n * n];
+    let mut x = vec![0.0; ndof];
+    for (k, ck) in cols.iter().enumerate() {
+        x.fill(0.0);
+        for &(r, v) in ck {
+            x[r] = v;
+        }
+        factor.solve_in_place(&mut x);
+        for (j, cj) in cols.iter().enumerate() {
+            w[j * n + k] = cj.iter().map(|&(r, v)| v * x[r]).sum();
+        }
+    }
+    for i in 0..n {
+        for j in i + 1..n {
+            let s = 0.5 * (w[i * n + j] + w[j * n + i]);
+            w[i * n + j] = s;
+            w[j * n + i] = s;
+        }
+    }
+    let q = cols
+        .iter()
+        .enumerate()
+        .map(|(k, ck)| {
+            ck.iter().map(|&(r, v)| v * v_free[r]).sum::<f64>() + extra.map_or(0.0, |e| e[k])
+        })
+        .collect();
+    Ok(Assembled { w, q, v_free })
+}
+
+/// the velocity after the impulses: `v = v_free + M^{-1} G r`.
+pub fn post_velocity(
+    factor: &MassFactor,
+    g: &Triplets<'_>,
+    v_free: &[f64],
+    r: &[f64],
+) -> Result<Vec<f64>> {
+    g.check("the contact Jacobian G")?;
+    if v_free.len() != g.nrows || r.len() != g.ncols {
+        return Err(CoulombError::Shape(format!(
+            "v_free must have ndof = {} entries and r dim nc = {} entries, got {} and {}",
+            g.nrows,
+            g.ncols,
+            v_free.len(),
+            r.len()
+        )));
+    }
+    check_finite("v_free", v_free)?;
+    check_finite("r", r)?;
+    let mut x = vec![0.0; g.nrows];
+    for (k, &v) in g.vals.iter().enumerate() {
+        x[g.rows[k]] += v * r[g.cols[k]];
+    }
+    factor.solve_in_place(&mut x);
+    for (xi, vi) in x.iter_mut().zip(v_free) {
+        *xi += vi;
+    }
+    Ok(x)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dense_cholesky_solves_and_refuses_indefinite_blocks() {
+        // [[4, 2], [2, 3]]: L = [[2, 0], [1, sqrt 2]]
+        let mut a = vec![4.0, 2.0, 2.0, 3.0];
+        cholesky_in_place(&mut a, 2, 0.0).unwrap();
+        assert!((a[0] - 2.0).abs() < 1e-15 && (a[2] - 1.0).abs() < 1e-15);
+        assert!((a[3] - 2f64.sqrt()).abs() < 1e-15 && a[1] == 0.0);
+        let mut b = vec![1.0, 2.0, 2.0, 1.0];
+        assert_eq!(cholesky_in_place(&mut b, 2, 0.0), Err(1));
+    }
+
+    #[test]
+    fn block_partition_follows_the_couplings() {
+        // dofs 0-1 coupled, 2 alone, 3-4 coupled through (4, 3) only
+        let rows = [0, 1, 0, 1, 2, 3, 4, 4, 3];
+        let cols = [0, 1, 1, 0, 2, 3, 4, 3, 4];
+        let vals = [2.0, 2.0, 0.5, 0.5, 1.0, 3.0, 3.0, -1.0, -1.0];
+        let m = Triplets {
+            nrows: 5,
+            ncols: 5,
+            rows: &rows,
+            cols: &cols,
+            vals: &vals,
+        };
+        let f = MassFactor::new(&m).unwrap();
+        let MassFactor::Blocks(b) = &f else {
+            panic!("expected blocks")
+        };
+        let sizes: Vec<(usize, usize)> = b.iter().map(|x| (x.0, x.1)).collect();
+        assert_eq!(sizes, vec![(0, 2), (2, 1), (3, 2)]);
+        // M x = e: check M (M^{-1} e) = e
+        let mut x = vec![1.0, 2.0, 3.0, 4.0, 5.0];
+        f.solve_in_place(&mut x);
+        let mut back = [0.0; 5];
+        for k in 0..vals.len() {
+            back[rows[k]] += vals[k] * x[cols[k]];
+        }
+        for (i, v) in back.iter().enumerate() {
+            assert!((v - (i as f64 + 1.0)).abs() < 1e-14, "{back:?}");
+        }
+    }
+}

@@ -1,0 +1,565 @@
+//! The robust mode: a proximal-point semismooth Newton method on the natural map.
+//!
+//! The friction-contact problem is written as the nonsmooth equation (the natural map of
+//! De Saxce's form, per contact i, with a scaling `rho_i > 0` that leaves its zeros unchanged)
+//!
+//! ```text
+//!     F_i(r) = r_i - P_{K_i}( r_i - rho_i (u_i + g_i(u_i)) ) = 0,     u = W r + q,
+//!     g_i(u_i) = mu_i ||u_{t,i}|| n,
+//! ```
+//!
+//! whose zeros are exactly the solutions (Signorini's condition and Coulomb's law). Plain
+//! semismooth Newton on F fails where W is singular (redundant contacts: the generalized
+//! Jacobian is singular on sticking contacts), which is also where NSGS stalls. Each iteration
+//! here is instead one semismooth Newton step on the *proximal-point subproblem* centred at the
+//! current iterate r_k (Rockafellar's proximal point method; the subproblem adds `eta (r - r_k)`
+//! to the velocity seen by the cone, so its W is `W + eta I`, positive definite):
+//!
+//! ```text
+//!     J_eta d = -F(r_k),
+//!     J_eta   = I - D + diag(rho_i D_i (I + Dg_i)) W + eta diag(rho_i D_i),
+//! ```
+//!
+//! with `D_i` a generalized Jacobian of the projection on the second-order cone K_i at
+//! `x_i = r_i - rho_i (u_i + g_i)` (I inside K_i, 0 inside its polar, and on the rest the
+//! closed form of [`cone_projection_jacobian`]) and `Dg_i` the Jacobian of De Saxce's term
+//! (`mu_i u_t^T / ||u_t||` in the normal row; 0 when `u_t = 0`). At the centre the
+//! subproblem's residual equals F(r_k), so eta only damps the step: eta large gives a short
+//! step along -F (a projected fixed-point step), eta -> 0 gives the full semismooth Newton
+//! step (locally superlinear). A backtracking line search on `||F||` (Armijo, factor 1/2)
+//! accepts the step; eta is divided by 10 after a full step, left after a damped one, and
+//! multiplied by 10 when no step length decreases `||F||`. J_eta has the block pattern of W
+//! plus the diagonal; it is assembled from [`ContactProblem::for_each_block`] once into a
+//! block list and factored by faer's sparse LU (partial pivoting) with the symbolic analysis
+//! done once.
+//!
+//! Measured choice (FCLib subset and the siconos-fc local problems, see the report of issue 3
+//! and `benches/peer_contact.py`): this solves every FCLib local/global 3D problem except
+//! RockPile to `error_q <= 1e-8`, and the siconos-fc problems on which NSGS stalls
+//! (BoxesStack1-i100000-32, OneObject-i100000-316 and -499) in a few dozen Newton steps. A
+//! proximal outer loop with NSGS as inner solver was not kept: the inner problems are well
+//! conditioned only for eta comparable to W's diagonal, and then the outer loop contracts at
+//! the rate `eta / (eta + lambda_min)` of W's small nonzero eigenvalues, i.e. it stalls like
+//! NSGS itself.
+//!
+//! The stopping test is on [`super::ContactMeasures::error_q`] (the residual divided by
+//! `||q||`, as Acary et al. report FCLib results): `error_q <= tol` (default 1e-8). Since the
+//! other measure `error` divides by `max(||q||, ||r||, ||u||) >= ||q||`, it implies
+//! `error <= tol` too; both are reported.
+
+use faer::linalg::solvers::Solve;
+use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
+use faer::sparse::{SparseColMat, Triplet};
+
+use super::nsgs::{solve_nsgs, NsgsSettings};
+use super::projection::{project_cone, tangent_norm};
+use super::{measure_into, ContactMeasures, ContactProblem, ContactSolution, ContactStatus};
+use crate::error::{check_finite, CoulombError, Result};
+
+/// Settings of [`solve_prox`].
+#[derive(Clone, Debug)]
+pub struct ProxSettings {
+    /// stop when [`ContactMeasures::error_q`] is at most this (which implies
+    /// [`ContactMeasures::error`] <= tol).
+    pub tol: f64,
+    /// Newton iterations at most (each one factorization; at least 1).
+    pub max_iter: usize,
+    /// the initial proximal parameter eta relative to the mean diagonal of W (> 0).
+    pub eta: f64,
+    /// warm start: impulses (`dim nc`, projected on the cones first); zeros when `None`.
+    pub initial: Option<Vec<f64>>,
+}
+
+impl Default for ProxSettings {
+    fn default() -> Self {
+        Self {
+            tol: 1e-8,
+            max_iter: 200,
+            eta: 1.0,
+            initial: None,
+        }
+    }
+}
+
+/// the smallest relative proximal parameter: a floor that keeps J_eta invertible when W is
+/// singular (redundant contacts) without slowing the local convergence measurably.
+const ETA_MIN: f64 = 1e-12;
+/// beyond this relative eta no step length decreases ||F||: the method has stalled.
+const ETA_MAX: f64 = 1e10;
+/// Newton steps without a tenfold decrease of `||F||` before a restart from NSGS sweeps.
+const STALL_WINDOW: usize = 25;
+/// NSGS sweeps of one restart.
+const RESTART_SWEEPS: usize = 100;
+/// restarts at most.
+const MAX_RESTARTS: usize = 10;
+/// step halvings in the line search.
+const MAX_HALVINGS: usize = 30;
+
+/// `D = dP_K(x)` for the Coulomb cone `K = { ||x_t|| <= mu x_n }` (x of length `dim`, normal
+/// first), written into the top-left `dim x dim` corner:
+///
+/// ```text
+///     I                                   if ||x_t|| <= mu x_n        (inside K)
+///     0                                   if mu ||x_t|| <= -x_n       (inside the polar cone)
+///     1/(1+mu^2) [[1, mu w^T], [mu w, mu^2 w w^T + mu (1+mu^2) a/s (I - w w^T)]]   otherwise,
+/// ```
+///
+/// with `s = ||x_t||`, `w = x_t / s` and `a = (x_n + mu s) / (1 + mu^2)` the normal component
+/// of the projection. For mu > 1 the coefficients are evaluated with `k = 1 / mu`.
+pub fn cone_projection_jacobian(x: &[f64], mu: f64) -> [[f64; 3]; 3] {
+    let dim = x.len();
+    let mut d = [[0.0; 3]; 3];
+    let n = x[0];
+    let s = tangent_norm(&x[1..]);
+    if s <= mu * n {
+        for (k, row) in d.iter_mut().enumerate().take(dim) {
+            row[k] = 1.0;
+        }
+        return d;
+    }
+    if mu * s <= -n {
+        return d;
+    }
+    // boundary case: here s > 0 (s = 0 falls in one of the two cases above)
+    // c0 = 1/(1+mu^2), c1 = mu/(1+mu^2), c2 = mu^2/(1+mu^2), robust for large mu
+    let (c0, c1, c2) = if mu <= 1.0 {
+        let den = 1.0 + mu * mu;
+        (1.0 / den, mu / den, mu * mu / den)
+    } else {
+        let k = 1.0 / mu;
+        let den = 1.0 + k * k;
+        (k * k / den, k / den, 1.0 / den)
+    };
+    // mu a / s with a = c0 n + c1 s: mu a / s = c1 n / s + c2
+    let rad = (c1 * n / s + c2).max(0.0);
+    let mut w = [0.0; 2];
+    for k in 1..dim {
+        w[k - 1] = x[k] / s;
+    }
+    d[0][0] = c0;
+    for k in 1..dim {
+        d[0][k] = c1 * w[k - 1];
+        d[k][0] = c1 * w[k - 1];
+        for l in 1..dim {
+            let ww = w[k - 1] * w[l - 1];
+            let id = if k == l { 1.0 } else { 0.0 };
+            d[k][l] = c2 * ww + rad * (id - ww);
+        }
+    }
+    d
+}
+
+/// `F(r)` (scaled natural map, see the module notes) into `f`, given `u = W r + q`; returns
+/// `||F||`.
+fn natural_map(dim: usize, mu: &[f64], rho: &[f64], r: &[f64], u: &[f64], f: &mut [f64]) -> f64 {
+    let mut sum = 0.0;
+    for (i, (&mui, &rhoi)) in mu.iter().zip(rho).enumerate() {
+        let o = i * dim;
+        let ri = &r[o..o + dim];
+        let ui = &u[o..o + dim];
+        let ut = tangent_norm(&ui[1..]);
+        let mut x = [0.0; 3];
+        x[0] = ri[0] - rhoi * (ui[0] + mui * ut);
+        for k in 1..dim {
+            x[k] = ri[k] - rhoi * ui[k];
+        }
+        project_cone(&mut x[..dim], mui);
+        for k in 0..dim {
+            let v = ri[k] - x[k];
+            f[o + k] = v;
+            sum += v * v;
+        }
+    }
+    sum.sqrt()
+}
+
+/// `u = W r + q` into `u`.
+fn velocity(problem: &ContactProblem<'_>, r: &[f64], u: &mut [f64]) {
+    problem.mul_w(r, u);
+    for (ui, qi) in u.iter_mut().zip(problem.q) {
+        *ui += qi;
+    }
+}
+
+/// The Newton matrix's pattern and values: the nonzero blocks of W (plus every diagonal
+/// block), each expanded to `dim x dim` triplets in a fixed order.
+struct Jacobian {
+    dim: usize,
+    /// (i, j, W_ij), with every diagonal block present.
+    blocks: Vec<(usize, usize, [[f64; 3]; 3])>,
+    triplets: Vec<Triplet<usize, usize, f64>>,
+    symbolic: Option<SymbolicLu<usize>>,
+}
+
+impl Jacobian {
+    fn new(problem: &ContactProblem<'_>) -> Self {
+        let dim = problem.dim;
+        let mut blocks = Vec::new();
+        let mut has_diag = vec![false; problem.nc];
+        problem.for_each_block(|i, j, b| {
+            if i == j {
+                has_diag[i] = true;
+            }
+            blocks.push((i, j, *b));
+        });
+        for (i, _) in has_diag.iter().enumerate().filter(|(_, &h)| !h) {
+            blocks.push((i, i, [[0.0; 3]; 3]));
+        }
+        let mut triplets = Vec::with_capacity(blocks.len() * dim * dim);
+        for &(i, j, _) in &blocks {
+            for a in 0..dim {
+                for c in 0..dim {
+                    triplets.push(Triplet::new(i * dim + a, j * dim + c, 0.0));
+                }
+            }
+        }
+        Self {
+            dim,
+            blocks,
+            triplets,
+            symbolic: None,
+        }
+    }
+
+    /// fills the values of J_eta (see the module notes) from the per-contact factors
+    /// `A_i = rho_i D_i (I + Dg_i)`, `D_i` and the scaled proximal term `rho_i eta`.
+    fn fill(&mut self, a: &[[[f64; 3]; 3]], d: &[[[f64; 3]; 3]], rho_eta: &[f64]) {
+        let dim = self.dim;
+        let mut t = 0;
+        for &(i, j, ref w) in &self.blocks {
+            let ai = &a[i];
+            for row in 0..dim {
+                for col in 0..dim {
+                    let mut v: f64 = (0..dim).map(|k| ai[row][k] * w[k][col]).sum();
+                    if i == j {
+                        let id = if row == col { 1.0 } else { 0.0 };
+                        v += id - d[i][row][col] + rho_eta[i] * d[i][row][col];
+                    }
+                    self.triplets[t].val = v;
+                    t += 1;
+                }
+            }
+        }
+    }
+
+    /// solves `J x = rhs` in place; `false` when the factorization fails or gives a
+    /// non-finite answer.
+    fn solve(&mut self, n: usize, rhs: &mut [f64]) -> bool {
+        let Ok(mat) = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &self.triplets)
+        else {
+            return false;
+        };
+        let symbolic = match &self.symbolic {
+            Some(s) => s.clone(),
+            None => match SymbolicLu::try_new(mat.symbolic()) {
+                Ok(s) => {
+                    self.symbolic = Some(s.clone());
+                    s
+                }
+                Err(_) => return false,
+            },
+        };
+        let Ok(lu) = Lu::try_new_with_symbolic(symbolic, mat.as_ref()) else {
+            return false;
+        };
+        lu.solve_in_place(faer::MatMut::from_column_major_slice_mut(rhs, n, 1));
+        rhs.iter().all(|v| v.is_finite())
+    }
+}
+
+/// Solves the friction-contact problem by the proximal-point semismooth Newton method (see the
+/// module notes).
+pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<ContactSolution> {
+    if !(s.tol.is_finite() && s.tol > 0.0) {
+        return Err(CoulombError::InvalidParameter(format!(
+            "tol must be a positive finite number, got {}",
+            s.tol
+        )));
+    }
+    if !(s.eta.is_finite() && s.eta > 0.0) {
+        return Err(CoulombError::InvalidParameter(format!(
+            "eta (the initial proximal parameter) must be a positive finite number, got {}",
+            s.eta
+        )));
+    }
+    if s.max_iter == 0 {
+        return Err(CoulombError::InvalidParameter(
+            "max_iter must be at least 1".into(),
+        ));
+    }
+    let dim = problem.dim;
+    let nc = problem.nc;
+    let n = problem.size();
+    let mut r = match &s.initial {
+        Some(r0) => {
+            if r0.len() != n {
+                return Err(CoulombError::Shape(format!(
+                    "initial impulses have length {}, expected {n}",
+                    r0.len()
+                )));
+            }
+            check_finite("initial impulses", r0)?;
+            let mut r = r0.clone();
+            for (ri, &mu) in r.chunks_exact_mut(dim).zip(problem.mu) {
+                project_cone(ri, mu);
+            }
+            r
+        }
+        None => vec![0.0; n],
+    };
+
+    // scales: rho_i = 1 / (W_ii)_nn (the mean normal diagonal where that is not positive)
+    let diag: Vec<f64> = (0..nc).map(|i| problem.w_block(i, i)[0][0]).collect();
+    let positive: Vec<f64> = diag.iter().copied().filter(|&v| v > 0.0).collect();
+    let wscale = if positive.is_empty() {
+        1.0
+    } else {
+        positive.iter().sum::<f64>() / positive.len() as f64
+    };
+    let rho: Vec<f64> = diag
+        .iter()
+        .map(|&v| {
+            if v > 1e-12 * wscale {
+                1.0 / v
+            } else {
+                1.0 / wscale
+            }
+        })
+        .collect();
+
+    let mut jac = Jacobian::new(problem);
+    let mut u = vec![0.0; n];
+    let mut f = vec![0.0; n];
+    let mut d = vec![0.0; n];
+    let mut r_try = vec![0.0; n];
+    let mut u_try = vec![0.0; n];
+    let mut f_try = vec![0.0; n];
+    let mut a_blocks = vec![[[0.0; 3]; 3]; nc];
+    let mut d_blocks = vec![[[0.0; 3]; 3]; nc];
+    let mut rho_eta = vec![0.0; nc];
+
+    let mut eta = s.eta;
+    let mut measures: ContactMeasures = measure_into(problem, &r, &mut u);
+    let mut phi = natural_map(dim, problem.mu, &rho, &r, &u, &mut f);
+    let mut iterations = 0;
+    let mut stalled = false;
+    let mut factor_failures = 0usize;
+    let mut restarts = 0usize;
+    // progress mark: the last time ||F|| fell below a tenth of its value at the previous mark
+    let (mut phi_mark, mut iter_mark) = (phi, 0usize);
+    while measures.error_q > s.tol && iterations < s.max_iter {
+        if stalled || iterations - iter_mark >= STALL_WINDOW {
+            // restart from NSGS sweeps (see the module notes)
+            if restarts >= MAX_RESTARTS {
+                stalled = true;
+                break;
+            }
+            restarts += 1;
+            let sweep = NsgsSettings {
+                tol: s.tol,
+                max_iter: RESTART_SWEEPS,
+                relaxation: 1.0,
+                initial: Some(r.clone()),
+            };
+            let out = solve_nsgs(problem, &sweep)?;
+            if out.impulse.iter().all(|v| v.is_finite()) {
+                r = out.impulse;
+                measures = measure_into(problem, &r, &mut u);
+                phi = natural_map(dim, problem.mu, &rho, &r, &u, &mut f);
+            }
+            stalled = false;
+            eta = s.eta;
+            phi_mark = phi;
+            iter_mark = iterations;
+            continue;
+        }
+        iterations += 1;
+        // the generalized Jacobian at r
+        for i in 0..nc {
+            let o = i * dim;
+            let mu = problem.mu[i];
+            let ri = &r[o..o + dim];
+            let ui = &u[o..o + dim];
+            let ut = tangent_norm(&ui[1..]);
+            let mut x = [0.0; 3];
+            x[0] = ri[0] - rho[i] * (ui[0] + mu * ut);
+            for k in 1..dim {
+                x[k] = ri[k] - rho[i] * ui[k];
+            }
+            let dp = cone_projection_jacobian(&x[..dim], mu);
+            // I + Dg: identity plus mu u_t^T / ||u_t|| in the normal row
+            let mut ig = [[0.0; 3]; 3];
+            for (k, row) in ig.iter_mut().enumerate().take(dim) {
+                row[k] = 1.0;
+            }
+            if ut > 0.0 {
+                for k in 1..dim {
+                    ig[0][k] = mu * ui[k] / ut;
+                }
+            }
+            let mut ai = [[0.0; 3]; 3];
+            for row in 0..dim {
+                for col in 0..dim {
+                    ai[row][col] = rho[i] * (0..dim).map(|k| dp[row][k] * ig[k][col]).sum::<f64>();
+                }
+            }
+            a_blocks[i] = ai;
+            d_blocks[i] = dp;
+            rho_eta[i] = rho[i] * eta * wscale;
+        }
+        jac.fill(&a_blocks, &d_blocks, &rho_eta);
+        for (di, fi) in d.iter_mut().zip(&f) {
+            *di = -fi;
+        }
+        if !jac.solve(n, &mut d) {
+            factor_failures += 1;
+            eta *= 10.0;
+            if eta > ETA_MAX || factor_failures > 50 {
+                stalled = true;
+            }
+            continue;
+        }
+        // backtracking on ||F||
+        let mut t = 1.0;
+        let mut accepted = false;
+        for _ in 0..=MAX_HALVINGS {
+            for k in 0..n {
+                r_try[k] = r[k] + t * d[k];
+            }
+            velocity(problem, &r_try, &mut u_try);
+            let phi_try = natural_map(dim, problem.mu, &rho, &r_try, &u_try, &mut f_try);
+            if phi_try <= (1.0 - 1e-4 * t) * phi {
+                phi = phi_try;
+                accepted = true;
+                break;
+            }
+            t *= 0.5;
+        }
+        if accepted {
+            std::mem::swap(&mut r, &mut r_try);
+            std::mem::swap(&mut f, &mut f_try);
+            measures = measure_into(problem, &r, &mut u);
+            if phi < 0.1 * phi_mark {
+                phi_mark = phi;
+                iter_mark = iterations;
+            }
+            if t == 1.0 {
+                eta = (eta * 0.1).max(ETA_MIN);
+            }
+        } else {
+            eta *= 10.0;
+            if eta > ETA_MAX {
+                stalled = true;
+            }
+        }
+    }
+
+    let (status, message) = if measures.error_q <= s.tol {
+        (
+            ContactStatus::Solved,
+            format!(
+                "solved in {iterations} Newton steps (error_q {:.2e}, error {:.2e})",
+                measures.error_q, measures.error
+            ),
+        )
+    } else if !measures.error_q.is_finite() || r.iter().any(|v| !v.is_finite()) {
+        (
+            ContactStatus::NumericalFailure,
+            format!("the iterates became non-finite after {iterations} Newton steps"),
+        )
+    } else if stalled {
+        (
+            ContactStatus::NumericalFailure,
+            format!(
+                "stalled after {iterations} Newton steps: no step decreases the natural-map \
+                 residual even with the proximal parameter at {eta:.1e} (error_q {:.2e} > tol \
+                 {:.1e})",
+                measures.error_q, s.tol
+            ),
+        )
+    } else {
+        (
+            ContactStatus::IterationLimit,
+            format!(
+                "stopped at max_iter = {} with error_q {:.2e} > tol {:.1e}",
+                s.max_iter, measures.error_q, s.tol
+            ),
+        )
+    };
+    Ok(ContactSolution {
+        impulse: r,
+        velocity: u,
+        status,
+        message,
+        iterations,
+        measures,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testing::SplitMix64;
+
+    #[test]
+    fn cone_jacobian_matches_finite_differences() {
+        let mut rng = SplitMix64::new(5);
+        for case in 0..400 {
+            let dim = 2 + case % 2;
+            let mu = [0.0, 0.3, 1.0, 2.5][case % 4];
+            let mut x = [0.0; 3];
+            for v in x.iter_mut().take(dim) {
+                *v = rng.normal();
+            }
+            let d = cone_projection_jacobian(&x[..dim], mu);
+            let h = 1e-7;
+            for c in 0..dim {
+                let mut xp = x;
+                let mut xm = x;
+                xp[c] += h;
+                xm[c] -= h;
+                project_cone(&mut xp[..dim], mu);
+                project_cone(&mut xm[..dim], mu);
+                for r in 0..dim {
+                    let fd = (xp[r] - xm[r]) / (2.0 * h);
+                    assert!(
+                        (fd - d[r][c]).abs() < 1e-6,
+                        "case {case} mu {mu} x {x:?}: D[{r}][{c}] = {} vs {fd}",
+                        d[r][c]
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn settings_are_checked() {
+        let w = [0.5, 0.0, 0.0, 0.5];
+        let q = [-3.0, 1.0];
+        let p = ContactProblem::new(2, &w, &q, &[0.2]).unwrap();
+        for s in [
+            ProxSettings {
+                tol: 0.0,
+                ..Default::default()
+            },
+            ProxSettings {
+                eta: f64::NAN,
+                ..Default::default()
+            },
+            ProxSettings {
+                max_iter: 0,
+                ..Default::default()
+            },
+        ] {
+            assert!(matches!(
+                solve_prox(&p, &s),
+                Err(CoulombError::InvalidParameter(_))
+            ));
+        }
+        let s = ProxSettings {
+            initial: Some(vec![1.0]),
+            ..Default::default()
+        };
+        assert!(matches!(solve_prox(&p, &s), Err(CoulombError::Shape(_))));
+    }
+}
