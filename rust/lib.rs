@@ -5,6 +5,8 @@
 //!
 //! - [`lcp`]: linear complementarity problems `0 <= z ⊥ M z + q >= 0` — Lemke's complementary
 //!   pivoting (the certified default), projected Gauss-Seidel, and complete enumeration.
+//! - [`step`]: the impulse time stepper (the seed's "One impulse-based time step") over
+//!   particles and rigid bodies with contact, friction and restitution.
 //! - [`io`]: readers for the standard benchmark formats (Siconos text files).
 //!
 //! The Python bindings (`coulomb._core`) live behind the `python` feature.
@@ -15,6 +17,7 @@ pub mod error;
 pub mod io;
 pub mod lcp;
 pub mod matrix;
+pub mod step;
 pub mod testing;
 
 #[cfg(feature = "python")]

@@ -1,0 +1,384 @@
+//! The impulse time stepper (DESIGN.md, part 3): the seed's "One impulse-based time step".
+//!
+//! Per step, with M and the contact Jacobians frozen at `q_k`:
+//!
+//! ```text
+//!     v_free  = v_k + h M^{-1} f_k
+//!     v_{k+1} = v_free + M^{-1} G P              (G = [J_n^T  J_t^T], P the contact impulses)
+//!     q_{k+1} = q_k + h v_{k+1}                  (orientations kept unit)
+//! ```
+//!
+//! The impulses solve the friction-contact problem over the frozen Delassus matrix
+//! `W = G^T M^{-1} G` (see [`crate::contact`]) with the free contact velocity
+//! `q_c = G^T v_free + (restitution or gap term)`, per contact:
+//!
+//! - a *closed* contact (`g <= gap_tolerance`) gets Newton's velocity-level restitution
+//!   condition `0 <= P_n ⊥ J_n v_{k+1} + e v_n^- >= 0` with `v_n^- = J_n v_k`, or the approach
+//!   velocity remembered from the step that closed it (below), whichever is more negative;
+//! - an *imminently closing* contact (`g > gap_tolerance`, but the free motion would close it
+//!   within the step) gets the gap term `0 <= P_n ⊥ J_n v_{k+1} + g / h >= 0`: the contact may
+//!   close during the step but not pass through, and nothing is applied unless it would. When
+//!   such a step does push (`P_n > 0`), its approach velocity `J_n v_k` is remembered, and the
+//!   next step, with the contact closed, applies restitution with it: the rebound is then
+//!   `-e v_n^-` wherever in the step the impact fell;
+//! - a contact that is far (neither of the above) carries no unknowns (seed: "A contact
+//!   search must first identify closed or imminently closing contacts").
+//!
+//! The friction law is Coulomb's with the exact disk (NSGS) or the polyhedral cone (Lemke), as
+//! [`crate::contact`] solves it. Frictionless contacts (`mu = 0`) get no tangential impulse.
+//!
+//! Bodies ([`BodyKind`]): particles (2D or 3D), planar rigid bodies `(x, y, theta)`, spatial
+//! rigid bodies (position, unit quaternion `(w, x, y, z)`; velocity: linear, then the angular
+//! velocity in the world frame; inertia given in the body frame). Shapes ([`Shape`]) are sets
+//! of body-frame points with a common radius: a point, a disk or sphere (one point), a segment's
+//! ends, a box's or polygon's corners. Pairs ([`Pair`]): shape vs a static half-space, and
+//! sphere vs sphere (every point of one shape against every point of the other).
+//!
+//! Drift: a velocity-level condition does not enforce `g(q_{k+1}) >= 0` exactly (seed,
+//! "Position drift and restitution"). Gaps are monitored in every step's record; no correction
+//! is applied.
+
+mod stepper;
+
+pub use stepper::{simulate, ContactRecord, StepRecord, Stepper, Trajectory};
+
+use crate::contact::{NsgsSettings, PolyhedralSettings};
+use crate::error::{check_finite, CoulombError, Result};
+
+/// What a body is, which fixes its coordinates q and velocities v.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BodyKind {
+    /// a point mass: q = v = position (dim entries).
+    Particle,
+    /// a planar rigid body (dim 2 only): q = (x, y, theta), v = (vx, vy, omega).
+    Planar,
+    /// a spatial rigid body (dim 3 only): q = (x, y, z, qw, qx, qy, qz) with a unit quaternion,
+    /// v = (vx, vy, vz, wx, wy, wz), the angular velocity in the world frame.
+    Spatial,
+}
+
+impl BodyKind {
+    /// the number of coordinates.
+    pub fn nq(self, dim: usize) -> usize {
+        match self {
+            BodyKind::Particle => dim,
+            BodyKind::Planar => 3,
+            BodyKind::Spatial => 7,
+        }
+    }
+
+    /// the number of velocities.
+    pub fn nv(self, dim: usize) -> usize {
+        match self {
+            BodyKind::Particle => dim,
+            BodyKind::Planar => 3,
+            BodyKind::Spatial => 6,
+        }
+    }
+}
+
+/// A body with its mass properties, initial state and constant external force.
+#[derive(Clone, Debug)]
+pub struct Body {
+    /// particle, planar or spatial rigid body.
+    pub kind: BodyKind,
+    /// mass (kg), `> 0`.
+    pub mass: f64,
+    /// central inertia: planar, `[J]` (kg m^2); spatial, the body-frame 3 x 3 tensor row-major
+    /// (symmetric positive definite); particle, empty.
+    pub inertia: Vec<f64>,
+    /// initial coordinates (`kind.nq(dim)` entries).
+    pub q0: Vec<f64>,
+    /// initial velocities (`kind.nv(dim)` entries).
+    pub v0: Vec<f64>,
+    /// a constant force at the centre of mass (N), `dim` entries (besides gravity).
+    pub force: Vec<f64>,
+}
+
+/// A set of body-frame points with a common radius: the contact features of one body.
+#[derive(Clone, Debug)]
+pub struct Shape {
+    /// the index of the body carrying it.
+    pub body: usize,
+    /// body-frame points (`dim` entries each): a point, a sphere's centre, a segment's ends,
+    /// a box's corners.
+    pub points: Vec<Vec<f64>>,
+    /// the radius around every point (m), `>= 0` (0 for points and corners).
+    pub radius: f64,
+}
+
+/// A static half-space `{ x : n . (x - p) <= 0 }`, its boundary a floor, plane or ramp.
+#[derive(Clone, Debug)]
+pub struct HalfSpace {
+    /// a point on the boundary (`dim` entries).
+    pub point: Vec<f64>,
+    /// the outward normal (`dim` entries, normalised on construction of the stepper).
+    pub normal: Vec<f64>,
+}
+
+/// Which features may touch, with their friction coefficient and Newton restitution.
+#[derive(Clone, Copy, Debug)]
+pub enum Pair {
+    /// every point of `shape` against `half_space`.
+    ShapeHalfSpace {
+        /// the shape's index.
+        shape: usize,
+        /// the half-space's index.
+        half_space: usize,
+        /// friction coefficient, `>= 0`.
+        mu: f64,
+        /// Newton restitution coefficient, in `[0, 1]`.
+        e: f64,
+    },
+    /// every point of shape a against every point of shape b (spheres; the shapes must be on
+    /// different bodies).
+    SphereSphere {
+        /// the first shape's index.
+        a: usize,
+        /// the second shape's index.
+        b: usize,
+        /// friction coefficient, `>= 0`.
+        mu: f64,
+        /// Newton restitution coefficient, in `[0, 1]`.
+        e: f64,
+    },
+}
+
+/// A scene: bodies, shapes, half-spaces and contact pairs in a planar (dim 2) or spatial
+/// (dim 3) world.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// 2 (planar: contacts have a normal and one tangent) or 3 (spatial: two tangents).
+    pub dim: usize,
+    /// gravitational acceleration (m/s^2), `dim` entries.
+    pub gravity: Vec<f64>,
+    /// the bodies.
+    pub bodies: Vec<Body>,
+    /// the shapes.
+    pub shapes: Vec<Shape>,
+    /// the static half-spaces.
+    pub half_spaces: Vec<HalfSpace>,
+    /// the pairs that may be in contact.
+    pub pairs: Vec<Pair>,
+}
+
+fn bad(msg: String) -> CoulombError {
+    CoulombError::InvalidParameter(msg)
+}
+
+fn check_len(name: &str, v: &[f64], n: usize) -> Result<()> {
+    if v.len() != n {
+        return Err(CoulombError::Shape(format!(
+            "{name} has {} entries, expected {n}",
+            v.len()
+        )));
+    }
+    check_finite(name, v)
+}
+
+impl Scene {
+    /// checks every shape, index and value before any work.
+    pub fn validate(&self) -> Result<()> {
+        let dim = self.dim;
+        if dim != 2 && dim != 3 {
+            return Err(bad(format!(
+                "dim must be 2 (planar) or 3 (spatial), got {dim}"
+            )));
+        }
+        check_len("gravity", &self.gravity, dim)?;
+        for (i, b) in self.bodies.iter().enumerate() {
+            match (b.kind, dim) {
+                (BodyKind::Planar, 3) => {
+                    return Err(bad(format!("body {i}: a planar rigid body needs dim = 2")))
+                }
+                (BodyKind::Spatial, 2) => {
+                    return Err(bad(format!("body {i}: a spatial rigid body needs dim = 3")))
+                }
+                _ => {}
+            }
+            if !(b.mass.is_finite() && b.mass > 0.0) {
+                return Err(bad(format!(
+                    "body {i}: mass must be finite and > 0, got {}",
+                    b.mass
+                )));
+            }
+            check_len(&format!("body {i} q0"), &b.q0, b.kind.nq(dim))?;
+            check_len(&format!("body {i} v0"), &b.v0, b.kind.nv(dim))?;
+            check_len(&format!("body {i} force"), &b.force, dim)?;
+            match b.kind {
+                BodyKind::Particle => {}
+                BodyKind::Planar => {
+                    check_len(&format!("body {i} inertia"), &b.inertia, 1)?;
+                    if b.inertia[0] <= 0.0 {
+                        return Err(bad(format!(
+                            "body {i}: inertia must be > 0, got {}",
+                            b.inertia[0]
+                        )));
+                    }
+                }
+                BodyKind::Spatial => {
+                    check_len(&format!("body {i} inertia"), &b.inertia, 9)?;
+                    let j = &b.inertia;
+                    let asym = (j[1] - j[3])
+                        .abs()
+                        .max((j[2] - j[6]).abs())
+                        .max((j[5] - j[7]).abs());
+                    let scale = j.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                    if asym > 1e-12 * scale {
+                        return Err(bad(format!("body {i}: inertia must be symmetric")));
+                    }
+                    // Sylvester's criterion
+                    let d1 = j[0];
+                    let d2 = j[0] * j[4] - j[1] * j[3];
+                    let d3 = det3(j);
+                    if !(d1 > 0.0 && d2 > 0.0 && d3 > 0.0) {
+                        return Err(bad(format!("body {i}: inertia must be positive definite")));
+                    }
+                    let qn = b.q0[3..7].iter().map(|v| v * v).sum::<f64>().sqrt();
+                    if (qn - 1.0).abs() > 1e-6 {
+                        return Err(bad(format!(
+                            "body {i}: the orientation quaternion must be unit, has norm {qn}"
+                        )));
+                    }
+                }
+            }
+        }
+        for (i, s) in self.shapes.iter().enumerate() {
+            if s.body >= self.bodies.len() {
+                return Err(bad(format!(
+                    "shape {i}: body index {} out of range ({} bodies)",
+                    s.body,
+                    self.bodies.len()
+                )));
+            }
+            if !(s.radius.is_finite() && s.radius >= 0.0) {
+                return Err(bad(format!(
+                    "shape {i}: radius must be finite and >= 0, got {}",
+                    s.radius
+                )));
+            }
+            if s.points.is_empty() {
+                return Err(bad(format!("shape {i} has no points")));
+            }
+            for p in &s.points {
+                check_len(&format!("shape {i} point"), p, dim)?;
+            }
+        }
+        for (i, h) in self.half_spaces.iter().enumerate() {
+            check_len(&format!("half-space {i} point"), &h.point, dim)?;
+            check_len(&format!("half-space {i} normal"), &h.normal, dim)?;
+            let n = h.normal.iter().map(|v| v * v).sum::<f64>().sqrt();
+            if n == 0.0 {
+                return Err(bad(format!("half-space {i}: the normal is zero")));
+            }
+        }
+        for (i, p) in self.pairs.iter().enumerate() {
+            let (mu, e) = match *p {
+                Pair::ShapeHalfSpace {
+                    shape,
+                    half_space,
+                    mu,
+                    e,
+                } => {
+                    if shape >= self.shapes.len() || half_space >= self.half_spaces.len() {
+                        return Err(bad(format!("pair {i}: index out of range")));
+                    }
+                    (mu, e)
+                }
+                Pair::SphereSphere { a, b, mu, e } => {
+                    if a >= self.shapes.len() || b >= self.shapes.len() {
+                        return Err(bad(format!("pair {i}: index out of range")));
+                    }
+                    if self.shapes[a].body == self.shapes[b].body {
+                        return Err(bad(format!(
+                            "pair {i}: both shapes are on body {}",
+                            self.shapes[a].body
+                        )));
+                    }
+                    (mu, e)
+                }
+            };
+            if !(mu.is_finite() && mu >= 0.0) {
+                return Err(bad(format!(
+                    "pair {i}: mu must be finite and >= 0, got {mu}"
+                )));
+            }
+            if !(0.0..=1.0).contains(&e) {
+                return Err(bad(format!("pair {i}: e must be in [0, 1], got {e}")));
+            }
+        }
+        Ok(())
+    }
+
+    /// the total number of coordinates.
+    pub fn nq(&self) -> usize {
+        self.bodies.iter().map(|b| b.kind.nq(self.dim)).sum()
+    }
+
+    /// the total number of velocities.
+    pub fn nv(&self) -> usize {
+        self.bodies.iter().map(|b| b.kind.nv(self.dim)).sum()
+    }
+}
+
+pub(crate) fn det3(j: &[f64]) -> f64 {
+    j[0] * (j[4] * j[8] - j[5] * j[7]) - j[1] * (j[3] * j[8] - j[5] * j[6])
+        + j[2] * (j[3] * j[7] - j[4] * j[6])
+}
+
+/// The contact solver of every step.
+#[derive(Clone, Debug)]
+pub enum StepSolver {
+    /// nonsmooth Gauss-Seidel on the exact friction disk.
+    Nsgs(NsgsSettings),
+    /// the polyhedral-cone LCP by Lemke's method.
+    Lemke(PolyhedralSettings),
+}
+
+/// Settings of [`simulate`].
+#[derive(Clone, Debug)]
+pub struct StepSettings {
+    /// the time step h (s), `> 0`.
+    pub h: f64,
+    /// the number of steps.
+    pub steps: usize,
+    /// the contact solver and its options.
+    pub solver: StepSolver,
+    /// a contact with gap at most this (m) is closed; above it, it is open (imminent or far).
+    pub gap_tolerance: f64,
+    /// start each contact solve from the previous step's impulses of the same contacts.
+    pub warm_start: bool,
+}
+
+impl StepSettings {
+    /// NSGS with tolerance 1e-12, gap tolerance 1e-9 m, warm start.
+    pub fn new(h: f64, steps: usize) -> Self {
+        Self {
+            h,
+            steps,
+            solver: StepSolver::Nsgs(NsgsSettings {
+                tol: 1e-12,
+                ..NsgsSettings::default()
+            }),
+            gap_tolerance: 1e-9,
+            warm_start: true,
+        }
+    }
+
+    /// checks h and the tolerances before any work.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.h.is_finite() && self.h > 0.0) {
+            return Err(bad(format!(
+                "the time step h must be finite and > 0, got {}",
+                self.h
+            )));
+        }
+        if !(self.gap_tolerance.is_finite() && self.gap_tolerance >= 0.0) {
+            return Err(bad(format!(
+                "gap_tolerance must be finite and >= 0, got {}",
+                self.gap_tolerance
+            )));
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,1007 @@
+//! The time-stepping loop: contact search, Delassus assembly, contact solve, update, checks.
+
+// index loops mirror the equations (a: velocity component, j: contact-frame component)
+#![allow(clippy::needless_range_loop)]
+
+use super::{det3, BodyKind, Pair, Scene, StepSettings, StepSolver};
+use crate::contact::{
+    measure, solve_nsgs, solve_polyhedral, ContactMeasures, ContactProblem, ContactSolution,
+    ContactStatus, NsgsSettings,
+};
+use crate::error::Result;
+
+/// below this a norm counts as zero when forming a relative residual.
+const TINY: f64 = 1e-300;
+
+/// The checks of one step k -> k+1 (the seed's "Time-step accuracy and validation" list).
+#[derive(Clone, Debug)]
+pub struct StepRecord {
+    /// active contacts (closed or imminently closing) that carried unknowns.
+    pub active: usize,
+    /// the contact solver's status; `None` when no contact was active.
+    pub status: Option<ContactStatus>,
+    /// the contact solver's error (natural-map residual, relative); 0 without contacts.
+    pub error: f64,
+    /// the contact solver's sweeps or pivots.
+    pub iterations: usize,
+    /// `||M (v_{k+1} - v_free) - G P|| / ||G P||` (the absolute norm when `G P = 0`).
+    pub momentum_residual: f64,
+    /// `min_i P_{n,i}` over the active contacts (0 without contacts).
+    pub min_normal_impulse: f64,
+    /// `max_i max(||P_{t,i}|| - mu_i P_{n,i}, 0)`.
+    pub cone_violation: f64,
+    /// `max_i |P_{n,i} (J_n v_{k+1} + e v_n^- or gap term)_i|`, the complementarity product.
+    pub complementarity: f64,
+    /// a closed contact used the approach velocity remembered from the step that closed it
+    /// (that step stopped the approach with the gap term; this one gives the rebound back), so
+    /// energy is judged across the two steps.
+    pub resumed: bool,
+}
+
+/// One active contact in one step.
+#[derive(Clone, Copy, Debug)]
+pub struct ContactRecord {
+    /// the step k (the impulse acts between `t_k` and `t_{k+1}`).
+    pub step: usize,
+    /// the contact's identity: the index of its candidate (pair, feature), stable over steps.
+    pub id: usize,
+    /// the impulse, normal first then tangents (N s), `dim` used entries.
+    pub impulse: [f64; 3],
+    /// the contact velocity `J v_{k+1}` in the contact frame (m/s), `dim` used entries.
+    pub velocity: [f64; 3],
+    /// the normal approach velocity used by the step: `v_n^-` (closed) or `J_n v_k` (open).
+    pub approach: f64,
+    /// the gap at `q_k` (m).
+    pub gap: f64,
+    /// whether the contact was closed (`gap <= gap_tolerance`) rather than imminent.
+    pub closed: bool,
+}
+
+/// The result of [`simulate`]: states at `t_0 .. t_N`, the checks of every step and the
+/// impulse of every active contact.
+#[derive(Clone, Debug)]
+pub struct Trajectory {
+    /// the contact dimension.
+    pub dim: usize,
+    /// coordinates per state.
+    pub nq: usize,
+    /// velocities per state.
+    pub nv: usize,
+    /// the times, `N + 1`.
+    pub t: Vec<f64>,
+    /// the coordinates, `(N + 1) nq` row-major.
+    pub q: Vec<f64>,
+    /// the velocities, `(N + 1) nv` row-major.
+    pub v: Vec<f64>,
+    /// kinetic energy per state (J).
+    pub kinetic_energy: Vec<f64>,
+    /// potential energy of gravity and the constant forces per state, `-Σ (m g + F) . x` (J).
+    pub potential_energy: Vec<f64>,
+    /// the smallest gap over every candidate contact, per state (`+inf` without candidates).
+    pub min_gap: Vec<f64>,
+    /// how many candidate contacts have a gap below `-gap_tolerance`, per state.
+    pub negative_gaps: Vec<usize>,
+    /// the checks of every step, `N`.
+    pub steps: Vec<StepRecord>,
+    /// every active contact of every step.
+    pub contacts: Vec<ContactRecord>,
+    /// `None` when all steps ran; otherwise why the run stopped early.
+    pub stopped: Option<String>,
+}
+
+/// A contact candidate: a pair of features that may touch.
+#[derive(Clone, Copy, Debug)]
+struct Candidate {
+    /// body a and its body-frame point and radius.
+    a: (usize, [f64; 3], f64),
+    /// body b (sphere vs sphere) or `None` (a static half-space).
+    b: Option<(usize, [f64; 3], f64)>,
+    /// the half-space (point, unit normal) when `b` is `None`.
+    plane: ([f64; 3], [f64; 3]),
+    mu: f64,
+    e: f64,
+}
+
+/// Per-body constants.
+#[derive(Clone, Debug)]
+struct BodyInfo {
+    kind: BodyKind,
+    off_q: usize,
+    off_v: usize,
+    nv: usize,
+    mass: f64,
+    /// body-frame inertia (spatial) or `[J, ..]` (planar), row-major 3 x 3.
+    inertia: [f64; 9],
+    inertia_inv: [f64; 9],
+    /// m g + F.
+    load: [f64; 3],
+}
+
+/// Per-body quantities frozen at `q_k`.
+#[derive(Clone, Copy, Debug)]
+struct Frozen {
+    /// rotation body -> world, row-major.
+    rot: [f64; 9],
+    /// M and M^{-1}, `nv x nv` row-major in a 6 x 6 array.
+    m: [f64; 36],
+    minv: [f64; 36],
+}
+
+impl Default for Frozen {
+    fn default() -> Self {
+        Self {
+            rot: [0.0; 9],
+            m: [0.0; 36],
+            minv: [0.0; 36],
+        }
+    }
+}
+
+/// One side of an active contact: the body, its G block and `M^{-1} G`.
+#[derive(Clone, Copy, Debug, Default)]
+struct Side {
+    body: usize,
+    /// G block, `nv x dim`, entry (a, j) at `a * 3 + j`.
+    g: [f64; 18],
+    /// `M^{-1}` times the G block, same layout.
+    b: [f64; 18],
+}
+
+#[derive(Clone, Copy, Debug, Default)]
+struct Active {
+    cand: usize,
+    gap: f64,
+    closed: bool,
+    vn_k: f64,
+    approach: f64,
+    sides: [Side; 2],
+    nsides: usize,
+}
+
+/// The geometry of a candidate at the current state.
+#[derive(Clone, Copy, Debug)]
+struct Geometry {
+    gap: f64,
+    normal: [f64; 3],
+    /// (body, sign, world offset of the contact point from the body's centre).
+    sides: [(usize, f64, [f64; 3]); 2],
+    nsides: usize,
+}
+
+/// The stepper: a scene's state and the workspaces reused by every step.
+pub struct Stepper {
+    dim: usize,
+    settings: StepSettings,
+    bodies: Vec<BodyInfo>,
+    candidates: Vec<Candidate>,
+    nq: usize,
+    nv: usize,
+    /// the current time, coordinates and velocities.
+    pub t: f64,
+    /// the coordinates `q_k`.
+    pub q: Vec<f64>,
+    /// the velocities `v_k`.
+    pub v: Vec<f64>,
+    step_index: usize,
+    frozen: Vec<Frozen>,
+    v_free: Vec<f64>,
+    active: Vec<Active>,
+    w: Vec<f64>,
+    qc: Vec<f64>,
+    mu: Vec<f64>,
+    /// the last impulse of every candidate (`dim` each), for warm starts.
+    warm: Vec<f64>,
+    /// the approach velocity remembered when an open contact pushed (<= 0), per candidate.
+    approach: Vec<f64>,
+    gp: Vec<f64>,
+    v_next: Vec<f64>,
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn mat3_vec(r: &[f64; 9], x: [f64; 3]) -> [f64; 3] {
+    [
+        r[0] * x[0] + r[1] * x[1] + r[2] * x[2],
+        r[3] * x[0] + r[4] * x[1] + r[5] * x[2],
+        r[6] * x[0] + r[7] * x[1] + r[8] * x[2],
+    ]
+}
+
+/// `R A R^T` for 3 x 3 row-major matrices.
+fn congruence(r: &[f64; 9], a: &[f64; 9]) -> [f64; 9] {
+    let mut ra = [0.0; 9];
+    for i in 0..3 {
+        for j in 0..3 {
+            ra[i * 3 + j] = (0..3).map(|k| r[i * 3 + k] * a[k * 3 + j]).sum();
+        }
+    }
+    let mut out = [0.0; 9];
+    for i in 0..3 {
+        for j in 0..3 {
+            out[i * 3 + j] = (0..3).map(|k| ra[i * 3 + k] * r[j * 3 + k]).sum();
+        }
+    }
+    out
+}
+
+fn inverse3(j: &[f64; 9]) -> [f64; 9] {
+    let d = det3(j);
+    [
+        (j[4] * j[8] - j[5] * j[7]) / d,
+        (j[2] * j[7] - j[1] * j[8]) / d,
+        (j[1] * j[5] - j[2] * j[4]) / d,
+        (j[5] * j[6] - j[3] * j[8]) / d,
+        (j[0] * j[8] - j[2] * j[6]) / d,
+        (j[2] * j[3] - j[0] * j[5]) / d,
+        (j[3] * j[7] - j[4] * j[6]) / d,
+        (j[1] * j[6] - j[0] * j[7]) / d,
+        (j[0] * j[4] - j[1] * j[3]) / d,
+    ]
+}
+
+/// the rotation matrix of a unit quaternion `(w, x, y, z)`.
+fn quat_to_rot(q: &[f64]) -> [f64; 9] {
+    let (w, x, y, z) = (q[0], q[1], q[2], q[3]);
+    [
+        1.0 - 2.0 * (y * y + z * z),
+        2.0 * (x * y - w * z),
+        2.0 * (x * z + w * y),
+        2.0 * (x * y + w * z),
+        1.0 - 2.0 * (x * x + z * z),
+        2.0 * (y * z - w * x),
+        2.0 * (x * z - w * y),
+        2.0 * (y * z + w * x),
+        1.0 - 2.0 * (x * x + y * y),
+    ]
+}
+
+/// An orthonormal contact frame, normal first: in 2D the tangent is the normal turned by
+/// -90 degrees (a floor's tangent is +x); in 3D the branch-free basis of Duff et al. (2017),
+/// continuous away from `n_z = -1`.
+fn frame(dim: usize, n: [f64; 3]) -> [[f64; 3]; 3] {
+    if dim == 2 {
+        return [n, [n[1], -n[0], 0.0], [0.0; 3]];
+    }
+    let s = 1f64.copysign(n[2]);
+    let a = -1.0 / (s + n[2]);
+    let b = n[0] * n[1] * a;
+    [
+        n,
+        [1.0 + s * n[0] * n[0] * a, s * b, -s * n[0]],
+        [b, s + n[1] * n[1] * a, -n[1]],
+    ]
+}
+
+impl Stepper {
+    /// Checks the scene and settings, and sizes every workspace.
+    pub fn new(scene: &Scene, settings: &StepSettings) -> Result<Self> {
+        scene.validate()?;
+        settings.validate()?;
+        let dim = scene.dim;
+        let mut bodies = Vec::with_capacity(scene.bodies.len());
+        let (mut off_q, mut off_v) = (0, 0);
+        let mut q = Vec::with_capacity(scene.nq());
+        let mut v = Vec::with_capacity(scene.nv());
+        for b in &scene.bodies {
+            let mut inertia = [0.0; 9];
+            let mut inertia_inv = [0.0; 9];
+            match b.kind {
+                BodyKind::Particle => {}
+                BodyKind::Planar => {
+                    inertia[0] = b.inertia[0];
+                    inertia_inv[0] = 1.0 / b.inertia[0];
+                }
+                BodyKind::Spatial => {
+                    inertia.copy_from_slice(&b.inertia);
+                    inertia_inv = inverse3(&inertia);
+                }
+            }
+            let mut load = [0.0; 3];
+            for k in 0..dim {
+                load[k] = b.mass * scene.gravity[k] + b.force[k];
+            }
+            let nv = b.kind.nv(dim);
+            bodies.push(BodyInfo {
+                kind: b.kind,
+                off_q,
+                off_v,
+                nv,
+                mass: b.mass,
+                inertia,
+                inertia_inv,
+                load,
+            });
+            q.extend_from_slice(&b.q0);
+            v.extend_from_slice(&b.v0);
+            if b.kind == BodyKind::Spatial {
+                let n = q[off_q + 3..off_q + 7]
+                    .iter()
+                    .map(|x| x * x)
+                    .sum::<f64>()
+                    .sqrt();
+                for x in &mut q[off_q + 3..off_q + 7] {
+                    *x /= n;
+                }
+            }
+            off_q += b.kind.nq(dim);
+            off_v += nv;
+        }
+        let pad = |p: &[f64]| {
+            let mut out = [0.0; 3];
+            out[..p.len()].copy_from_slice(p);
+            out
+        };
+        let mut candidates = Vec::new();
+        for pair in &scene.pairs {
+            match *pair {
+                Pair::ShapeHalfSpace {
+                    shape,
+                    half_space,
+                    mu,
+                    e,
+                } => {
+                    let s = &scene.shapes[shape];
+                    let hs = &scene.half_spaces[half_space];
+                    let mut n = pad(&hs.normal);
+                    let nn = dot(n, n).sqrt();
+                    for x in &mut n {
+                        *x /= nn;
+                    }
+                    for p in &s.points {
+                        candidates.push(Candidate {
+                            a: (s.body, pad(p), s.radius),
+                            b: None,
+                            plane: (pad(&hs.point), n),
+                            mu,
+                            e,
+                        });
+                    }
+                }
+                Pair::SphereSphere { a, b, mu, e } => {
+                    let (sa, sb) = (&scene.shapes[a], &scene.shapes[b]);
+                    for pa in &sa.points {
+                        for pb in &sb.points {
+                            candidates.push(Candidate {
+                                a: (sa.body, pad(pa), sa.radius),
+                                b: Some((sb.body, pad(pb), sb.radius)),
+                                plane: ([0.0; 3], [0.0; 3]),
+                                mu,
+                                e,
+                            });
+                        }
+                    }
+                }
+            }
+        }
+        let nc = candidates.len();
+        Ok(Self {
+            dim,
+            settings: settings.clone(),
+            frozen: vec![Frozen::default(); bodies.len()],
+            bodies,
+            nq: off_q,
+            nv: off_v,
+            t: 0.0,
+            v_free: vec![0.0; off_v],
+            gp: vec![0.0; off_v],
+            v_next: vec![0.0; off_v],
+            q,
+            v,
+            step_index: 0,
+            active: Vec::with_capacity(nc),
+            w: Vec::new(),
+            qc: Vec::new(),
+            mu: Vec::new(),
+            warm: vec![0.0; nc * dim],
+            approach: vec![0.0; nc],
+            candidates,
+        })
+    }
+
+    /// the number of candidate contacts (pairs of features that may touch).
+    pub fn candidates(&self) -> usize {
+        self.candidates.len()
+    }
+
+    /// M, M^{-1} and the rotation of every body at the current q.
+    fn freeze(&mut self) {
+        for (bi, b) in self.bodies.iter().enumerate() {
+            let f = &mut self.frozen[bi];
+            *f = Frozen::default();
+            let nv = b.nv;
+            match b.kind {
+                BodyKind::Particle => {
+                    f.rot = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0];
+                    for a in 0..nv {
+                        f.m[a * 6 + a] = b.mass;
+                        f.minv[a * 6 + a] = 1.0 / b.mass;
+                    }
+                }
+                BodyKind::Planar => {
+                    let th = self.q[b.off_q + 2];
+                    let (s, c) = th.sin_cos();
+                    f.rot = [c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0];
+                    for a in 0..2 {
+                        f.m[a * 6 + a] = b.mass;
+                        f.minv[a * 6 + a] = 1.0 / b.mass;
+                    }
+                    f.m[2 * 6 + 2] = b.inertia[0];
+                    f.minv[2 * 6 + 2] = b.inertia_inv[0];
+                }
+                BodyKind::Spatial => {
+                    f.rot = quat_to_rot(&self.q[b.off_q + 3..b.off_q + 7]);
+                    let iw = congruence(&f.rot, &b.inertia);
+                    let iwinv = congruence(&f.rot, &b.inertia_inv);
+                    for a in 0..3 {
+                        f.m[a * 6 + a] = b.mass;
+                        f.minv[a * 6 + a] = 1.0 / b.mass;
+                        for c in 0..3 {
+                            f.m[(3 + a) * 6 + 3 + c] = iw[a * 3 + c];
+                            f.minv[(3 + a) * 6 + 3 + c] = iwinv[a * 3 + c];
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// `v_free = v_k + h M^{-1} f_k`, f the loads and, for spatial bodies, the gyroscopic
+    /// term `-ω × (I ω)`.
+    fn free_velocity(&mut self) {
+        let h = self.settings.h;
+        let dim = self.dim;
+        for (bi, b) in self.bodies.iter().enumerate() {
+            let f = &self.frozen[bi];
+            let v = &self.v[b.off_v..b.off_v + b.nv];
+            let vf = &mut self.v_free[b.off_v..b.off_v + b.nv];
+            vf.copy_from_slice(v);
+            for k in 0..dim {
+                vf[k] += h * b.load[k] / b.mass;
+            }
+            if b.kind == BodyKind::Spatial {
+                let w = [v[3], v[4], v[5]];
+                let mut iw = [0.0; 3];
+                for (a, x) in iw.iter_mut().enumerate() {
+                    *x = (0..3).map(|c| f.m[(3 + a) * 6 + 3 + c] * w[c]).sum();
+                }
+                let tau = cross(w, iw);
+                for a in 0..3 {
+                    let dw: f64 = (0..3).map(|c| f.minv[(3 + a) * 6 + 3 + c] * tau[c]).sum();
+                    vf[3 + a] -= h * dw;
+                }
+            }
+        }
+    }
+
+    /// the world position of a body's centre and of a body-frame point.
+    fn world_point(&self, body: usize, p: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+        let b = &self.bodies[body];
+        let q = &self.q[b.off_q..];
+        let mut x = [0.0; 3];
+        match b.kind {
+            BodyKind::Particle => x[..self.dim].copy_from_slice(&q[..self.dim]),
+            BodyKind::Planar => x[..2].copy_from_slice(&q[..2]),
+            BodyKind::Spatial => x.copy_from_slice(&q[..3]),
+        }
+        let r = match b.kind {
+            BodyKind::Particle => p,
+            _ => mat3_vec(&self.frozen[body].rot, p),
+        };
+        (x, [x[0] + r[0], x[1] + r[1], x[2] + r[2]])
+    }
+
+    /// the gap, normal and contact points of candidate c at the current q (bodies frozen).
+    fn geometry(&self, c: usize) -> Geometry {
+        let cand = &self.candidates[c];
+        let (ba, pa, ra) = cand.a;
+        let (xa, wa) = self.world_point(ba, pa);
+        match cand.b {
+            None => {
+                let (p0, n) = cand.plane;
+                let d = [wa[0] - p0[0], wa[1] - p0[1], wa[2] - p0[2]];
+                let gap = dot(n, d) - ra;
+                let cp = [wa[0] - ra * n[0], wa[1] - ra * n[1], wa[2] - ra * n[2]];
+                let r = [cp[0] - xa[0], cp[1] - xa[1], cp[2] - xa[2]];
+                Geometry {
+                    gap,
+                    normal: n,
+                    sides: [(ba, 1.0, r), (0, 0.0, [0.0; 3])],
+                    nsides: 1,
+                }
+            }
+            Some((bb, pb, rb)) => {
+                let (xb, wb) = self.world_point(bb, pb);
+                let d = [wa[0] - wb[0], wa[1] - wb[1], wa[2] - wb[2]];
+                let dist = dot(d, d).sqrt();
+                let n = if dist > 0.0 {
+                    [d[0] / dist, d[1] / dist, d[2] / dist]
+                } else if self.dim == 2 {
+                    [0.0, 1.0, 0.0]
+                } else {
+                    [0.0, 0.0, 1.0]
+                };
+                let ca = [wa[0] - ra * n[0], wa[1] - ra * n[1], wa[2] - ra * n[2]];
+                let cb = [wb[0] + rb * n[0], wb[1] + rb * n[1], wb[2] + rb * n[2]];
+                Geometry {
+                    gap: dist - ra - rb,
+                    normal: n,
+                    sides: [
+                        (ba, 1.0, [ca[0] - xa[0], ca[1] - xa[1], ca[2] - xa[2]]),
+                        (bb, -1.0, [cb[0] - xb[0], cb[1] - xb[1], cb[2] - xb[2]]),
+                    ],
+                    nsides: 2,
+                }
+            }
+        }
+    }
+
+    /// the generalized direction of a world direction d applied at world offset r of a body:
+    /// the column of `J^T` (linear part d, angular part `r × d`).
+    fn column(&self, body: usize, r: [f64; 3], d: [f64; 3]) -> [f64; 6] {
+        let mut out = [0.0; 6];
+        match self.bodies[body].kind {
+            BodyKind::Particle => out[..3].copy_from_slice(&d),
+            BodyKind::Planar => {
+                out[0] = d[0];
+                out[1] = d[1];
+                out[2] = r[0] * d[1] - r[1] * d[0];
+            }
+            BodyKind::Spatial => {
+                out[..3].copy_from_slice(&d);
+                out[3..].copy_from_slice(&cross(r, d));
+            }
+        }
+        out
+    }
+
+    /// `J_n v` of a geometry for a velocity vector.
+    fn normal_velocity(&self, g: &Geometry, v: &[f64]) -> f64 {
+        let mut s = 0.0;
+        for &(body, sign, r) in &g.sides[..g.nsides] {
+            let col = self.column(body, r, g.normal);
+            let b = &self.bodies[body];
+            s += sign * (0..b.nv).map(|a| col[a] * v[b.off_v + a]).sum::<f64>();
+        }
+        s
+    }
+
+    /// min gap over all candidates and the number below `-gap_tolerance` at the current q
+    /// (bodies must be frozen at it).
+    fn gap_summary(&self) -> (f64, usize) {
+        let mut min_gap = f64::INFINITY;
+        let mut negative = 0;
+        for c in 0..self.candidates.len() {
+            let g = self.geometry(c).gap;
+            min_gap = min_gap.min(g);
+            if g < -self.settings.gap_tolerance {
+                negative += 1;
+            }
+        }
+        (min_gap, negative)
+    }
+
+    /// kinetic and potential energy at the current state (bodies frozen at it).
+    fn energies(&self) -> (f64, f64) {
+        let (mut t, mut v) = (0.0, 0.0);
+        for (bi, b) in self.bodies.iter().enumerate() {
+            let m = &self.frozen[bi].m;
+            let vel = &self.v[b.off_v..b.off_v + b.nv];
+            for a in 0..b.nv {
+                for c in 0..b.nv {
+                    t += 0.5 * vel[a] * m[a * 6 + c] * vel[c];
+                }
+            }
+            for k in 0..self.dim {
+                v -= b.load[k] * self.q[b.off_q + k];
+            }
+        }
+        (t, v)
+    }
+
+    /// The seed's "One impulse-based time step", from `(t_k, q_k, v_k)` to
+    /// `(t_{k+1}, q_{k+1}, v_{k+1})`; appends the active contacts to `contacts` and returns the
+    /// step's checks. Errors only for settings the contact solver refuses.
+    pub fn step(&mut self, contacts: &mut Vec<ContactRecord>) -> Result<StepRecord> {
+        let h = self.settings.h;
+        let dim = self.dim;
+        let tol_gap = self.settings.gap_tolerance;
+        self.freeze();
+        self.free_velocity();
+
+        // contact search: closed or imminently closing contacts only
+        self.active.clear();
+        for c in 0..self.candidates.len() {
+            let geo = self.geometry(c);
+            let vn_k = self.normal_velocity(&geo, &self.v);
+            let vn_free = self.normal_velocity(&geo, &self.v_free);
+            let closing = (-vn_k).max(-vn_free).max(0.0);
+            if geo.gap > tol_gap + 2.0 * h * closing {
+                self.approach[c] = 0.0;
+                for x in &mut self.warm[c * dim..(c + 1) * dim] {
+                    *x = 0.0;
+                }
+                continue;
+            }
+            let fr = frame(dim, geo.normal);
+            let mut act = Active {
+                cand: c,
+                gap: geo.gap,
+                closed: geo.gap <= tol_gap,
+                vn_k,
+                nsides: geo.nsides,
+                ..Active::default()
+            };
+            for s in 0..geo.nsides {
+                let (body, sign, r) = geo.sides[s];
+                let side = &mut act.sides[s];
+                side.body = body;
+                let nv = self.bodies[body].nv;
+                for (j, d) in fr.iter().enumerate().take(dim) {
+                    let col = self.column(body, r, *d);
+                    for a in 0..nv {
+                        side.g[a * 3 + j] = sign * col[a];
+                    }
+                }
+                let minv = &self.frozen[body].minv;
+                for a in 0..nv {
+                    for j in 0..dim {
+                        side.b[a * 3 + j] =
+                            (0..nv).map(|k| minv[a * 6 + k] * side.g[k * 3 + j]).sum();
+                    }
+                }
+            }
+            self.active.push(act);
+        }
+
+        let nc = self.active.len();
+        let n = nc * dim;
+        let mut record = StepRecord {
+            active: nc,
+            status: None,
+            error: 0.0,
+            iterations: 0,
+            momentum_residual: 0.0,
+            min_normal_impulse: 0.0,
+            cone_violation: 0.0,
+            complementarity: 0.0,
+            resumed: false,
+        };
+        for x in &mut self.gp {
+            *x = 0.0;
+        }
+        let mut v_next = std::mem::take(&mut self.v_next);
+        v_next.copy_from_slice(&self.v_free);
+        let mut solution: Option<ContactSolution> = None;
+        if nc > 0 {
+            // W = G^T M^{-1} G, block (i, j) summed over the bodies both contacts touch
+            self.w.clear();
+            self.w.resize(n * n, 0.0);
+            self.qc.clear();
+            self.qc.resize(n, 0.0);
+            self.mu.clear();
+            for i in 0..nc {
+                let ai = self.active[i];
+                let cand = self.candidates[ai.cand];
+                self.mu.push(cand.mu);
+                for j in 0..nc {
+                    let aj = &self.active[j];
+                    for si in &ai.sides[..ai.nsides] {
+                        for sj in &aj.sides[..aj.nsides] {
+                            if si.body != sj.body {
+                                continue;
+                            }
+                            let nv = self.bodies[si.body].nv;
+                            for al in 0..dim {
+                                for be in 0..dim {
+                                    let s: f64 =
+                                        (0..nv).map(|a| si.g[a * 3 + al] * sj.b[a * 3 + be]).sum();
+                                    self.w[(i * dim + al) * n + j * dim + be] += s;
+                                }
+                            }
+                        }
+                    }
+                }
+                // q_c = G^T v_free, then the normal's restitution or gap term
+                for si in &ai.sides[..ai.nsides] {
+                    let b = &self.bodies[si.body];
+                    for al in 0..dim {
+                        self.qc[i * dim + al] += (0..b.nv)
+                            .map(|a| si.g[a * 3 + al] * self.v_free[b.off_v + a])
+                            .sum::<f64>();
+                    }
+                }
+                let bound = if ai.closed {
+                    // Newton: 0 <= P_n ⊥ J_n v_{k+1} + e v_n^- >= 0
+                    let vminus = ai.vn_k.min(self.approach[ai.cand]).min(0.0);
+                    if self.approach[ai.cand] < ai.vn_k.min(0.0) {
+                        record.resumed = true;
+                    }
+                    self.active[i].approach = vminus;
+                    cand.e * vminus
+                } else {
+                    // imminent: 0 <= P_n ⊥ J_n v_{k+1} + g / h >= 0
+                    self.active[i].approach = ai.vn_k;
+                    ai.gap / h
+                };
+                self.qc[i * dim] += bound;
+            }
+            let problem = ContactProblem::new(dim, &self.w, &self.qc, &self.mu)?;
+            // r = 0 solves the problem exactly when no contact's normal would close
+            // (u = q, u_n >= 0, and 0 lies in every cone): no solve needed
+            let separating = (0..nc).all(|i| self.qc[i * dim] >= 0.0);
+            let sol = if separating {
+                let r = vec![0.0; n];
+                let (velocity, measures) = measure(&problem, &r)?;
+                ContactSolution {
+                    impulse: r,
+                    velocity,
+                    status: ContactStatus::Solved,
+                    message: "no contact closes: zero impulses".into(),
+                    iterations: 0,
+                    measures: ContactMeasures {
+                        error: 0.0,
+                        error_q: 0.0,
+                        ..measures
+                    },
+                }
+            } else {
+                match &self.settings.solver {
+                    StepSolver::Nsgs(s) => {
+                        let initial = if self.settings.warm_start {
+                            let mut init = vec![0.0; n];
+                            for (i, a) in self.active.iter().enumerate() {
+                                init[i * dim..(i + 1) * dim]
+                                    .copy_from_slice(&self.warm[a.cand * dim..(a.cand + 1) * dim]);
+                            }
+                            Some(init)
+                        } else {
+                            None
+                        };
+                        let settings = NsgsSettings {
+                            initial,
+                            ..s.clone()
+                        };
+                        solve_nsgs(&problem, &settings)?
+                    }
+                    StepSolver::Lemke(s) => solve_polyhedral(&problem, s)?,
+                }
+            };
+            record.status = Some(sol.status);
+            record.error = sol.measures.error;
+            record.iterations = sol.iterations;
+            record.min_normal_impulse = sol.measures.min_normal_impulse;
+            record.cone_violation = sol.measures.cone_violation;
+            record.complementarity = sol.measures.max_complementarity;
+            // v_{k+1} = v_free + M^{-1} G P
+            for (i, a) in self.active.iter().enumerate() {
+                let p = &sol.impulse[i * dim..(i + 1) * dim];
+                for s in &a.sides[..a.nsides] {
+                    let b = &self.bodies[s.body];
+                    for k in 0..b.nv {
+                        let mut dv = 0.0;
+                        let mut g = 0.0;
+                        for j in 0..dim {
+                            dv += s.b[k * 3 + j] * p[j];
+                            g += s.g[k * 3 + j] * p[j];
+                        }
+                        v_next[b.off_v + k] += dv;
+                        self.gp[b.off_v + k] += g;
+                    }
+                }
+            }
+            solution = Some(sol);
+        }
+
+        // momentum balance: ||M (v_{k+1} - v_free) - G P|| / ||G P||
+        let (mut res2, mut gp2) = (0.0, 0.0);
+        for (bi, b) in self.bodies.iter().enumerate() {
+            let m = &self.frozen[bi].m;
+            for a in 0..b.nv {
+                let mdv: f64 = (0..b.nv)
+                    .map(|c| m[a * 6 + c] * (v_next[b.off_v + c] - self.v_free[b.off_v + c]))
+                    .sum();
+                let r = mdv - self.gp[b.off_v + a];
+                res2 += r * r;
+                gp2 += self.gp[b.off_v + a] * self.gp[b.off_v + a];
+            }
+        }
+        record.momentum_residual = if gp2.sqrt() > TINY {
+            (res2 / gp2).sqrt()
+        } else {
+            res2.sqrt()
+        };
+
+        // remember impulses and approach velocities by contact identity; record contacts
+        if let Some(sol) = &solution {
+            for (i, a) in self.active.iter().enumerate() {
+                let p = &sol.impulse[i * dim..(i + 1) * dim];
+                self.warm[a.cand * dim..(a.cand + 1) * dim].copy_from_slice(p);
+                if a.closed {
+                    self.approach[a.cand] = 0.0;
+                } else if p[0] > 0.0 && a.vn_k < 0.0 {
+                    self.approach[a.cand] = self.approach[a.cand].min(a.vn_k);
+                }
+                let mut impulse = [0.0; 3];
+                impulse[..dim].copy_from_slice(p);
+                let mut velocity = [0.0; 3];
+                for s in &a.sides[..a.nsides] {
+                    let b = &self.bodies[s.body];
+                    for (j, vj) in velocity.iter_mut().enumerate().take(dim) {
+                        *vj += (0..b.nv)
+                            .map(|k| s.g[k * 3 + j] * v_next[b.off_v + k])
+                            .sum::<f64>();
+                    }
+                }
+                contacts.push(ContactRecord {
+                    step: self.step_index,
+                    id: a.cand,
+                    impulse,
+                    velocity,
+                    approach: a.approach,
+                    gap: a.gap,
+                    closed: a.closed,
+                });
+            }
+        }
+
+        // q_{k+1} = q_k + h v_{k+1}, orientations kept unit
+        self.v.copy_from_slice(&v_next);
+        self.v_next = v_next;
+        for b in &self.bodies {
+            let q = &mut self.q[b.off_q..];
+            let v = &self.v[b.off_v..b.off_v + b.nv];
+            match b.kind {
+                BodyKind::Particle | BodyKind::Planar => {
+                    for k in 0..b.nv {
+                        q[k] += h * v[k];
+                    }
+                }
+                BodyKind::Spatial => {
+                    for k in 0..3 {
+                        q[k] += h * v[k];
+                    }
+                    // q <- exp(h ω / 2) ⊗ q: the exact rotation by the world-frame h ω
+                    let w = [v[3], v[4], v[5]];
+                    let angle = dot(w, w).sqrt() * h;
+                    if angle > 0.0 {
+                        let (s, c) = (0.5 * angle).sin_cos();
+                        let k = s / (angle / h);
+                        let d = [c, k * w[0], k * w[1], k * w[2]];
+                        let o = [q[3], q[4], q[5], q[6]];
+                        let dv = [d[1], d[2], d[3]];
+                        let ov = [o[1], o[2], o[3]];
+                        let cr = cross(dv, ov);
+                        let nw = d[0] * o[0] - dot(dv, ov);
+                        let mut nq = [
+                            nw,
+                            d[0] * ov[0] + o[0] * dv[0] + cr[0],
+                            d[0] * ov[1] + o[0] * dv[1] + cr[1],
+                            d[0] * ov[2] + o[0] * dv[2] + cr[2],
+                        ];
+                        let norm = nq.iter().map(|x| x * x).sum::<f64>().sqrt();
+                        for x in &mut nq {
+                            *x /= norm;
+                        }
+                        q[3..7].copy_from_slice(&nq);
+                    }
+                }
+            }
+        }
+        self.step_index += 1;
+        self.t = self.step_index as f64 * h;
+        Ok(record)
+    }
+
+    fn push_state(&mut self, out: &mut Trajectory) {
+        self.freeze();
+        out.t.push(self.t);
+        out.q.extend_from_slice(&self.q);
+        out.v.extend_from_slice(&self.v);
+        let (t, v) = self.energies();
+        out.kinetic_energy.push(t);
+        out.potential_energy.push(v);
+        let (g, neg) = self.gap_summary();
+        out.min_gap.push(g);
+        out.negative_gaps.push(neg);
+    }
+}
+
+/// Runs `settings.steps` steps of the impulse time stepper on `scene` from its initial state.
+/// A step whose impulses or velocities are not finite stops the run (`stopped` says why);
+/// a contact solve that misses its tolerance is recorded in its step's status and the run goes
+/// on with the best impulses found.
+pub fn simulate(scene: &Scene, settings: &StepSettings) -> Result<Trajectory> {
+    let mut st = Stepper::new(scene, settings)?;
+    let steps = settings.steps;
+    let mut out = Trajectory {
+        dim: st.dim,
+        nq: st.nq,
+        nv: st.nv,
+        t: Vec::with_capacity(steps + 1),
+        q: Vec::with_capacity((steps + 1) * st.nq),
+        v: Vec::with_capacity((steps + 1) * st.nv),
+        kinetic_energy: Vec::with_capacity(steps + 1),
+        potential_energy: Vec::with_capacity(steps + 1),
+        min_gap: Vec::with_capacity(steps + 1),
+        negative_gaps: Vec::with_capacity(steps + 1),
+        steps: Vec::with_capacity(steps),
+        contacts: Vec::new(),
+        stopped: None,
+    };
+    st.push_state(&mut out);
+    for k in 0..steps {
+        let rec = st.step(&mut out.contacts)?;
+        out.steps.push(rec);
+        let finite = st.v.iter().chain(st.q.iter()).all(|x| x.is_finite());
+        if !finite {
+            out.stopped = Some(format!(
+                "step {k} produced a non-finite state (contact solver: {})",
+                out.steps[k].status.map_or("no contacts", |s| s.as_str())
+            ));
+            out.steps.pop();
+            out.contacts.retain(|c| c.step < k);
+            break;
+        }
+        st.push_state(&mut out);
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frames_are_orthonormal() {
+        for n in [
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, -1.0],
+            [0.6, 0.0, 0.8],
+            [0.36, 0.48, -0.8],
+        ] {
+            let f = frame(3, n);
+            for i in 0..3 {
+                for j in 0..3 {
+                    let d = dot(f[i], f[j]);
+                    let want = if i == j { 1.0 } else { 0.0 };
+                    assert!((d - want).abs() < 1e-15, "{n:?} {i} {j} {d}");
+                }
+            }
+            // right-handed: t1 x t2 = n
+            let c = cross(f[1], f[2]);
+            for k in 0..3 {
+                assert!((c[k] - n[k]).abs() < 1e-15);
+            }
+        }
+        assert_eq!(frame(2, [0.0, 1.0, 0.0])[1], [1.0, 0.0, 0.0]);
+    }
+
+    #[test]
+    fn quaternion_rotation_and_inverse() {
+        let h = std::f64::consts::FRAC_1_SQRT_2;
+        let r = quat_to_rot(&[h, 0.0, 0.0, h]); // 90 degrees about z
+        let x = mat3_vec(&r, [1.0, 0.0, 0.0]);
+        assert!((x[0]).abs() < 1e-15 && (x[1] - 1.0).abs() < 1e-15);
+        let j = [2.0, 0.1, 0.0, 0.1, 3.0, 0.2, 0.0, 0.2, 4.0];
+        let ji = inverse3(&j);
+        let id = congruence(&[1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0], &ji);
+        for a in 0..3 {
+            let row: Vec<f64> = (0..3)
+                .map(|c| (0..3).map(|k| j[a * 3 + k] * id[k * 3 + c]).sum())
+                .collect();
+            for (c, v) in row.iter().enumerate() {
+                assert!((v - if a == c { 1.0 } else { 0.0 }).abs() < 1e-14);
+            }
+        }
+    }
+}

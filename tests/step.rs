@@ -1,0 +1,484 @@
+//! Integration tests of the impulse time stepper against the seed's figures: free flight,
+//! a resting block, the ramp (stop and stick), the floor impact (Newton restitution wherever
+//! in the step the impact falls), the oblique inelastic impact, a bouncing ball, a box with
+//! four redundant corner contacts, and Painleve's rod.
+
+use coulomb::contact::{ContactStatus, PolyhedralSettings};
+use coulomb::step::{
+    simulate, Body, BodyKind, HalfSpace, Pair, Scene, Shape, StepSettings, StepSolver, Trajectory,
+};
+
+const G: f64 = 9.81;
+
+fn particle(dim: usize, mass: f64, q0: &[f64], v0: &[f64]) -> Body {
+    Body {
+        kind: BodyKind::Particle,
+        mass,
+        inertia: vec![],
+        q0: q0.to_vec(),
+        v0: v0.to_vec(),
+        force: vec![0.0; dim],
+    }
+}
+
+/// one body with one point shape against one half-space.
+fn point_on_plane(
+    dim: usize,
+    body: Body,
+    gravity: &[f64],
+    normal: &[f64],
+    mu: f64,
+    e: f64,
+) -> Scene {
+    Scene {
+        dim,
+        gravity: gravity.to_vec(),
+        bodies: vec![body],
+        shapes: vec![Shape {
+            body: 0,
+            points: vec![vec![0.0; dim]],
+            radius: 0.0,
+        }],
+        half_spaces: vec![HalfSpace {
+            point: vec![0.0; dim],
+            normal: normal.to_vec(),
+        }],
+        pairs: vec![Pair::ShapeHalfSpace {
+            shape: 0,
+            half_space: 0,
+            mu,
+            e,
+        }],
+    }
+}
+
+fn run(scene: &Scene, h: f64, t_end: f64) -> Trajectory {
+    let steps = (t_end / h).round() as usize;
+    let tr = simulate(scene, &StepSettings::new(h, steps)).expect("valid scene");
+    assert!(tr.stopped.is_none(), "{:?}", tr.stopped);
+    tr
+}
+
+fn q_at(tr: &Trajectory, k: usize) -> &[f64] {
+    &tr.q[k * tr.nq..(k + 1) * tr.nq]
+}
+
+fn v_at(tr: &Trajectory, k: usize) -> &[f64] {
+    &tr.v[k * tr.nv..(k + 1) * tr.nv]
+}
+
+fn every_step_solved(tr: &Trajectory) {
+    for (k, s) in tr.steps.iter().enumerate() {
+        if let Some(st) = s.status {
+            assert_eq!(st, ContactStatus::Solved, "step {k}: {s:?}");
+        }
+        assert!(s.momentum_residual < 1e-12, "step {k}: {s:?}");
+        assert!(s.min_normal_impulse >= 0.0, "step {k}: {s:?}");
+        assert!(s.cone_violation < 1e-12, "step {k}: {s:?}");
+    }
+}
+
+/// Free flight is the exact discrete parabola of q_{k+1} = q_k + h v_{k+1}:
+/// `v_k = v_0 + k h g`, `x_k = x_0 + k h v_0 + h^2 g k (k + 1) / 2`.
+#[test]
+fn free_flight_is_the_exact_discrete_parabola() {
+    let h = 1e-3;
+    let body = particle(2, 1.5, &[0.0, 10.0], &[2.0, 5.0]);
+    let scene = point_on_plane(2, body, &[0.0, -G], &[0.0, 1.0], 0.5, 0.5);
+    let tr = run(&scene, h, 1.0);
+    for k in [1usize, 10, 500, 1000] {
+        let kf = k as f64;
+        let x = 2.0 * kf * h;
+        let y = 10.0 + 5.0 * kf * h - G * h * h * kf * (kf + 1.0) / 2.0;
+        let q = q_at(&tr, k);
+        assert!((q[0] - x).abs() < 1e-12 * (1.0 + x.abs()), "{k}");
+        assert!((q[1] - y).abs() < 1e-12 * 10.0, "{k}: {} vs {y}", q[1]);
+        assert!((v_at(&tr, k)[1] - (5.0 - kf * h * G)).abs() < 1e-12);
+        assert_eq!(
+            tr.steps[k - 1].active,
+            0,
+            "the far floor carries no unknowns"
+        );
+    }
+    // and the energy drops by exactly m g^2 h^2 / 2 per step
+    for k in 0..tr.steps.len() {
+        let e0 = tr.kinetic_energy[k] + tr.potential_energy[k];
+        let e1 = tr.kinetic_energy[k + 1] + tr.potential_energy[k + 1];
+        assert!((e1 - e0 + 0.5 * 1.5 * G * G * h * h).abs() < 1e-10);
+    }
+}
+
+/// A block at rest on a floor stays put to 1e-12 m over 10 s.
+#[test]
+fn resting_block_stays_put() {
+    let body = particle(2, 1.0, &[0.3, 0.0], &[0.0, 0.0]);
+    let scene = point_on_plane(2, body, &[0.0, -G], &[0.0, 1.0], 0.5, 0.5);
+    let tr = run(&scene, 1e-3, 10.0);
+    every_step_solved(&tr);
+    let n = tr.t.len() - 1;
+    for k in 0..=n {
+        let q = q_at(&tr, k);
+        assert!(
+            (q[0] - 0.3).abs() < 1e-12 && q[1].abs() < 1e-12,
+            "{k}: {q:?}"
+        );
+    }
+    // the impulse holds gravity exactly: P_n = m g h
+    let last = tr.contacts.last().expect("a closed contact");
+    assert!((last.impulse[0] - G * 1e-3).abs() < 1e-14);
+}
+
+/// the ramp of the seed: theta = 20 deg, descending toward +x.
+fn ramp(mu: f64) -> Scene {
+    let th = 20f64.to_radians();
+    let (s, c) = th.sin_cos();
+    let body = particle(2, 1.0, &[0.0, 0.0], &[c, -s]);
+    point_on_plane(2, body, &[0.0, -G], &[s, c], mu, 0.0)
+}
+
+fn downhill(q: &[f64]) -> f64 {
+    let th = 20f64.to_radians();
+    q[0] * th.cos() - q[1] * th.sin()
+}
+
+/// (t_stop, s_stop) and the largest motion after the stop through the end.
+fn ramp_stop(h: f64) -> (f64, f64, f64) {
+    let tr = run(&ramp(0.4), h, 10.0);
+    every_step_solved(&tr);
+    let k = (0..tr.t.len())
+        .find(|&k| v_at(&tr, k).iter().all(|x| x.abs() < 1e-12))
+        .expect("the block stops");
+    let s_stop = downhill(q_at(&tr, k));
+    let mut creep: f64 = 0.0;
+    for j in k..tr.t.len() {
+        let q = q_at(&tr, j);
+        let q0 = q_at(&tr, k);
+        creep = creep.max((q[0] - q0[0]).hypot(q[1] - q0[1]));
+    }
+    (tr.t[k], s_stop, creep)
+}
+
+/// Ramp: deceleration 0.3321 m/s^2 while sliding, stop at t = 3.011 s after s = 1.505 m
+/// within O(h) (pinned by two step sizes), then no motion to 1e-9 m through t = 10 s.
+#[test]
+fn ramp_block_decelerates_stops_and_sticks() {
+    let th = 20f64.to_radians();
+    let a = G * (th.sin() - 0.4 * th.cos());
+    assert!((a + 0.3321).abs() < 5e-5);
+    let t_star = 1.0 / -a;
+    let s_star = 0.5 / -a;
+    assert!((t_star - 3.011).abs() < 5e-4 && (s_star - 1.505).abs() < 5e-4);
+
+    // the sliding deceleration, step by step
+    let tr = run(&ramp(0.4), 1e-3, 1.0);
+    for k in 0..1000 {
+        let dv = downhill(v_at(&tr, k + 1)) - downhill(v_at(&tr, k));
+        assert!((dv / 1e-3 - a).abs() < 1e-9, "{k}: {}", dv / 1e-3);
+        // no lift-off: the normal velocity stays zero
+        let v = v_at(&tr, k + 1);
+        assert!((v[0] * th.sin() + v[1] * th.cos()).abs() < 1e-12);
+    }
+
+    let (t1, s1, creep1) = ramp_stop(1e-2);
+    let (t2, s2, creep2) = ramp_stop(1e-3);
+    assert!(t1 >= t_star && t1 - t_star < 1e-2, "{t1}");
+    assert!(t2 >= t_star && t2 - t_star < 1e-3, "{t2}");
+    let (e1, e2) = ((s1 - s_star).abs(), (s2 - s_star).abs());
+    assert!(e1 < 1e-2 && e2 < 1e-3, "{e1} {e2}");
+    // first order: ten times smaller step, about ten times smaller error
+    assert!(e1 / e2 > 5.0 && e1 / e2 < 20.0, "{e1} {e2}");
+    assert!(creep1 < 1e-9 && creep2 < 1e-9, "{creep1} {creep2}");
+}
+
+/// With mu = 0.3 < tan 20 deg the block never sticks: it speeds up at
+/// g (sin 20 - 0.3 cos 20) all along.
+#[test]
+fn ramp_block_with_mu_0_3_never_sticks() {
+    let th = 20f64.to_radians();
+    let a = G * (th.sin() - 0.3 * th.cos());
+    let tr = run(&ramp(0.3), 1e-3, 10.0);
+    every_step_solved(&tr);
+    for k in 0..tr.steps.len() {
+        let dv = downhill(v_at(&tr, k + 1)) - downhill(v_at(&tr, k));
+        assert!((dv / 1e-3 - a).abs() < 1e-8, "{k}");
+    }
+    assert!((downhill(v_at(&tr, 10_000)) - (1.0 + 10.0 * a)).abs() < 1e-9);
+}
+
+/// Floor impact (m = 0.5, e = 0.6): the rebound is -e times the approach speed, the impulse
+/// m (1 + e) |v| and the loss (1 - e^2) T, at several speeds and step sizes, wherever in the
+/// step the impact falls (no gravity, so the figures are exact).
+#[test]
+fn floor_impact_rebounds_with_e_wherever_the_impact_falls() {
+    let (m, e) = (0.5, 0.6);
+    for speed in [3.0, 0.5, 12.0] {
+        for h in [1e-3, 1e-2, 2.5e-4] {
+            for frac in [0.0, 0.25, 0.5, 0.999] {
+                let z0 = frac * speed * h;
+                let body = particle(2, m, &[0.0, z0], &[0.0, -speed]);
+                let scene = point_on_plane(2, body, &[0.0, 0.0], &[0.0, 1.0], 0.0, e);
+                let tr = run(&scene, h, 5.0 * h);
+                every_step_solved(&tr);
+                let vn = v_at(&tr, 5)[1];
+                assert!(
+                    (vn - e * speed).abs() < 1e-12 * speed,
+                    "{speed} {h} {frac}: {vn}"
+                );
+                let p: f64 = tr.contacts.iter().map(|c| c.impulse[0]).sum();
+                assert!((p - m * (1.0 + e) * speed).abs() < 1e-12 * speed);
+                let loss = tr.kinetic_energy[0] - tr.kinetic_energy[5];
+                let want = 0.5 * m * speed * speed * (1.0 - e * e);
+                assert!((loss - want).abs() < 1e-12 * want.max(1.0));
+                // the floor is never crossed
+                assert!(tr.min_gap.iter().all(|&g| g > -1e-12), "{:?}", tr.min_gap);
+                if speed == 3.0 {
+                    assert!((vn - 1.8).abs() < 1e-12 && (p - 2.4).abs() < 1e-12);
+                    assert!((loss - 1.44).abs() < 1e-12);
+                }
+            }
+        }
+    }
+}
+
+/// With gravity the rebound is -e times the normal velocity at the start of the step in which
+/// the ball reaches the floor.
+#[test]
+fn floor_impact_with_gravity() {
+    let (m, e, h) = (0.5, 0.6, 1e-3);
+    let body = particle(2, m, &[0.0, 0.00137], &[0.0, -3.0]);
+    let scene = point_on_plane(2, body, &[0.0, -G], &[0.0, 1.0], 0.0, e);
+    let tr = run(&scene, h, 0.01);
+    every_step_solved(&tr);
+    let first = tr.contacts[0];
+    assert!(!first.closed);
+    let closed = tr.contacts.iter().find(|c| c.closed).expect("closes");
+    assert_eq!(closed.approach, first.approach);
+    assert!((closed.velocity[0] + e * first.approach).abs() < 1e-12);
+    assert!((first.approach + 3.0).abs() < 0.01);
+}
+
+/// The seed's oblique inelastic impact: m = 2, e = 0, v = (1, -3), mu = 0.2 gives
+/// v_t^+ = 0.4, v_n^+ = 0, P_n = 6, P_t = -1.2; afterwards, under gravity, no lift-off.
+#[test]
+fn oblique_inelastic_impact_slides_on_without_lift_off() {
+    for frac in [0.0, 0.4] {
+        let h = 1e-3;
+        let body = particle(2, 2.0, &[0.0, frac * 3.0 * h], &[1.0, -3.0]);
+        let scene = point_on_plane(2, body, &[0.0, 0.0], &[0.0, 1.0], 0.2, 0.0);
+        let tr = run(&scene, h, 3.0 * h);
+        every_step_solved(&tr);
+        let v = v_at(&tr, 3);
+        assert!((v[0] - 0.4).abs() < 1e-12 && v[1].abs() < 1e-12, "{v:?}");
+        let pn: f64 = tr.contacts.iter().map(|c| c.impulse[0]).sum();
+        let pt: f64 = tr.contacts.iter().map(|c| c.impulse[1]).sum();
+        assert!((pn - 6.0).abs() < 1e-12 && (pt + 1.2).abs() < 1e-12);
+        assert!((tr.kinetic_energy[3] - 0.16).abs() < 1e-12);
+    }
+    // with gravity: slides, decelerating at mu g, never leaves the floor
+    let h = 1e-3;
+    let body = particle(2, 2.0, &[0.0, 0.0], &[1.0, -3.0]);
+    let scene = point_on_plane(2, body, &[0.0, -G], &[0.0, 1.0], 0.2, 0.0);
+    let tr = run(&scene, h, 0.5);
+    every_step_solved(&tr);
+    for k in 1..tr.t.len() {
+        let (q, v) = (q_at(&tr, k), v_at(&tr, k));
+        assert!(q[1].abs() < 1e-12 && v[1].abs() < 1e-12, "{k}: {q:?} {v:?}");
+    }
+}
+
+/// heights of the apexes (local maxima of y) of a trajectory of a 2D particle.
+fn apexes(tr: &Trajectory) -> Vec<f64> {
+    let n = tr.t.len();
+    (1..n - 1)
+        .filter(|&k| {
+            let (a, b, c) = (q_at(tr, k - 1)[1], q_at(tr, k)[1], q_at(tr, k + 1)[1]);
+            b > a && b >= c
+        })
+        .map(|k| q_at(tr, k)[1])
+        .collect()
+}
+
+/// A bouncing ball: successive apex heights fall by e^2 (to O(h)).
+#[test]
+fn bouncing_ball_apexes_fall_by_e_squared() {
+    let e = 0.8;
+    let mut errs = vec![];
+    for h in [1e-3, 1e-4] {
+        let body = particle(2, 1.0, &[0.0, 1.0], &[0.0, 0.0]);
+        let scene = point_on_plane(2, body, &[0.0, -G], &[0.0, 1.0], 0.0, e);
+        let tr = run(&scene, h, 3.0);
+        every_step_solved(&tr);
+        let ap = apexes(&tr);
+        assert!(ap.len() >= 3, "{ap:?}");
+        let mut worst: f64 = 0.0;
+        for w in ap.windows(2).take(3) {
+            worst = worst.max((w[1] / w[0] - e * e).abs());
+        }
+        errs.push(worst);
+        // energy never increases; across an impact (the step that closes the contact and
+        // the one that gives the rebound back) up to the O(h) work of gravity
+        for k in 0..tr.steps.len() {
+            let e = |j: usize| tr.kinetic_energy[j] + tr.potential_energy[j];
+            if tr.steps[k].resumed {
+                let work = (tr.potential_energy[k + 1] - tr.potential_energy[k - 1]).abs();
+                assert!(e(k + 1) <= e(k - 1) + work + 1e-12, "{k}");
+            } else {
+                assert!(e(k + 1) <= e(k) + 1e-12, "{k}");
+            }
+        }
+    }
+    assert!(errs[0] < 2e-2 && errs[1] < 2e-3, "{errs:?}");
+}
+
+fn cube_scene(mu: f64) -> Scene {
+    let a = 0.5;
+    let mut corners = vec![];
+    for sx in [-a, a] {
+        for sy in [-a, a] {
+            for sz in [-a, a] {
+                corners.push(vec![sx, sy, sz]);
+            }
+        }
+    }
+    let m = 2.0;
+    let i = m * (2.0 * a) * (2.0 * a) / 6.0;
+    Scene {
+        dim: 3,
+        gravity: vec![0.0, 0.0, -G],
+        bodies: vec![Body {
+            kind: BodyKind::Spatial,
+            mass: m,
+            inertia: vec![i, 0.0, 0.0, 0.0, i, 0.0, 0.0, 0.0, i],
+            q0: vec![0.1, -0.2, a, 1.0, 0.0, 0.0, 0.0],
+            v0: vec![0.0; 6],
+            force: vec![0.0; 3],
+        }],
+        shapes: vec![Shape {
+            body: 0,
+            points: corners,
+            radius: 0.0,
+        }],
+        half_spaces: vec![HalfSpace {
+            point: vec![0.0; 3],
+            normal: vec![0.0, 0.0, 1.0],
+        }],
+        pairs: vec![Pair::ShapeHalfSpace {
+            shape: 0,
+            half_space: 0,
+            mu,
+            e: 0.0,
+        }],
+    }
+}
+
+/// A box on a plane with four redundant corner contacts rests without drift or jitter, with
+/// both contact solvers.
+#[test]
+fn resting_box_with_four_redundant_corners() {
+    let scene = cube_scene(0.5);
+    for solver in [
+        StepSettings::new(1e-3, 2000).solver,
+        StepSolver::Lemke(PolyhedralSettings::for_dim(3)),
+    ] {
+        let settings = StepSettings {
+            solver,
+            ..StepSettings::new(1e-3, 2000)
+        };
+        let tr = simulate(&scene, &settings).expect("valid");
+        assert!(tr.stopped.is_none());
+        for s in &tr.steps {
+            assert_eq!(s.active, 4);
+            assert_eq!(s.status, Some(ContactStatus::Solved), "{s:?}");
+        }
+        let q0 = q_at(&tr, 0).to_vec();
+        let (mut dq, mut dv) = (0.0f64, 0.0f64);
+        for k in 0..tr.t.len() {
+            for (a, b) in q_at(&tr, k).iter().zip(&q0) {
+                dq = dq.max((a - b).abs());
+            }
+            dv = v_at(&tr, k).iter().fold(dv, |m, x| m.max(x.abs()));
+        }
+        // NSGS (tol 1e-12): 2e-15 m and 2e-14 m/s; Lemke (its default tol 1e-9): 5e-13 m and
+        // 5e-12 m/s
+        assert!(dq < 1e-12 && dv < 1e-11, "{dq:e} {dv:e}");
+    }
+}
+
+/// Painleve's rod (m = 1, l = 1, J = 1/12, mu = 2, theta = 45 deg), the lower end on the floor
+/// sliding left at 1 m/s: no smooth sliding mode exists (A = -0.5, b = -9.81); the impulse step
+/// jams the end within one step by a tangential impulse, energy never increases, and the jam
+/// impulse converges as h -> 0 (to P_n = 0.375, P_t = 0.625 N s from the contact-space 2x2
+/// system with W = [[2.5, -1.5], [-1.5, 2.5]]).
+#[test]
+fn painleve_rod_jams_within_one_step() {
+    let th = 45f64.to_radians();
+    let (m, l, j, mu) = (1.0, 1.0, 1.0 / 12.0, 2.0);
+    let mut first = vec![];
+    for h in [1e-2, 1e-3, 1e-4] {
+        let y = 0.5 * l * th.sin();
+        let scene = Scene {
+            dim: 2,
+            gravity: vec![0.0, -G],
+            bodies: vec![Body {
+                kind: BodyKind::Planar,
+                mass: m,
+                inertia: vec![j],
+                q0: vec![0.0, y, th],
+                v0: vec![-1.0, 0.0, 0.0],
+                force: vec![0.0; 2],
+            }],
+            shapes: vec![Shape {
+                body: 0,
+                points: vec![vec![-0.5 * l, 0.0], vec![0.5 * l, 0.0]],
+                radius: 0.0,
+            }],
+            half_spaces: vec![HalfSpace {
+                point: vec![0.0, 0.0],
+                normal: vec![0.0, 1.0],
+            }],
+            pairs: vec![Pair::ShapeHalfSpace {
+                shape: 0,
+                half_space: 0,
+                mu,
+                e: 0.0,
+            }],
+        };
+        let tr = run(&scene, h, 0.05);
+        every_step_solved(&tr);
+        let c = tr.contacts[0];
+        assert_eq!((c.step, c.id), (0, 0));
+        assert!(c.velocity[1].abs() < 1e-10, "slides on: {c:?}");
+        first.push(c.impulse);
+        for k in 0..tr.steps.len() {
+            let e0 = tr.kinetic_energy[k] + tr.potential_energy[k];
+            let e1 = tr.kinetic_energy[k + 1] + tr.potential_energy[k + 1];
+            assert!(e1 <= e0 + 1e-12, "{h} {k}: {e0} -> {e1}");
+        }
+    }
+    let d1 = (first[0][0] - 0.375).abs().max((first[0][1] - 0.625).abs());
+    let d2 = (first[1][0] - 0.375).abs().max((first[1][1] - 0.625).abs());
+    let d3 = (first[2][0] - 0.375).abs().max((first[2][1] - 0.625).abs());
+    assert!(d1 > d2 && d2 > d3 && d3 < 1e-3, "{first:?}");
+}
+
+/// Bad input is refused before any work.
+#[test]
+fn bad_scenes_are_refused() {
+    let good = ramp(0.4);
+    let mut s = good.clone();
+    s.bodies[0].mass = 0.0;
+    assert!(simulate(&s, &StepSettings::new(1e-3, 1)).is_err());
+    let mut s = good.clone();
+    s.pairs[0] = Pair::ShapeHalfSpace {
+        shape: 0,
+        half_space: 0,
+        mu: 0.4,
+        e: 1.5,
+    };
+    assert!(simulate(&s, &StepSettings::new(1e-3, 1)).is_err());
+    let mut s = good.clone();
+    s.bodies[0].q0[0] = f64::NAN;
+    assert!(simulate(&s, &StepSettings::new(1e-3, 1)).is_err());
+    assert!(simulate(&good, &StepSettings::new(0.0, 1)).is_err());
+    assert!(simulate(&good, &StepSettings::new(-1e-3, 1)).is_err());
+}
