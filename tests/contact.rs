@@ -3,13 +3,14 @@
 //! problem with every check, and bad input.
 
 use coulomb::contact::{
-    measure, solve_nsgs, ContactProblem, ContactSolution, ContactStatus, NsgsSettings,
+    measure, solve_nsgs, BlockCsr, ContactProblem, ContactSolution, ContactStatus, NsgsSettings,
 };
 use coulomb::testing::SplitMix64;
 use coulomb::CoulombError;
 
 mod common;
 use common::{cube_g, delassus, post_velocity};
+mod pile;
 
 fn nsgs(dim: usize, w: &[f64], q: &[f64], mu: &[f64], s: &NsgsSettings) -> ContactSolution {
     let p = ContactProblem::new(dim, w, q, mu).expect("well-formed test problem");
@@ -392,4 +393,147 @@ fn no_contacts_is_trivially_solved() {
     let s = nsgs(3, &[], &[], &[], &NsgsSettings::default());
     assert!(s.success());
     assert!(s.impulse.is_empty());
+}
+
+// --- block-sparse storage ----------------------------------------------------------------
+
+fn nsgs_sparse(w: &BlockCsr, q: &[f64], mu: &[f64], s: &NsgsSettings) -> ContactSolution {
+    let p = ContactProblem::with_block_sparse(w, q, mu).expect("well-formed test problem");
+    solve_nsgs(&p, s).expect("valid settings")
+}
+
+fn assert_same(a: &ContactSolution, b: &ContactSolution) {
+    assert_eq!(a.impulse, b.impulse);
+    assert_eq!(a.velocity, b.velocity);
+    assert_eq!(a.iterations, b.iterations);
+    assert_eq!(a.status, b.status);
+    assert_eq!(a.measures, b.measures);
+}
+
+#[test]
+fn block_sparse_and_dense_storage_give_identical_answers() {
+    // a dense W (every tile nonzero), 3D and 2D
+    let (w, q) = random_problem(10, 42);
+    let mu = vec![0.5; 10];
+    let sparse = BlockCsr::from_dense(3, 30, &w).unwrap();
+    assert_eq!(sparse.nnz_blocks(), 100);
+    let s = NsgsSettings::default();
+    let a = nsgs(3, &w, &q, &mu, &s);
+    assert!(a.success(), "{}", a.message);
+    assert_same(&a, &nsgs_sparse(&sparse, &q, &mu, &s));
+    // a pile: a few tiles per block row
+    let p = pile::pile(60, 0.4, 7);
+    let sparse = BlockCsr::from_coo(3, p.n, &p.rows, &p.cols, &p.vals).unwrap();
+    assert!(
+        sparse.nnz_blocks() < 60 * 12,
+        "{} tiles",
+        sparse.nnz_blocks()
+    );
+    let dense = sparse.to_dense();
+    let s = NsgsSettings {
+        max_iter: 3000,
+        ..Default::default()
+    };
+    let a = nsgs(3, &dense, &p.q, &p.mu, &s);
+    assert!(a.success(), "{}", a.message);
+    println!("pile nc = 60: {}", a.message);
+    assert_same(&a, &nsgs_sparse(&sparse, &p.q, &p.mu, &s));
+    // 2D with an over-relaxation and a warm start
+    let mut rng = SplitMix64::new(3);
+    let (ndof, nc) = (12, 10);
+    let g: Vec<f64> = (0..ndof * 2 * nc)
+        .map(|_| {
+            if rng.uniform() < 0.3 {
+                rng.normal()
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let v_free: Vec<f64> = (0..ndof).map(|_| rng.normal()).collect();
+    let (w, mut q) = delassus(&g, ndof, &vec![1.0; ndof], &v_free);
+    for i in 0..nc {
+        q[2 * i] -= 1.0;
+    }
+    let sparse = BlockCsr::from_dense(2, 2 * nc, &w).unwrap();
+    let s = NsgsSettings {
+        relaxation: 1.2,
+        initial: Some(vec![0.1; 2 * nc]),
+        ..Default::default()
+    };
+    let mu = vec![0.3; nc];
+    assert_same(
+        &nsgs(2, &w, &q, &mu, &s),
+        &nsgs_sparse(&sparse, &q, &mu, &s),
+    );
+}
+
+#[test]
+fn accessors_agree_between_storages() {
+    let p = pile::pile(25, 0.4, 11);
+    let sparse = BlockCsr::from_coo(3, p.n, &p.rows, &p.cols, &p.vals).unwrap();
+    let dense = sparse.to_dense();
+    let a = ContactProblem::new(3, &dense, &p.q, &p.mu).unwrap();
+    let b = ContactProblem::with_block_sparse(&sparse, &p.q, &p.mu).unwrap();
+    let mut rng = SplitMix64::new(5);
+    let x: Vec<f64> = (0..p.n).map(|_| rng.normal()).collect();
+    let (mut ya, mut yb) = (vec![0.0; p.n], vec![0.0; p.n]);
+    a.mul_w(&x, &mut ya);
+    b.mul_w(&x, &mut yb);
+    assert_eq!(ya, yb);
+    for i in 0..25 {
+        assert_eq!(a.block_row_mul(i, &x), b.block_row_mul(i, &x));
+        assert_eq!(
+            a.block_row_mul_offdiag(i, &x),
+            b.block_row_mul_offdiag(i, &x)
+        );
+        // offdiag = full - W_ii x_i
+        let full = b.block_row_mul(i, &x);
+        let off = b.block_row_mul_offdiag(i, &x);
+        let wii = b.w_block(i, i);
+        for k in 0..3 {
+            let own: f64 = (0..3).map(|l| wii[k][l] * x[3 * i + l]).sum();
+            assert!((full[k] - own - off[k]).abs() <= 1e-12 * (1.0 + full[k].abs()));
+        }
+        for j in 0..25 {
+            assert_eq!(a.w_block(i, j), b.w_block(i, j));
+        }
+    }
+    let (mut la, mut lb) = (Vec::new(), Vec::new());
+    a.for_each_block(|i, j, w| la.push((i, j, *w)));
+    b.for_each_block(|i, j, w| lb.push((i, j, *w)));
+    assert_eq!(la, lb);
+    // a pile is sparse: a few tiles per row
+    assert!(la.len() < 25 * 10 && la.len() > 25, "{} tiles", la.len());
+    // mismatched mu / q are refused
+    assert!(matches!(
+        ContactProblem::with_block_sparse(&sparse, &p.q, &p.mu[..3]),
+        Err(CoulombError::Shape(_))
+    ));
+    assert!(matches!(
+        ContactProblem::with_block_sparse(&sparse, &p.q[..3], &p.mu),
+        Err(CoulombError::Shape(_))
+    ));
+}
+
+#[test]
+fn a_large_sparse_pile_is_solved() {
+    let p = pile::pile(2000, 0.3, 1);
+    let w = BlockCsr::from_coo(3, p.n, &p.rows, &p.cols, &p.vals).unwrap();
+    let s = nsgs_sparse(
+        &w,
+        &p.q,
+        &p.mu,
+        &NsgsSettings {
+            tol: 1e-8,
+            max_iter: 5000,
+            ..Default::default()
+        },
+    );
+    println!("pile nc = 2000: {}", s.message);
+    assert!(s.success(), "{}", s.message);
+    assert!(
+        s.measures.cone_violation <= 1e-10 * s.impulse.iter().fold(0.0f64, |m, v| m.max(v.abs()))
+    );
+    assert!(s.measures.min_normal_impulse >= 0.0);
 }

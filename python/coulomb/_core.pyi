@@ -26,7 +26,7 @@ def lcp_measures(
 ) -> dict[str, Any]: ...
 def read_siconos_lcp(path: str) -> tuple[NDArray[np.float64], NDArray[np.float64]]: ...
 def contact_solve(
-    w: NDArray[np.float64],
+    w: NDArray[np.float64] | None,
     q: NDArray[np.float64],
     mu: NDArray[np.float64],
     dim: int,
@@ -36,6 +36,11 @@ def contact_solve(
     relaxation: float = 1.0,
     initial: NDArray[np.float64] | None = None,
     facets: int | None = None,
+    w_csr: tuple[
+        int, NDArray[np.int32 | np.int64], NDArray[np.int32 | np.int64], NDArray[np.float64]
+    ]
+    | None = None,
+    mu_pair: NDArray[np.float64] | None = None,
 ) -> dict[str, Any]: ...
 def read_siconos_fc(path: str) -> dict[str, Any]: ...
 def simd_level() -> str: ...

@@ -27,6 +27,9 @@ Methods:
     problem with the others frozen is solved exactly (2D by case split, 3D by a normal /
     tangential block descent whose tangential step is the exact disk-constrained quadratic),
     with relaxation and warm start.
+    With anisotropic friction (an ellipse), the tangential step is the exact minimiser over
+    the ellipse (the ellipse projection when the contact's tangential block is a multiple of
+    the identity).
 ``"lemke"``
     The seed's Stewart-Trinkle LCP: the friction disk of every frictional contact is replaced
     by the polygon of ``facets`` unit tangent directions in +/- pairs (default 8 in 3D; in 2D
@@ -47,6 +50,13 @@ Every answer is measured on the original data (W, q, mu):
     projection on the product of the Coulomb cones (divided by 1 instead when all three norms
     are below 1e-300). It is zero exactly at a solution. For ``"nsgs"``, ``success`` means
     ``error <= tol``.
+    For a contact with anisotropic friction ``(mu_1, mu_2)``, with ``m = max(mu_1, mu_2)``
+    and ``B = diag(1, mu_1 / m, mu_2 / m)``, the change of variables ``r = B r^``,
+    ``u^ = B u`` maps the elliptic cone onto the isotropic cone ``K_m`` and keeps the power
+    ``r . u``, so its part of the residual is
+    ``r - B P_{K_m}(B^+ r - (u^ + m ||u^_t|| n))`` (``m ||u^_t||`` is the ellipse's support
+    function ``sqrt((mu_1 u_t1)^2 + (mu_2 u_t2)^2)``; for ``mu_1 = mu_2`` it is the isotropic
+    residual).
 ``error_q``
     The same residual divided by ``||q||`` (by 1 when ``||q|| < 1e-300``), as Acary et al.
     report it for FCLib.
@@ -55,7 +65,8 @@ Every answer is measured on the original data (W, q, mu):
 ``max_complementarity``
     ``max_i |r_{n,i} u_{n,i}|``: a contact both pushing and separating.
 ``cone_violation``
-    ``max_i max(||r_{t,i}|| - mu_i r_{n,i}, 0)``: friction beyond the Coulomb cone.
+    ``max_i max(||r_{t,i}|| - mu_i r_{n,i}, 0)``: friction beyond the Coulomb cone
+    (anisotropic contacts: ``||B^+ r_t|| - m r_n``).
 ``dissipation_violation``
     ``max_i max(0, r_{t,i} . u_{t,i})`` over sliding contacts: a sliding friction impulse must
     oppose the slip (maximal dissipation).
@@ -63,14 +74,14 @@ Every answer is measured on the original data (W, q, mu):
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core
 from ._result import Result
-from .errors import InvalidParameterError, NonFiniteError, ShapeError
+from .errors import InvalidInputError, InvalidParameterError, NonFiniteError, ShapeError
 from .lcp import _as_array
 
 __all__ = ["ContactResult", "solve"]
@@ -140,14 +151,21 @@ def solve(
 
     Parameters
     ----------
-    W : (dim nc, dim nc) array_like or scipy.sparse matrix
-        The Delassus matrix (symmetric positive semidefinite). A scipy.sparse matrix is
-        densified for now (the solver works on dense W).
+    W : (dim nc, dim nc) array_like, or scipy.sparse array or matrix
+        The Delassus matrix (symmetric positive semidefinite). Dense input is solved on dense
+        storage. A scipy.sparse W (CSR, CSC, COO, BSR, ... ; converted to CSR here if needed,
+        its arrays then passed to the core without a copy) is stored block-sparse, as
+        ``dim x dim`` tiles, and never densified: an NSGS sweep then costs O(nnz(W)). Both
+        storages give bitwise identical answers on the same W.
     q : (dim nc,) array_like
         The free contact velocity, contact by contact, normal first.
-    mu : float or (nc,) array_like
+    mu : float, (nc,) or (nc, 2) array_like
         The friction coefficient, one for all contacts or one per contact; ``>= 0``. When an
-        array, its length fixes nc; when a scalar, ``nc = len(q) // dim``.
+        array, its length fixes nc; when a scalar, ``nc = len(q) // dim``. In 3D an (nc, 2)
+        array gives anisotropic friction: per contact the pair ``(mu_1, mu_2)`` along the two
+        tangents, the friction set being the ellipse
+        ``(P_t1 / mu_1)^2 + (P_t2 / mu_2)^2 <= P_n^2`` (``"nsgs"`` only; ``"lemke"`` refuses
+        pairs with ``mu_1 != mu_2`` with InvalidParameterError).
     dim : {2, 3}
         Components per contact.
     method : {"nsgs", "lemke"}
@@ -210,29 +228,13 @@ def solve(
             )
     elif facets is not None:
         raise InvalidParameterError("facets applies to method='lemke' only")
-    Wa = _as_array(W, "W", 2)
     qa = _as_array(q, "q", 1)
     n = qa.shape[0]
     if n % dim != 0:
         raise ShapeError(f"q has length {n}, which is not a multiple of dim = {dim}")
     nc = n // dim
-    mu_in = np.asarray(mu) if not isinstance(mu, np.ndarray) else mu
-    if mu_in.ndim == 0:
-        mua = np.full(nc, float(_as_array(np.atleast_1d(mu_in), "mu", 1)[0]))
-    else:
-        mua = _as_array(mu_in, "mu", 1)
-        if mua.shape[0] != nc:
-            raise ShapeError(
-                f"mu has {mua.shape[0]} entries but q of length {n} holds nc = {n} / {dim} = "
-                f"{nc} contacts"
-            )
-    if Wa.shape != (n, n):
-        raise ShapeError(f"W must have shape ({n}, {n}) to match q of length {n}, got {Wa.shape}")
-    if not np.isfinite(mua).all():
-        raise NonFiniteError("mu contains NaN or infinity")
-    if (mua < 0).any():
-        k = int(np.flatnonzero(mua < 0)[0])
-        raise InvalidParameterError(f"friction coefficients must be >= 0, mu[{k}] = {mua[k]}")
+    mua, pairs = _friction(mu, nc, n, dim)
+    Wa, csr = _delassus(W, n)
     # W and q are checked for NaN and infinity by the core, before any work
     init = None
     if initial is not None:
@@ -259,5 +261,85 @@ def solve(
         float(relaxation),
         init,
         facets,
+        w_csr=csr,
+        mu_pair=pairs,
     )
     return ContactResult(out)
+
+
+def _is_scipy_sparse(W: object) -> bool:
+    """A scipy.sparse array or matrix, recognised without importing scipy."""
+    return type(W).__module__.startswith("scipy.sparse") and callable(getattr(W, "tocsr", None))
+
+
+def _delassus(
+    W: object, n: int
+) -> tuple[NDArray[np.float64] | None, tuple[int, NDArray[Any], NDArray[Any], NDArray[Any]] | None]:
+    """W as a dense float64 array, or (for scipy.sparse input) as the CSR arrays
+    ``(n, indptr, indices, data)`` the core reads without a copy and stores block-sparse."""
+    if not _is_scipy_sparse(W):
+        Wa = _as_array(W, "W", 2)  # type: ignore[arg-type]
+        if Wa.shape != (n, n):
+            raise ShapeError(
+                f"W must have shape ({n}, {n}) to match q of length {n}, got {Wa.shape}"
+            )
+        return Wa, None
+    shape = tuple(W.shape)  # type: ignore[attr-defined]
+    if shape != (n, n):
+        raise ShapeError(f"W must have shape ({n}, {n}) to match q of length {n}, got {shape}")
+    csr = W.tocsr()  # type: ignore[attr-defined]  # no copy when already CSR
+    data = csr.data
+    if np.iscomplexobj(data):
+        raise InvalidInputError("W must be real, got a complex sparse matrix")
+    if data.dtype != np.float64 or not data.flags.c_contiguous:
+        data = np.ascontiguousarray(data, dtype=np.float64)
+    indptr, indices = csr.indptr, csr.indices
+    if not (indptr.dtype == indices.dtype and indptr.dtype in (np.int32, np.int64)):
+        indptr = np.ascontiguousarray(indptr, dtype=np.int64)
+        indices = np.ascontiguousarray(indices, dtype=np.int64)
+    # W's data is checked for NaN and infinity, and its indices for range, by the core
+    return None, (n, indptr, indices, data)
+
+
+def _friction(
+    mu: ArrayLike, nc: int, n: int, dim: int
+) -> tuple[NDArray[np.float64], NDArray[np.float64] | None]:
+    """mu as ``nc`` coefficients, and for an (nc, 2) array the flat anisotropic pairs (the
+    coefficients then hold ``max(mu_1, mu_2)``)."""
+    mu_in = np.asarray(mu) if not isinstance(mu, np.ndarray) else mu
+    pairs = None
+    if mu_in.ndim == 0:
+        mua = np.full(nc, float(_as_array(np.atleast_1d(mu_in), "mu", 1)[0]))
+    elif mu_in.ndim == 2:
+        m2 = _as_array(mu_in, "mu", 2)
+        if m2.shape != (nc, 2):
+            raise ShapeError(
+                f"anisotropic mu must have shape ({nc}, 2) (one pair mu_1, mu_2 per contact; "
+                f"q of length {n} holds nc = {nc} contacts), got {m2.shape}"
+            )
+        if dim != 3:
+            raise InvalidParameterError(
+                "anisotropic friction (mu of shape (nc, 2)) needs dim = 3 (two tangents)"
+            )
+        if not np.isfinite(m2).all():
+            raise NonFiniteError("mu contains NaN or infinity")
+        if (m2 < 0).any():
+            k, j = (int(v) for v in np.argwhere(m2 < 0)[0])
+            raise InvalidParameterError(
+                f"friction coefficients must be >= 0, mu[{k}, {j}] = {m2[k, j]}"
+            )
+        pairs = np.ascontiguousarray(m2.reshape(2 * nc))
+        mua = np.ascontiguousarray(m2.max(axis=1)) if nc else np.zeros(0)
+    else:
+        mua = _as_array(mu_in, "mu", 1)
+        if mua.shape[0] != nc:
+            raise ShapeError(
+                f"mu has {mua.shape[0]} entries but q of length {n} holds nc = {n} / {dim} = "
+                f"{nc} contacts"
+            )
+    if not np.isfinite(mua).all():
+        raise NonFiniteError("mu contains NaN or infinity")
+    if (mua < 0).any():
+        k = int(np.flatnonzero(mua < 0)[0])
+        raise InvalidParameterError(f"friction coefficients must be >= 0, mu[{k}] = {mua[k]}")
+    return mua, pairs

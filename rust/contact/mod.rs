@@ -21,31 +21,78 @@ pub mod nsgs;
 pub mod polyhedral;
 pub mod projection;
 pub mod prox;
+pub mod sparse;
 
 use crate::error::{check_finite, CoulombError, Result};
 use projection::{project_cone, tangent_norm};
 
 pub use nsgs::{solve_nsgs, NsgsSettings};
 pub use polyhedral::{solve_polyhedral, PolyhedralSettings};
+pub use sparse::BlockCsr;
+
+/// How W is stored, chosen by the caller: dense row-major, or block CSR of `dim x dim` tiles
+/// ([`BlockCsr`]). Solvers do not look inside: they go through [`ContactProblem`]'s
+/// accessors, which cost O(nnz(W)) for the block-sparse storage.
+#[derive(Clone, Copy, Debug)]
+pub enum Delassus<'a> {
+    /// row-major, `(dim nc)^2` entries.
+    Dense(&'a [f64]),
+    /// block CSR of `dim x dim` tiles.
+    BlockSparse(&'a BlockCsr),
+}
 
 /// A checked friction-contact problem over a frozen W.
+///
+/// W is assumed symmetric positive semidefinite (as `G^T M^{-1} G` is); solvers reach it only
+/// through [`Self::mul_w`], [`Self::w_block`], [`Self::block_row_mul`],
+/// [`Self::block_row_mul_offdiag`], [`Self::for_each_block`] and
+/// [`Self::for_each_block_in_row`].
+///
+/// Friction is isotropic (the disk `||r_t|| <= mu r_n`) unless an anisotropic pair
+/// `(mu_1, mu_2)` is given per contact (3D only, [`Self::with_anisotropic_friction`]): then the
+/// friction set is the ellipse `(r_t1 / mu_1)^2 + (r_t2 / mu_2)^2 <= r_n^2` in the contact's
+/// tangent frame.
 #[derive(Clone, Copy, Debug)]
 pub struct ContactProblem<'a> {
     /// components per contact: 2 (planar) or 3 (spatial).
     pub dim: usize,
     /// number of contacts.
     pub nc: usize,
-    /// the Delassus matrix W, row-major, `(dim nc)^2` entries, assumed symmetric positive
-    /// semidefinite (as `G^T M^{-1} G` is).
-    pub w: &'a [f64],
+    /// the Delassus matrix W.
+    w: Delassus<'a>,
     /// the free contact velocity q, `dim nc` entries.
     pub q: &'a [f64],
-    /// the friction coefficient of each contact, `nc` entries, `>= 0`.
+    /// the friction coefficient of each contact, `nc` entries, `>= 0`; with anisotropic
+    /// friction, `mu_i = max(mu_1, mu_2)` (the disk that circumscribes the ellipse).
     pub mu: &'a [f64],
+    /// anisotropic friction: `(mu_1, mu_2)` per contact (`2 nc` entries, 3D only), or `None`
+    /// for isotropic friction.
+    pub mu_pair: Option<&'a [f64]>,
+}
+
+fn check_q_mu(dim: usize, q: &[f64], mu: &[f64]) -> Result<()> {
+    let nc = mu.len();
+    let n = dim * nc;
+    if q.len() != n {
+        return Err(CoulombError::Shape(format!(
+            "q has length {}, expected dim * nc = {dim} * {nc} = {n} (nc = len(mu))",
+            q.len()
+        )));
+    }
+    check_finite("q", q)?;
+    check_finite("mu", mu)?;
+    if let Some(k) = mu.iter().position(|&m| m < 0.0) {
+        return Err(CoulombError::InvalidParameter(format!(
+            "friction coefficients must be >= 0, mu[{k}] = {}",
+            mu[k]
+        )));
+    }
+    Ok(())
 }
 
 impl<'a> ContactProblem<'a> {
-    /// checks dim, shapes, finiteness and `mu >= 0` before any work; `nc = mu.len()`.
+    /// checks dim, shapes, finiteness and `mu >= 0` before any work; `nc = mu.len()`; W dense
+    /// row-major.
     pub fn new(dim: usize, w: &'a [f64], q: &'a [f64], mu: &'a [f64]) -> Result<Self> {
         if dim != 2 && dim != 3 {
             return Err(CoulombError::InvalidParameter(format!(
@@ -68,15 +115,94 @@ impl<'a> ContactProblem<'a> {
             )));
         }
         check_finite("W", w)?;
-        check_finite("q", q)?;
-        check_finite("mu", mu)?;
-        if let Some(k) = mu.iter().position(|&m| m < 0.0) {
-            return Err(CoulombError::InvalidParameter(format!(
-                "friction coefficients must be >= 0, mu[{k}] = {}",
-                mu[k]
+        check_q_mu(dim, q, mu)?;
+        Ok(Self {
+            dim,
+            nc,
+            w: Delassus::Dense(w),
+            q,
+            mu,
+            mu_pair: None,
+        })
+    }
+
+    /// the same checks with W in block CSR (already checked when built); `dim` and nc are W's.
+    pub fn with_block_sparse(w: &'a BlockCsr, q: &'a [f64], mu: &'a [f64]) -> Result<Self> {
+        let (dim, nc) = (w.dim(), w.nc());
+        if mu.len() != nc {
+            return Err(CoulombError::Shape(format!(
+                "mu has {} entries but W holds nc = {nc} contacts of dim {dim}",
+                mu.len()
             )));
         }
-        Ok(Self { dim, nc, w, q, mu })
+        check_q_mu(dim, q, mu)?;
+        Ok(Self {
+            dim,
+            nc,
+            w: Delassus::BlockSparse(w),
+            q,
+            mu,
+            mu_pair: None,
+        })
+    }
+
+    /// Anisotropic friction: `pairs[2i], pairs[2i + 1]` = `(mu_1, mu_2)` of contact i along its
+    /// two tangents (3D only; finite, `>= 0`, and `mu[i] = max(mu_1, mu_2)`).
+    pub fn with_anisotropic_friction(mut self, pairs: &'a [f64]) -> Result<Self> {
+        if self.dim != 3 {
+            return Err(CoulombError::InvalidParameter(
+                "anisotropic friction (a pair mu_1, mu_2 per contact) needs dim = 3".into(),
+            ));
+        }
+        if pairs.len() != 2 * self.nc {
+            return Err(CoulombError::Shape(format!(
+                "anisotropic friction needs 2 coefficients per contact (2 * {} = {}), got {}",
+                self.nc,
+                2 * self.nc,
+                pairs.len()
+            )));
+        }
+        check_finite("anisotropic mu", pairs)?;
+        if let Some(k) = pairs.iter().position(|&m| m < 0.0) {
+            return Err(CoulombError::InvalidParameter(format!(
+                "friction coefficients must be >= 0, mu[{}][{}] = {}",
+                k / 2,
+                k % 2,
+                pairs[k]
+            )));
+        }
+        for (i, p) in pairs.chunks_exact(2).enumerate() {
+            if self.mu[i] != p[0].max(p[1]) {
+                return Err(CoulombError::InvalidParameter(format!(
+                    "mu[{i}] = {} must be max(mu_1, mu_2) = {} with anisotropic friction",
+                    self.mu[i],
+                    p[0].max(p[1])
+                )));
+            }
+        }
+        self.mu_pair = Some(pairs);
+        Ok(self)
+    }
+
+    /// the pair `(mu_1, mu_2)` of contact i when its friction is anisotropic (`mu_1 != mu_2`),
+    /// `None` when it is the disk of radius `mu[i] r_n`.
+    #[inline]
+    pub fn anisotropy(&self, i: usize) -> Option<[f64; 2]> {
+        match self.mu_pair {
+            Some(p) if p[2 * i] != p[2 * i + 1] => Some([p[2 * i], p[2 * i + 1]]),
+            _ => None,
+        }
+    }
+
+    /// whether every contact has isotropic friction (solvers that only know the disk must
+    /// refuse the problem otherwise).
+    pub fn is_isotropic(&self) -> bool {
+        (0..self.nc).all(|i| self.anisotropy(i).is_none())
+    }
+
+    /// how W is stored.
+    pub fn storage(&self) -> Delassus<'a> {
+        self.w
     }
 
     /// the number of unknowns, `dim nc`.
@@ -86,49 +212,129 @@ impl<'a> ContactProblem<'a> {
 
     /// `out = W x` (both `dim nc` long). Solvers reach W only through this and the block
     /// accessors below, so the storage of W (dense or block-sparse) stays this type's choice.
+    /// O(nnz(W)) for block-sparse storage.
     pub fn mul_w(&self, x: &[f64], out: &mut [f64]) {
-        let n = self.size();
-        for (i, oi) in out.iter_mut().enumerate().take(n) {
-            let row = &self.w[i * n..(i + 1) * n];
-            *oi = row.iter().zip(x).map(|(a, b)| a * b).sum::<f64>();
+        match self.w {
+            Delassus::Dense(w) => {
+                let n = self.size();
+                for (i, oi) in out.iter_mut().enumerate().take(n) {
+                    let row = &w[i * n..(i + 1) * n];
+                    *oi = row.iter().zip(x).map(|(a, b)| a * b).sum::<f64>();
+                }
+            }
+            Delassus::BlockSparse(b) => b.mul(x, out),
         }
     }
 
-    /// the `dim x dim` block `W_ij` of contacts i and j, zero-padded to 3 x 3.
+    /// the `dim x dim` block `W_ij` of contacts i and j, zero-padded to 3 x 3 (O(log) for
+    /// block-sparse storage).
     pub fn w_block(&self, i: usize, j: usize) -> [[f64; 3]; 3] {
-        let n = self.size();
         let d = self.dim;
         let mut b = [[0.0; 3]; 3];
-        for (a, row) in b.iter_mut().enumerate().take(d) {
-            for (c, v) in row.iter_mut().enumerate().take(d) {
-                *v = self.w[(i * d + a) * n + j * d + c];
+        match self.w {
+            Delassus::Dense(w) => {
+                let n = self.size();
+                for (a, row) in b.iter_mut().enumerate().take(d) {
+                    for (c, v) in row.iter_mut().enumerate().take(d) {
+                        *v = w[(i * d + a) * n + j * d + c];
+                    }
+                }
+            }
+            Delassus::BlockSparse(s) => {
+                if let Some(t) = s.block(i, j) {
+                    pad(d, t, &mut b);
+                }
             }
         }
         b
     }
 
-    /// `(W x)_i`, the `dim` components of contact i, zero-padded to 3.
+    /// `(W x)_i`, the `dim` components of contact i, zero-padded to 3 (O(tiles in the row) for
+    /// block-sparse storage).
     pub fn block_row_mul(&self, i: usize, x: &[f64]) -> [f64; 3] {
-        let n = self.size();
-        let d = self.dim;
-        let mut out = [0.0; 3];
-        for (a, o) in out.iter_mut().enumerate().take(d) {
-            let row = &self.w[(i * d + a) * n..(i * d + a + 1) * n];
-            *o = row.iter().zip(x).map(|(p, q)| p * q).sum::<f64>();
+        match self.w {
+            Delassus::Dense(w) => {
+                let n = self.size();
+                let d = self.dim;
+                let mut out = [0.0; 3];
+                for (a, o) in out.iter_mut().enumerate().take(d) {
+                    let row = &w[(i * d + a) * n..(i * d + a + 1) * n];
+                    *o = row.iter().zip(x).map(|(p, q)| p * q).sum::<f64>();
+                }
+                out
+            }
+            Delassus::BlockSparse(s) => s.row_mul(i, x, false),
         }
-        out
     }
 
-    /// calls `f(i, j, W_ij)` for every block that is not identically zero, row by row.
-    pub fn for_each_block(&self, mut f: impl FnMut(usize, usize, &[[f64; 3]; 3])) {
-        for i in 0..self.nc {
-            for j in 0..self.nc {
-                let b = self.w_block(i, j);
-                if b.iter().flatten().any(|&v| v != 0.0) {
-                    f(i, j, &b);
+    /// `Σ_{j != i} W_ij x_j`: what the other contacts' impulses add to contact i's velocity
+    /// (zero-padded to 3; O(tiles in the row) for block-sparse storage).
+    #[inline]
+    pub fn block_row_mul_offdiag(&self, i: usize, x: &[f64]) -> [f64; 3] {
+        match self.w {
+            Delassus::Dense(w) => {
+                let n = self.size();
+                let d = self.dim;
+                let o = i * d;
+                let mut out = [0.0; 3];
+                for (a, v) in out.iter_mut().enumerate().take(d) {
+                    let row = &w[(o + a) * n..(o + a + 1) * n];
+                    // one running sum in column order (as the block-sparse product does)
+                    let mut acc = 0.0;
+                    for (p, q) in row[..o].iter().zip(&x[..o]) {
+                        acc += p * q;
+                    }
+                    for (p, q) in row[o + d..].iter().zip(&x[o + d..]) {
+                        acc += p * q;
+                    }
+                    *v = acc;
+                }
+                out
+            }
+            Delassus::BlockSparse(s) => s.row_mul(i, x, true),
+        }
+    }
+
+    /// calls `f(j, W_ij)` for every block of block row i that is not identically zero, j
+    /// increasing (O(tiles in the row) for block-sparse storage, O(nc) dense).
+    pub fn for_each_block_in_row(&self, i: usize, mut f: impl FnMut(usize, &[[f64; 3]; 3])) {
+        match self.w {
+            Delassus::Dense(_) => {
+                for j in 0..self.nc {
+                    let b = self.w_block(i, j);
+                    if b.iter().flatten().any(|&v| v != 0.0) {
+                        f(j, &b);
+                    }
+                }
+            }
+            Delassus::BlockSparse(s) => {
+                let d = self.dim;
+                for (k, &j) in s.row_cols(i).iter().enumerate() {
+                    let t = &s.row_values(i)[k * d * d..(k + 1) * d * d];
+                    if t.iter().any(|&v| v != 0.0) {
+                        let mut b = [[0.0; 3]; 3];
+                        pad(d, t, &mut b);
+                        f(j, &b);
+                    }
                 }
             }
         }
+    }
+
+    /// calls `f(i, j, W_ij)` for every block that is not identically zero, row by row
+    /// (O(nnz(W)) for block-sparse storage).
+    pub fn for_each_block(&self, mut f: impl FnMut(usize, usize, &[[f64; 3]; 3])) {
+        for i in 0..self.nc {
+            self.for_each_block_in_row(i, |j, b| f(i, j, b));
+        }
+    }
+}
+
+/// a `dim * dim` row-major tile into a zero-padded 3 x 3 block.
+#[inline]
+fn pad(d: usize, t: &[f64], b: &mut [[f64; 3]; 3]) {
+    for (a, row) in b.iter_mut().enumerate().take(d) {
+        row[..d].copy_from_slice(&t[a * d..(a + 1) * d]);
     }
 }
 
@@ -166,7 +372,8 @@ impl std::fmt::Display for ContactStatus {
 pub struct ContactMeasures {
     /// the natural-map residual on De Saxce's form,
     /// `||r - P_K(r - (u + mu ||u_t|| n))|| / max(||q||, ||r||, ||u||)` (divided by 1 instead
-    /// when all three norms are below 1e-300).
+    /// when all three norms are below 1e-300); for a contact with anisotropic friction its
+    /// part of the residual is the elliptic-cone one of [`anisotropic_residual`].
     pub error: f64,
     /// the same residual divided by `||q||` (by 1 when `||q|| < 1e-300`), as Acary et al.
     /// report it.
@@ -175,7 +382,8 @@ pub struct ContactMeasures {
     pub min_normal_impulse: f64,
     /// `max_i |r_{n,i} u_{n,i}|`.
     pub max_complementarity: f64,
-    /// `max_i max(||r_{t,i}|| - mu_i r_{n,i}, 0)`.
+    /// `max_i max(||r_{t,i}|| - mu_i r_{n,i}, 0)` (anisotropic contacts: see
+    /// [`anisotropic_residual`]).
     pub cone_violation: f64,
     /// `max_i max(0, r_{t,i} . u_{t,i})` over sliding contacts (`||u_t||` above 1e-12 times the
     /// largest velocity): a sliding impulse must oppose the slip.
@@ -247,22 +455,26 @@ pub(crate) fn measure_into(
         let mu = problem.mu[i];
         let ri = &r[i * dim..(i + 1) * dim];
         let ui = &u[i * dim..(i + 1) * dim];
-        let ut_norm = tangent_norm(&ui[1..]);
-        // v = r - (u + mu ||u_t|| n), residual r - P_K(v)
-        let mut v = [0.0; 3];
-        v[0] = ri[0] - (ui[0] + mu * ut_norm);
-        for k in 1..dim {
-            v[k] = ri[k] - ui[k];
-        }
-        project_cone(&mut v[..dim], mu);
-        for k in 0..dim {
-            let d = ri[k] - v[k];
-            res2 += d * d;
-        }
+        let (d2, viol) = match problem.anisotropy(i) {
+            None => {
+                let ut_norm = tangent_norm(&ui[1..]);
+                // v = r - (u + mu ||u_t|| n), residual r - P_K(v)
+                let mut v = [0.0; 3];
+                v[0] = ri[0] - (ui[0] + mu * ut_norm);
+                for k in 1..dim {
+                    v[k] = ri[k] - ui[k];
+                }
+                project_cone(&mut v[..dim], mu);
+                let d2: f64 = (0..dim).map(|k| (ri[k] - v[k]).powi(2)).sum();
+                (d2, tangent_norm(&ri[1..]) - mu * ri[0])
+            }
+            Some(pair) => anisotropic_residual(pair, ri, ui),
+        };
+        res2 += d2;
         min_n = min_n.min(ri[0]);
         comp = comp.max((ri[0] * ui[0]).abs());
-        let rt_norm = tangent_norm(&ri[1..]);
-        cone = cone.max(rt_norm - mu * ri[0]);
+        cone = cone.max(viol);
+        let ut_norm = tangent_norm(&ui[1..]);
         if ut_norm > 1e-12 * vscale {
             let dot: f64 = (1..dim).map(|k| ri[k] * ui[k]).sum();
             diss = diss.max(dot);
@@ -280,6 +492,54 @@ pub(crate) fn measure_into(
         cone_violation: cone.max(0.0),
         dissipation_violation: diss.max(0.0),
     }
+}
+
+/// The natural-map residual of one contact with elliptic friction `(mu_1, mu_2)` (3D), squared,
+/// and its cone violation.
+///
+/// With `m = max(mu_1, mu_2)` and `B = diag(1, mu_1 / m, mu_2 / m)`, the change of variables
+/// `r = B r^`, `u^ = B u` maps the elliptic cone `(r_t1 / mu_1)^2 + (r_t2 / mu_2)^2 <= r_n^2` onto
+/// the isotropic cone `K_m = { ||r^_t|| <= m r^_n }` and keeps the power `r . u = r^ . u^`, so
+/// Coulomb's law with maximal dissipation becomes the isotropic law in the hatted variables
+/// (De Saxce's modified velocity `u^ + m ||u^_t|| n`, where `m ||u^_t|| =
+/// sqrt((mu_1 u_t1)^2 + (mu_2 u_t2)^2)` is the support function of the ellipse, the dissipation
+/// rate per unit normal impulse). The residual is mapped back to impulse units by B:
+///
+/// ```text
+///     e = r - B P_{K_m}( B^+ r - (u^ + m ||u^_t|| n) ),     u^ = B u,
+/// ```
+///
+/// with `B^+` the pseudo-inverse (a tangent with `mu_k = 0` gets `r^_k = 0`, and then
+/// `e_k = r_k`: the impulse must vanish along it). B is invertible on the cone's span, so
+/// `e = 0` exactly at a solution; for `mu_1 = mu_2` it is `B = I` and e is the isotropic
+/// residual. The cone violation is `max(||B^+ r_t|| - m r_n, |r_k| for mu_k = 0)`.
+pub(crate) fn anisotropic_residual(pair: [f64; 2], r: &[f64], u: &[f64]) -> (f64, f64) {
+    let m = pair[0].max(pair[1]);
+    if m <= 0.0 {
+        // frictionless: the half-line
+        let mut v = [r[0] - u[0], r[1] - u[1], r[2] - u[2]];
+        project_cone(&mut v, 0.0);
+        let d2 = (0..3).map(|k| (r[k] - v[k]).powi(2)).sum();
+        return (d2, r[1].abs().max(r[2].abs()));
+    }
+    let b = [pair[0] / m, pair[1] / m];
+    let mut rh = [r[0], 0.0, 0.0];
+    let mut uh = [u[0], 0.0, 0.0];
+    let mut flat: f64 = 0.0;
+    for k in 0..2 {
+        if b[k] > 0.0 {
+            rh[1 + k] = r[1 + k] / b[k];
+            uh[1 + k] = u[1 + k] * b[k];
+        } else {
+            flat = flat.max(r[1 + k].abs());
+        }
+    }
+    let uht = uh[1].hypot(uh[2]);
+    let mut v = [rh[0] - (uh[0] + m * uht), rh[1] - uh[1], rh[2] - uh[2]];
+    project_cone(&mut v, m);
+    let e = [r[0] - v[0], r[1] - b[0] * v[1], r[2] - b[1] * v[2]];
+    let d2 = e.iter().map(|x| x * x).sum();
+    (d2, (rh[1].hypot(rh[2]) - m * r[0]).max(flat))
 }
 
 fn norm2(x: &[f64]) -> f64 {

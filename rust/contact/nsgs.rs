@@ -72,7 +72,11 @@ struct LocalBlock {
     c: [f64; 2],
     /// T as (t00, t01, t11).
     t: [f64; 3],
+    /// the eigendecomposition of T, or of `E T E` for anisotropic friction.
     eig: Eig2,
+    /// anisotropic friction: `E = diag(mu_1, mu_2)`, the tangential impulse is `r_t = E s`
+    /// with `||s|| <= r_n`.
+    scale: Option<[f64; 2]>,
 }
 
 /// `T = Q diag(small, large) Q^T` with `Q = [(-sn, cs), (cs, sn)]` (columns: the eigenvectors
@@ -187,6 +191,11 @@ fn local_descent(blk: &LocalBlock, mu: f64, b: &[f64; 3], dim: usize, r: &mut [f
             } else {
                 0.0
             };
+        } else if let Some(e) = blk.scale {
+            // r_t = E s, ||s|| <= r_n: min 1/2 s^T (E T E) s + (E g) . s over the disk
+            let x = disk_qp(&blk.eig, [e[0] * g[0], e[1] * g[1]], rn);
+            r[1] = e[0] * x[0];
+            r[2] = e[1] * x[1];
         } else {
             let x = disk_qp(&blk.eig, g, radius);
             r[1] = x[0];
@@ -196,6 +205,26 @@ fn local_descent(blk: &LocalBlock, mu: f64, b: &[f64; 3], dim: usize, r: &mut [f
         let size = (0..dim).map(|k| r[k].abs()).fold(0.0, f64::max);
         if change <= 1e-15 * size {
             break;
+        }
+    }
+}
+
+/// Projects contact i's impulse in place onto its friction cone: the Coulomb cone, or for
+/// anisotropic friction the elliptic cone through the change of variables of
+/// [`super::anisotropic_residual`] (`r^ = B^+ r` projected on `K_m`, mapped back by B: a point of
+/// the elliptic cone, the nearest one in the B-weighted norm). Used for warm starts.
+pub(crate) fn project_friction_cone(problem: &ContactProblem<'_>, i: usize, ri: &mut [f64]) {
+    match problem.anisotropy(i) {
+        None => super::projection::project_cone(ri, problem.mu[i]),
+        Some(pair) => {
+            let m = pair[0].max(pair[1]);
+            let b = [pair[0] / m, pair[1] / m];
+            for k in 0..2 {
+                ri[1 + k] = if b[k] > 0.0 { ri[1 + k] / b[k] } else { 0.0 };
+            }
+            super::projection::project_cone(ri, m);
+            ri[1] *= b[0];
+            ri[2] *= b[1];
         }
     }
 }
@@ -222,7 +251,6 @@ pub fn solve_nsgs(problem: &ContactProblem<'_>, s: &NsgsSettings) -> Result<Cont
     let dim = problem.dim;
     let nc = problem.nc;
     let n = problem.size();
-    let w = problem.w;
     let mut r = match &s.initial {
         Some(r0) => {
             if r0.len() != n {
@@ -233,8 +261,8 @@ pub fn solve_nsgs(problem: &ContactProblem<'_>, s: &NsgsSettings) -> Result<Cont
             }
             check_finite("initial impulses", r0)?;
             let mut r = r0.clone();
-            for (ri, &mu) in r.chunks_exact_mut(dim).zip(problem.mu) {
-                super::projection::project_cone(ri, mu);
+            for (i, ri) in r.chunks_exact_mut(dim).enumerate() {
+                project_friction_cone(problem, i, ri);
             }
             r
         }
@@ -244,8 +272,8 @@ pub fn solve_nsgs(problem: &ContactProblem<'_>, s: &NsgsSettings) -> Result<Cont
     // the diagonal blocks, once
     let blocks: Vec<LocalBlock> = (0..nc)
         .map(|i| {
-            let o = i * dim;
-            let at = |k: usize, l: usize| w[(o + k) * n + o + l];
+            let wb = problem.w_block(i, i);
+            let at = |k: usize, l: usize| wb[k][l];
             let mut b = LocalBlock {
                 a: at(0, 0),
                 ..Default::default()
@@ -258,7 +286,16 @@ pub fn solve_nsgs(problem: &ContactProblem<'_>, s: &NsgsSettings) -> Result<Cont
                 b.t[1] = 0.5 * (at(1, 2) + at(2, 1));
                 b.t[2] = at(2, 2);
             }
-            b.eig = Eig2::of(b.t);
+            b.scale = problem.anisotropy(i);
+            b.eig = match b.scale {
+                // E T E
+                Some(e) => Eig2::of([
+                    e[0] * e[0] * b.t[0],
+                    e[0] * e[1] * b.t[1],
+                    e[1] * e[1] * b.t[2],
+                ]),
+                None => Eig2::of(b.t),
+            };
             b
         })
         .collect();
@@ -283,13 +320,11 @@ pub fn solve_nsgs(problem: &ContactProblem<'_>, s: &NsgsSettings) -> Result<Cont
             let mu = problem.mu[i];
             let mut old = [0.0; 3];
             old[..dim].copy_from_slice(&r[o..o + dim]);
-            // b = q_i + W_i r - W_ii r_i
+            // b = q_i + Σ_{j != i} W_ij r_j, from the stored blocks of row i
+            let off = problem.block_row_mul_offdiag(i, &r);
             let mut b = [0.0; 3];
             for k in 0..dim {
-                let row = &w[(o + k) * n..(o + k + 1) * n];
-                let full: f64 = row.iter().zip(&r).map(|(x, y)| x * y).sum();
-                let own: f64 = (0..dim).map(|l| row[o + l] * old[l]).sum();
-                b[k] = problem.q[o + k] + full - own;
+                b[k] = problem.q[o + k] + off[k];
             }
             let mut new = old;
             let exact = if dim == 2 {
@@ -418,6 +453,7 @@ mod tests {
             c: [0.2, 0.0],
             t: [1.0, 0.0, 0.0],
             eig: Eig2::default(),
+            scale: None,
         };
         assert_eq!(local_2d_exact(&blk, 0.5, 1.0, 3.0), Some((0.0, 0.0)));
         // stick: W r = -b inside the cone

@@ -81,6 +81,13 @@ impl PolyhedralLcp {
     pub fn new(problem: &ContactProblem<'_>, facets: usize) -> Result<Self> {
         let dim = problem.dim;
         check_facets(dim, facets)?;
+        if !problem.is_isotropic() {
+            return Err(CoulombError::InvalidParameter(
+                "the polyhedral (Stewart-Trinkle) method approximates the isotropic friction \
+                 disk only; use method 'nsgs' for anisotropic friction"
+                    .into(),
+            ));
+        }
         let directions: Vec<[f64; 2]> = if dim == 2 {
             vec![[1.0, 0.0], [-1.0, 0.0]]
         } else {
@@ -100,28 +107,22 @@ impl PolyhedralLcp {
                 .collect()
         };
         let nc = problem.nc;
-        let nw = problem.size();
-        // the columns of B (contact space -> [r_n, β]): at most 2 entries each
-        let mut cols: Vec<([usize; 2], [f64; 2])> = Vec::new();
-        for i in 0..nc {
-            cols.push(([i * dim, 0], [1.0, 0.0]));
-        }
+        // per contact, the columns of B (contact space -> [r_n, β]): (index in z, the column's
+        // dim components on the contact), so that A_top = B^T W B tile by tile
+        let mut local: Vec<Vec<(usize, [f64; 3])>> =
+            (0..nc).map(|i| vec![(i, [1.0, 0.0, 0.0])]).collect();
         let mut beta = vec![None; nc];
         let mut lambda = vec![None; nc];
+        let mut p = nc;
         for (i, b) in beta.iter_mut().enumerate() {
             if problem.mu[i] > 0.0 {
-                *b = Some(cols.len());
+                *b = Some(p);
                 for d in &directions {
-                    let o = i * dim + 1;
-                    if dim == 2 {
-                        cols.push(([o, o], [d[0], 0.0]));
-                    } else {
-                        cols.push(([o, o + 1], [d[0], d[1]]));
-                    }
+                    local[i].push((p, [0.0, d[0], d[1]]));
+                    p += 1;
                 }
             }
         }
-        let p = cols.len();
         let mut nl = p;
         for l in lambda.iter_mut().zip(&beta) {
             if l.1.is_some() {
@@ -130,24 +131,31 @@ impl PolyhedralLcp {
             }
         }
         let n = nl;
-        // WB (nw x p), column by column, then A_top = B^T (W B)
-        let mut wb = vec![0.0; nw * p];
-        for (c, (idx, cf)) in cols.iter().enumerate() {
-            for row in 0..nw {
-                let wr = &problem.w[row * nw..(row + 1) * nw];
-                wb[row * p + c] = cf[0] * wr[idx[0]] + cf[1] * wr[idx[1]];
-            }
-        }
         let mut m = vec![0.0; n * n];
         let mut q = vec![0.0; n];
-        for (r, (idx, cf)) in cols.iter().enumerate() {
-            let a = &wb[idx[0] * p..(idx[0] + 1) * p];
-            let b = &wb[idx[1] * p..(idx[1] + 1) * p];
-            let out = &mut m[r * n..r * n + p];
-            for c in 0..p {
-                out[c] = cf[0] * a[c] + cf[1] * b[c];
+        let mut wv: Vec<[f64; 3]> = Vec::new();
+        problem.for_each_block(|i, j, wij| {
+            // W_ij v for every column v of contact j, then dotted with contact i's columns
+            wv.clear();
+            for (_, v) in &local[j] {
+                let mut o = [0.0; 3];
+                for (a, oa) in o.iter_mut().enumerate().take(dim) {
+                    *oa = (0..dim).map(|c| wij[a][c] * v[c]).sum();
+                }
+                wv.push(o);
             }
-            q[r] = cf[0] * problem.q[idx[0]] + cf[1] * problem.q[idx[1]];
+            for (za, va) in &local[i] {
+                let row = &mut m[za * n..(za + 1) * n];
+                for ((zb, _), x) in local[j].iter().zip(&wv) {
+                    row[*zb] += (0..dim).map(|a| va[a] * x[a]).sum::<f64>();
+                }
+            }
+        });
+        for (i, cols) in local.iter().enumerate() {
+            let qi = &problem.q[i * dim..(i + 1) * dim];
+            for (za, va) in cols {
+                q[*za] = (0..dim).map(|a| va[a] * qi[a]).sum();
+            }
         }
         let s = directions.len();
         for i in 0..nc {

@@ -14,7 +14,9 @@ use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyDict, PyType};
 
-use crate::contact::{self, ContactProblem, ContactSolution, NsgsSettings, PolyhedralSettings};
+use crate::contact::{
+    self, BlockCsr, ContactProblem, ContactSolution, NsgsSettings, PolyhedralSettings,
+};
 use crate::error::CoulombError;
 use crate::io::siconos::{NumericsMatrix, SiconosFcFile};
 use crate::io::ReadError;
@@ -311,15 +313,69 @@ enum ContactSettings {
     Lemke(PolyhedralSettings),
 }
 
+/// Scalar CSR index arrays as scipy stores them (int32 or int64), borrowed without a copy.
+#[derive(FromPyObject)]
+enum CsrIndex<'py> {
+    I32(PyReadonlyArray1<'py, i32>),
+    I64(PyReadonlyArray1<'py, i64>),
+}
+
+fn index_slice<'a, T: numpy::Element>(
+    py: Python<'_>,
+    name: &str,
+    a: &'a PyReadonlyArray1<'_, T>,
+) -> PyResult<&'a [T]> {
+    a.as_slice().map_err(|_| {
+        to_py(
+            py,
+            CoulombError::Shape(format!("{name} must be a contiguous integer array")),
+        )
+    })
+}
+
+/// builds the block CSR of a scalar CSR W (`n x n`), checking the arrays.
+fn block_csr(
+    py: Python<'_>,
+    dim: usize,
+    n: usize,
+    indptr: &CsrIndex<'_>,
+    indices: &CsrIndex<'_>,
+    data: &[f64],
+) -> PyResult<Result<BlockCsr, CoulombError>> {
+    Ok(match (indptr, indices) {
+        (CsrIndex::I32(p), CsrIndex::I32(i)) => BlockCsr::from_csr(
+            dim,
+            n,
+            index_slice(py, "indptr", p)?,
+            index_slice(py, "indices", i)?,
+            data,
+        ),
+        (CsrIndex::I64(p), CsrIndex::I64(i)) => BlockCsr::from_csr(
+            dim,
+            n,
+            index_slice(py, "indptr", p)?,
+            index_slice(py, "indices", i)?,
+            data,
+        ),
+        _ => Err(CoulombError::Shape(
+            "W's indptr and indices must have the same integer type".into(),
+        )),
+    })
+}
+
 /// Solves the friction-contact problem `u = W r + q`, per contact
 /// `K ∋ r ⊥ u + mu ||u_t|| n ∈ K^*`. The Python wrapper `coulomb.contact.solve` documents the
-/// arguments; this takes them already converted to float64 arrays (W dense, q and mu flat).
+/// arguments; this takes them already converted to float64 arrays: W either dense (`w`) or
+/// scalar CSR (`w_csr = (n, indptr, indices, data)`, borrowed, turned into block CSR without
+/// densifying); q and mu flat; `mu_pair` the flat `(mu_1, mu_2)` pairs of anisotropic friction
+/// (then `mu` holds `max(mu_1, mu_2)`).
 #[pyfunction]
-#[pyo3(signature = (w, q, mu, dim, method, tol, max_iter=None, relaxation=1.0, initial=None, facets=None))]
+#[pyo3(signature = (w, q, mu, dim, method, tol, max_iter=None, relaxation=1.0, initial=None,
+                    facets=None, w_csr=None, mu_pair=None))]
 #[allow(clippy::too_many_arguments)]
 fn contact_solve<'py>(
     py: Python<'py>,
-    w: PyReadonlyArray2<'py, f64>,
+    w: Option<PyReadonlyArray2<'py, f64>>,
     q: PyReadonlyArray1<'py, f64>,
     mu: PyReadonlyArray1<'py, f64>,
     dim: usize,
@@ -329,18 +385,20 @@ fn contact_solve<'py>(
     relaxation: f64,
     initial: Option<PyReadonlyArray1<'py, f64>>,
     facets: Option<usize>,
+    w_csr: Option<(
+        usize,
+        CsrIndex<'py>,
+        CsrIndex<'py>,
+        PyReadonlyArray1<'py, f64>,
+    )>,
+    mu_pair: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let shape = w.shape();
-    if shape[0] != shape[1] {
-        return Err(to_py(
-            py,
-            CoulombError::Shape(format!("W must be square, got {} x {}", shape[0], shape[1])),
-        ));
-    }
-    let n = shape[0];
-    let ws = slice2(py, "W", &w)?;
     let qs = slice1(py, "q", &q)?;
     let mus = slice1(py, "mu", &mu)?;
+    let pairs = match &mu_pair {
+        Some(p) => Some(slice1(py, "mu_pair", p)?),
+        None => None,
+    };
     let init = match &initial {
         Some(c) => Some(slice1(py, "initial", c)?.to_vec()),
         None => None,
@@ -371,9 +429,48 @@ fn contact_solve<'py>(
             ))
         }
     };
-    let (solution, nc, seconds) = guarded(py, n * n, || {
+    // W: dense, or block CSR built here (checked before any work)
+    enum Storage<'a> {
+        Dense(&'a [f64]),
+        Sparse(BlockCsr),
+    }
+    let (storage, work) = match (&w, &w_csr) {
+        (Some(w), None) => {
+            let shape = w.shape();
+            if shape[0] != shape[1] {
+                return Err(to_py(
+                    py,
+                    CoulombError::Shape(format!(
+                        "W must be square, got {} x {}",
+                        shape[0], shape[1]
+                    )),
+                ));
+            }
+            (Storage::Dense(slice2(py, "W", w)?), shape[0] * shape[0])
+        }
+        (None, Some((n, indptr, indices, data))) => {
+            let ds = slice1(py, "W's data", data)?;
+            let b = block_csr(py, dim, *n, indptr, indices, ds)?.map_err(|e| to_py(py, e))?;
+            (Storage::Sparse(b), ds.len().max(*n))
+        }
+        _ => {
+            return Err(to_py(
+                py,
+                CoulombError::InvalidParameter(
+                    "give W either dense (w) or as CSR arrays (w_csr), exactly one".into(),
+                ),
+            ))
+        }
+    };
+    let (solution, nc, seconds) = guarded(py, work, || {
         let start = std::time::Instant::now();
-        let problem = ContactProblem::new(dim, ws, qs, mus)?;
+        let mut problem = match &storage {
+            Storage::Dense(ws) => ContactProblem::new(dim, ws, qs, mus)?,
+            Storage::Sparse(b) => ContactProblem::with_block_sparse(b, qs, mus)?,
+        };
+        if let Some(p) = pairs {
+            problem = problem.with_anisotropic_friction(p)?;
+        }
         let s = match &settings {
             ContactSettings::Nsgs(s) => contact::solve_nsgs(&problem, s)?,
             ContactSettings::Lemke(s) => contact::solve_polyhedral(&problem, s)?,

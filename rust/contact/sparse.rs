@@ -1,0 +1,538 @@
+//! Block-sparse storage of the Delassus matrix W: block CSR of `dim x dim` tiles.
+//!
+//! W is `(dim nc) x (dim nc)`; tile `W_ij` couples contact i with contact j. Only the tiles
+//! with at least one stored scalar are kept (plus every diagonal tile, stored even when zero,
+//! so a nonsmooth Gauss-Seidel sweep finds `W_ii` in O(1)). In a mechanism `W = G^T M^-1 G`
+//! has a tile `W_ij != 0` only when contacts i and j touch a common body, so a pile or a chain
+//! of bodies gives a few tiles per block row and `W x` costs O(nnz(W)).
+//!
+//! The storage is built from scalar CSR, CSC or COO triplets without ever forming the dense
+//! matrix: the entries are bucketed by block row (a counting sort), the distinct block columns
+//! of each block row found with a marker array, sorted, and the scalars summed into their tiles
+//! (duplicate scalar entries add up, as in scipy.sparse). Any sparsity pattern is accepted: the
+//! tiles are only a grouping of the entries.
+
+use crate::error::{CoulombError, Result};
+
+/// W in block CSR: block row i holds the tiles `W_ij` for `j in cols[row_ptr[i]..row_ptr[i+1]]`
+/// (sorted, the diagonal always among them), each `dim * dim` scalars row-major in `values`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BlockCsr {
+    dim: usize,
+    nc: usize,
+    row_ptr: Vec<usize>,
+    cols: Vec<usize>,
+    values: Vec<f64>,
+    /// per block row, the position of its diagonal tile in `cols`.
+    diag: Vec<usize>,
+}
+
+/// An entry source for [`BlockCsr::from_entries`]: yields `(row, col, value)` and can be
+/// replayed.
+trait Entries: Fn(&mut dyn FnMut(usize, usize, f64)) {}
+impl<F: Fn(&mut dyn FnMut(usize, usize, f64))> Entries for F {}
+
+fn index_of<I>(name: &str, k: usize, v: I, bound: usize) -> Result<usize>
+where
+    I: Copy + TryInto<usize> + std::fmt::Debug,
+{
+    match v.try_into() {
+        Ok(u) if u < bound => Ok(u),
+        _ => Err(CoulombError::Shape(format!(
+            "W's {name}[{k}] = {v:?} is out of range [0, {bound})"
+        ))),
+    }
+}
+
+fn check_dims(dim: usize, n: usize) -> Result<usize> {
+    if dim != 2 && dim != 3 {
+        return Err(CoulombError::InvalidParameter(format!(
+            "dim must be 2 (planar) or 3 (spatial), got {dim}"
+        )));
+    }
+    if n % dim != 0 {
+        return Err(CoulombError::Shape(format!(
+            "W is {n} x {n}, which is not a whole number of {dim} x {dim} contact blocks"
+        )));
+    }
+    Ok(n / dim)
+}
+
+fn check_data(data: &[f64]) -> Result<()> {
+    crate::error::check_finite("W's data", data)
+}
+
+/// checks a compressed pointer array: `ptr.len() == n + 1`, `ptr[0] = 0`, nondecreasing,
+/// `ptr[n] = nnz`.
+fn check_ptr<I: Copy + TryInto<usize> + std::fmt::Debug>(
+    name: &str,
+    ptr: &[I],
+    n: usize,
+    nnz: usize,
+) -> Result<Vec<usize>> {
+    if ptr.len() != n + 1 {
+        return Err(CoulombError::Shape(format!(
+            "W's {name} has {} entries, expected n + 1 = {}",
+            ptr.len(),
+            n + 1
+        )));
+    }
+    let mut out = Vec::with_capacity(n + 1);
+    let mut prev = 0usize;
+    for (k, &p) in ptr.iter().enumerate() {
+        let p = index_of(name, k, p, nnz + 1)?;
+        if (k == 0 && p != 0) || p < prev {
+            return Err(CoulombError::Shape(format!(
+                "W's {name} must start at 0 and be nondecreasing ({name}[{k}] = {p} after {prev})"
+            )));
+        }
+        prev = p;
+        out.push(p);
+    }
+    if prev != nnz {
+        return Err(CoulombError::Shape(format!(
+            "W's {name}[n] = {prev} but {nnz} entries are given"
+        )));
+    }
+    Ok(out)
+}
+
+impl BlockCsr {
+    /// From scalar CSR arrays of an `n x n` W (scipy's `indptr`, `indices`, `data`), in
+    /// `dim x dim` tiles. Indices need not be sorted; duplicates are summed.
+    pub fn from_csr<I>(
+        dim: usize,
+        n: usize,
+        indptr: &[I],
+        indices: &[I],
+        data: &[f64],
+    ) -> Result<Self>
+    where
+        I: Copy + TryInto<usize> + std::fmt::Debug,
+    {
+        let nc = check_dims(dim, n)?;
+        if indices.len() != data.len() {
+            return Err(CoulombError::Shape(format!(
+                "W's indices ({}) and data ({}) differ in length",
+                indices.len(),
+                data.len()
+            )));
+        }
+        let ptr = check_ptr("indptr", indptr, n, data.len())?;
+        let mut cols = Vec::with_capacity(indices.len());
+        for (k, &c) in indices.iter().enumerate() {
+            cols.push(index_of("indices", k, c, n)?);
+        }
+        check_data(data)?;
+        let entries = |f: &mut dyn FnMut(usize, usize, f64)| {
+            for r in 0..n {
+                for k in ptr[r]..ptr[r + 1] {
+                    f(r, cols[k], data[k]);
+                }
+            }
+        };
+        Self::from_entries(dim, nc, data.len(), &entries)
+    }
+
+    /// From scalar CSC arrays of an `n x n` W (`indptr` over columns, `indices` the rows).
+    pub fn from_csc<I>(
+        dim: usize,
+        n: usize,
+        indptr: &[I],
+        indices: &[I],
+        data: &[f64],
+    ) -> Result<Self>
+    where
+        I: Copy + TryInto<usize> + std::fmt::Debug,
+    {
+        let nc = check_dims(dim, n)?;
+        if indices.len() != data.len() {
+            return Err(CoulombError::Shape(format!(
+                "W's indices ({}) and data ({}) differ in length",
+                indices.len(),
+                data.len()
+            )));
+        }
+        let ptr = check_ptr("indptr", indptr, n, data.len())?;
+        let mut rows = Vec::with_capacity(indices.len());
+        for (k, &r) in indices.iter().enumerate() {
+            rows.push(index_of("indices", k, r, n)?);
+        }
+        check_data(data)?;
+        let entries = |f: &mut dyn FnMut(usize, usize, f64)| {
+            for c in 0..n {
+                for k in ptr[c]..ptr[c + 1] {
+                    f(rows[k], c, data[k]);
+                }
+            }
+        };
+        Self::from_entries(dim, nc, data.len(), &entries)
+    }
+
+    /// From scalar COO triplets `(rows[k], cols[k], data[k])` of an `n x n` W, in any order;
+    /// duplicates are summed.
+    pub fn from_coo<I>(dim: usize, n: usize, rows: &[I], cols: &[I], data: &[f64]) -> Result<Self>
+    where
+        I: Copy + TryInto<usize> + std::fmt::Debug,
+    {
+        let nc = check_dims(dim, n)?;
+        if rows.len() != data.len() || cols.len() != data.len() {
+            return Err(CoulombError::Shape(format!(
+                "W's row ({}), column ({}) and data ({}) arrays differ in length",
+                rows.len(),
+                cols.len(),
+                data.len()
+            )));
+        }
+        let mut rc = Vec::with_capacity(data.len());
+        for k in 0..data.len() {
+            rc.push((
+                index_of("row", k, rows[k], n)?,
+                index_of("col", k, cols[k], n)?,
+            ));
+        }
+        check_data(data)?;
+        let entries = |f: &mut dyn FnMut(usize, usize, f64)| {
+            for (&(r, c), &v) in rc.iter().zip(data) {
+                f(r, c, v);
+            }
+        };
+        Self::from_entries(dim, nc, data.len(), &entries)
+    }
+
+    /// From a dense row-major `n x n` W: only the tiles with a nonzero entry (and the diagonal
+    /// ones) are stored. O(n^2); for tests and small problems.
+    pub fn from_dense(dim: usize, n: usize, w: &[f64]) -> Result<Self> {
+        let nc = check_dims(dim, n)?;
+        if w.len() != n * n {
+            return Err(CoulombError::Shape(format!(
+                "W must be {n} x {n} ({} entries), got {} entries",
+                n * n,
+                w.len()
+            )));
+        }
+        check_data(w)?;
+        let nnz = w.iter().filter(|&&v| v != 0.0).count();
+        let entries = |f: &mut dyn FnMut(usize, usize, f64)| {
+            for r in 0..n {
+                for c in 0..n {
+                    let v = w[r * n + c];
+                    if v != 0.0 {
+                        f(r, c, v);
+                    }
+                }
+            }
+        };
+        Self::from_entries(dim, nc, nnz, &entries)
+    }
+
+    /// the bucketing described in the module notes; indices are already checked.
+    fn from_entries(dim: usize, nc: usize, nnz: usize, entries: &dyn Entries) -> Result<Self> {
+        // 1. bucket the entries by block row (counting sort)
+        let mut start = vec![0usize; nc + 1];
+        entries(&mut |r, _, _| start[r / dim + 1] += 1);
+        for i in 0..nc {
+            start[i + 1] += start[i];
+        }
+        let mut fill = start.clone();
+        // (block column, offset inside the tile, value)
+        let mut bucket = vec![(0usize, 0usize, 0.0f64); nnz];
+        entries(&mut |r, c, v| {
+            let i = r / dim;
+            bucket[fill[i]] = (c / dim, (r % dim) * dim + c % dim, v);
+            fill[i] += 1;
+        });
+        // 2. distinct block columns per block row, the diagonal always present
+        let mut mark = vec![usize::MAX; nc];
+        let mut row_ptr = Vec::with_capacity(nc + 1);
+        row_ptr.push(0);
+        let mut cols: Vec<usize> = Vec::new();
+        for i in 0..nc {
+            let first = cols.len();
+            mark[i] = i;
+            cols.push(i);
+            for &(j, _, _) in &bucket[start[i]..start[i + 1]] {
+                if mark[j] != i {
+                    mark[j] = i;
+                    cols.push(j);
+                }
+            }
+            cols[first..].sort_unstable();
+            row_ptr.push(cols.len());
+        }
+        // 3. sum the scalars into their tiles (pos: block column -> tile index, per row)
+        let bs = dim * dim;
+        let mut values = vec![0.0; cols.len() * bs];
+        let mut pos = vec![0usize; nc];
+        let mut diag = vec![0usize; nc];
+        for i in 0..nc {
+            for t in row_ptr[i]..row_ptr[i + 1] {
+                pos[cols[t]] = t;
+                if cols[t] == i {
+                    diag[i] = t;
+                }
+            }
+            for &(j, off, v) in &bucket[start[i]..start[i + 1]] {
+                values[pos[j] * bs + off] += v;
+            }
+        }
+        Ok(Self {
+            dim,
+            nc,
+            row_ptr,
+            cols,
+            values,
+            diag,
+        })
+    }
+
+    /// components per contact.
+    pub fn dim(&self) -> usize {
+        self.dim
+    }
+
+    /// number of contacts (block rows).
+    pub fn nc(&self) -> usize {
+        self.nc
+    }
+
+    /// stored tiles (the diagonal ones included).
+    pub fn nnz_blocks(&self) -> usize {
+        self.cols.len()
+    }
+
+    /// the block columns of block row i, sorted.
+    pub fn row_cols(&self, i: usize) -> &[usize] {
+        &self.cols[self.row_ptr[i]..self.row_ptr[i + 1]]
+    }
+
+    /// the tiles of block row i, `dim * dim` row-major scalars each, in [`Self::row_cols`]
+    /// order.
+    pub fn row_values(&self, i: usize) -> &[f64] {
+        let bs = self.dim * self.dim;
+        &self.values[self.row_ptr[i] * bs..self.row_ptr[i + 1] * bs]
+    }
+
+    /// the diagonal tile of contact i (`dim * dim` scalars, row-major).
+    pub fn diag_values(&self, i: usize) -> &[f64] {
+        let bs = self.dim * self.dim;
+        &self.values[self.diag[i] * bs..(self.diag[i] + 1) * bs]
+    }
+
+    /// the tile `W_ij` (`dim * dim` scalars), `None` when not stored (zero). O(log row length).
+    pub fn block(&self, i: usize, j: usize) -> Option<&[f64]> {
+        let bs = self.dim * self.dim;
+        let lo = self.row_ptr[i];
+        self.row_cols(i)
+            .binary_search(&j)
+            .ok()
+            .map(|k| &self.values[(lo + k) * bs..(lo + k + 1) * bs])
+    }
+
+    /// `Σ_j W_ij x_j` (when `skip_diag`, over `j != i`): the `dim` components of contact i,
+    /// zero-padded to 3. O(tiles in the row). Each component is summed left to right in column
+    /// order, as the dense row product does, so dense and block-sparse storage of the same W
+    /// give bitwise equal products.
+    #[inline]
+    pub fn row_mul(&self, i: usize, x: &[f64], skip_diag: bool) -> [f64; 3] {
+        let d = self.dim;
+        let mut out = [0.0; 3];
+        let (lo, hi) = (self.row_ptr[i], self.row_ptr[i + 1]);
+        if d == 3 {
+            for t in lo..hi {
+                let j = self.cols[t];
+                if skip_diag && j == i {
+                    continue;
+                }
+                let b = &self.values[t * 9..t * 9 + 9];
+                let xj = &x[3 * j..3 * j + 3];
+                for (a, o) in out.iter_mut().enumerate() {
+                    *o += b[3 * a] * xj[0];
+                    *o += b[3 * a + 1] * xj[1];
+                    *o += b[3 * a + 2] * xj[2];
+                }
+            }
+        } else {
+            for t in lo..hi {
+                let j = self.cols[t];
+                if skip_diag && j == i {
+                    continue;
+                }
+                let b = &self.values[t * 4..t * 4 + 4];
+                let xj = &x[2 * j..2 * j + 2];
+                out[0] += b[0] * xj[0];
+                out[0] += b[1] * xj[1];
+                out[1] += b[2] * xj[0];
+                out[1] += b[3] * xj[1];
+            }
+        }
+        out
+    }
+
+    /// `out = W x`, O(nnz).
+    pub fn mul(&self, x: &[f64], out: &mut [f64]) {
+        let d = self.dim;
+        for i in 0..self.nc {
+            let o = self.row_mul(i, x, false);
+            out[i * d..(i + 1) * d].copy_from_slice(&o[..d]);
+        }
+    }
+
+    /// the dense row-major `(dim nc)^2` matrix (for tests and small problems).
+    pub fn to_dense(&self) -> Vec<f64> {
+        let d = self.dim;
+        let n = d * self.nc;
+        let mut w = vec![0.0; n * n];
+        for i in 0..self.nc {
+            for (k, &j) in self.row_cols(i).iter().enumerate() {
+                let b = &self.row_values(i)[k * d * d..(k + 1) * d * d];
+                for a in 0..d {
+                    for c in 0..d {
+                        w[(i * d + a) * n + j * d + c] = b[a * d + c];
+                    }
+                }
+            }
+        }
+        w
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testing::SplitMix64;
+
+    fn random_sparse(n: usize, density: f64, seed: u64) -> Vec<f64> {
+        let mut rng = SplitMix64::new(seed);
+        (0..n * n)
+            .map(|_| {
+                if rng.uniform() < density {
+                    rng.normal()
+                } else {
+                    0.0
+                }
+            })
+            .collect()
+    }
+
+    fn csr_of(n: usize, w: &[f64]) -> (Vec<i64>, Vec<i64>, Vec<f64>) {
+        let mut ptr = vec![0i64];
+        let (mut idx, mut val) = (Vec::new(), Vec::new());
+        for r in 0..n {
+            // reversed column order: unsorted input
+            for c in (0..n).rev() {
+                if w[r * n + c] != 0.0 {
+                    idx.push(c as i64);
+                    val.push(w[r * n + c]);
+                }
+            }
+            ptr.push(idx.len() as i64);
+        }
+        (ptr, idx, val)
+    }
+
+    #[test]
+    fn csr_csc_coo_and_dense_agree_and_round_trip() {
+        for (dim, nc, seed) in [(3, 7, 1), (2, 9, 2), (3, 1, 3), (2, 4, 4)] {
+            let n = dim * nc;
+            let w = random_sparse(n, 0.15, seed);
+            let (ptr, idx, val) = csr_of(n, &w);
+            let a = BlockCsr::from_csr(dim, n, &ptr, &idx, &val).unwrap();
+            assert_eq!(a.to_dense(), w);
+            // CSC of W is CSR of W^T
+            let wt: Vec<f64> = (0..n * n).map(|k| w[(k % n) * n + k / n]).collect();
+            let (cptr, cidx, cval) = csr_of(n, &wt);
+            let b = BlockCsr::from_csc(dim, n, &cptr, &cidx, &cval).unwrap();
+            assert_eq!(b.to_dense(), w);
+            // COO with duplicates: every entry split in two halves, shuffled order
+            let (mut rows, mut cols, mut data) = (Vec::new(), Vec::new(), Vec::new());
+            for k in (0..n * n).rev() {
+                if w[k] != 0.0 {
+                    for _ in 0..2 {
+                        rows.push((k / n) as i32);
+                        cols.push((k % n) as i32);
+                        data.push(0.5 * w[k]);
+                    }
+                }
+            }
+            let c = BlockCsr::from_coo(dim, n, &rows, &cols, &data).unwrap();
+            assert_eq!(c.to_dense(), w);
+            let d = BlockCsr::from_dense(dim, n, &w).unwrap();
+            assert_eq!(a, d);
+            assert_eq!(a, c);
+            // every diagonal tile is stored, sorted columns
+            for i in 0..nc {
+                assert!(a.row_cols(i).contains(&i));
+                assert!(a.row_cols(i).windows(2).all(|p| p[0] < p[1]));
+            }
+            // products
+            let mut rng = SplitMix64::new(seed + 100);
+            let x: Vec<f64> = (0..n).map(|_| rng.normal()).collect();
+            let mut y = vec![0.0; n];
+            a.mul(&x, &mut y);
+            for r in 0..n {
+                let e: f64 = (0..n).map(|c| w[r * n + c] * x[c]).sum();
+                assert!((y[r] - e).abs() <= 1e-13 * (1.0 + e.abs()));
+            }
+        }
+    }
+
+    #[test]
+    fn an_empty_matrix_keeps_zero_diagonal_tiles() {
+        let a = BlockCsr::from_csr::<i32>(3, 6, &[0; 7], &[], &[]).unwrap();
+        assert_eq!(a.nnz_blocks(), 2);
+        assert_eq!(a.diag_values(1), &[0.0; 9]);
+        assert!(a.block(0, 1).is_none());
+        assert_eq!(a.to_dense(), vec![0.0; 36]);
+    }
+
+    #[test]
+    fn bad_arrays_are_refused() {
+        let ptr = [0i64, 1, 2, 2, 3];
+        let idx = [0i64, 1, 3];
+        let val = [1.0, 2.0, 3.0];
+        assert!(BlockCsr::from_csr(2, 4, &ptr, &idx, &val).is_ok());
+        let shape = |r: Result<BlockCsr>| matches!(r, Err(CoulombError::Shape(_)));
+        // n not a multiple of dim
+        assert!(shape(BlockCsr::from_csr(3, 4, &ptr, &idx, &val)));
+        // index out of range, negative index
+        assert!(shape(BlockCsr::from_csr(2, 4, &ptr, &[0, 1, 4], &val)));
+        assert!(shape(BlockCsr::from_csr(2, 4, &ptr, &[0, -1, 3], &val)));
+        // indptr: wrong length, decreasing, wrong end, not starting at 0
+        assert!(shape(BlockCsr::from_csr(2, 4, &ptr[..4], &idx, &val)));
+        assert!(shape(BlockCsr::from_csr(
+            2,
+            4,
+            &[0, 2, 1, 2, 3],
+            &idx,
+            &val
+        )));
+        assert!(shape(BlockCsr::from_csr(
+            2,
+            4,
+            &[0, 1, 2, 2, 2],
+            &idx,
+            &val
+        )));
+        assert!(shape(BlockCsr::from_csr(
+            2,
+            4,
+            &[1, 1, 2, 2, 3],
+            &idx,
+            &val
+        )));
+        // lengths
+        assert!(shape(BlockCsr::from_csr(2, 4, &ptr, &idx[..2], &val)));
+        assert!(shape(BlockCsr::from_coo(2, 4, &idx, &idx[..2], &val)));
+        assert!(shape(BlockCsr::from_coo(2, 4, &[0, 1, 9], &idx, &val)));
+        assert!(matches!(
+            BlockCsr::from_csr(2, 4, &ptr, &idx, &[1.0, f64::NAN, 0.0]),
+            Err(CoulombError::NonFinite(_))
+        ));
+        assert!(matches!(
+            BlockCsr::from_csr(4, 4, &ptr, &idx, &val),
+            Err(CoulombError::InvalidParameter(_))
+        ));
+        assert!(shape(BlockCsr::from_dense(2, 4, &[0.0; 15])));
+    }
+}
