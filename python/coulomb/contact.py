@@ -273,8 +273,14 @@ def solve(
         raise InvalidParameterError(f"relaxation must lie in (0, 2), got {relaxation}")
     if method == "prox":
         out = _core.contact_solve_prox(
-            Wa, qa, mua, dim, float(tol), None if max_iter is None else int(max_iter),
-            1.0 if eta is None else float(eta), init,
+            Wa,
+            qa,
+            mua,
+            dim,
+            float(tol),
+            None if max_iter is None else int(max_iter),
+            1.0 if eta is None else float(eta),
+            init,
         )
         return ContactResult(out)
     out = _core.contact_solve(
