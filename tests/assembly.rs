@@ -1,6 +1,7 @@
 //! `contact::assembly`: W = G^T M^-1 G, q = G^T v_free + w and v = v_free + M^-1 G r against
 //! Gaussian elimination, for diagonal, block-diagonal and coupled (sparse Cholesky) M; M not
 //! positive definite is refused naming M.
+#![allow(clippy::needless_range_loop)]
 
 use coulomb::contact::assembly::{
     assemble, post_velocity, FreeMotion, MassFactor, Triplets, DENSE_BLOCK_MAX,
