@@ -43,4 +43,27 @@ def contact_solve(
     mu_pair: NDArray[np.float64] | None = None,
 ) -> dict[str, Any]: ...
 def read_siconos_fc(path: str) -> dict[str, Any]: ...
+def contact_solve_prox(
+    w: NDArray[np.float64],
+    q: NDArray[np.float64],
+    mu: NDArray[np.float64],
+    dim: int,
+    tol: float,
+    max_iter: int | None = None,
+    eta: float = 1.0,
+    initial: NDArray[np.float64] | None = None,
+) -> dict[str, Any]: ...
+
+_Triplets = tuple[int, int, NDArray[np.int64], NDArray[np.int64], NDArray[np.float64]]
+
+def contact_assemble(
+    m: _Triplets,
+    g: _Triplets,
+    v_free: NDArray[np.float64] | None = None,
+    force: NDArray[np.float64] | None = None,
+    extra: NDArray[np.float64] | None = None,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]: ...
+def contact_post_velocity(
+    m: _Triplets, g: _Triplets, v_free: NDArray[np.float64], r: NDArray[np.float64]
+) -> NDArray[np.float64]: ...
 def simd_level() -> str: ...

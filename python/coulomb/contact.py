@@ -41,6 +41,18 @@ Methods:
     them. The measures below are still taken against the exact disk, so in 3D ``error``
     reflects the facet approximation (it shrinks as ``facets`` grows, not monotonically: a
     sliding contact's impulse snaps to a facet).
+``"prox"`` (the robust mode)
+    A proximal-point semismooth Newton method on the natural map (Rust ``contact::prox``):
+    each iteration is one Newton step on the proximal subproblem ``W + eta I`` centred at the
+    current impulses, with a line search and ``eta`` adapted (``eta`` is relative to W's mean
+    diagonal; default 1), restarted from NSGS sweeps when it makes no progress. For the
+    problems where NSGS stalls at tight tolerances (redundant contacts, FCLib BoxesStack and
+    OneObject). ``success`` means ``error_q <= tol`` (which implies ``error <= tol``);
+    ``iterations`` counts Newton steps (each one sparse LU factorization); ``max_iter`` defaults
+    to 200; ``initial`` warm-starts it.
+
+The contact problem of a mechanism (mass matrix M, contact directions G, free velocity) is
+built by :func:`assemble` and the velocity after the impulses given by :func:`post_velocity`.
 
 Every answer is measured on the original data (W, q, mu):
 
@@ -80,14 +92,15 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core
+from ._assembly import assemble, post_velocity
 from ._result import Result
 from .errors import InvalidInputError, InvalidParameterError, NonFiniteError, ShapeError
 from .lcp import _as_array
 
-__all__ = ["ContactResult", "solve"]
+__all__ = ["ContactResult", "assemble", "post_velocity", "solve"]
 
-Method = Literal["nsgs", "lemke"]
-_METHODS = ("nsgs", "lemke")
+Method = Literal["nsgs", "lemke", "prox"]
+_METHODS = ("nsgs", "lemke", "prox")
 
 
 class ContactResult(Result):
@@ -146,6 +159,7 @@ def solve(
     relaxation: float = 1.0,
     initial: ArrayLike | None = None,
     facets: int | None = None,
+    eta: float | None = None,
 ) -> ContactResult:
     """Solve the friction-contact problem ``u = W r + q`` with Coulomb's law at every contact.
 
@@ -168,8 +182,8 @@ def solve(
         pairs with ``mu_1 != mu_2`` with InvalidParameterError).
     dim : {2, 3}
         Components per contact.
-    method : {"nsgs", "lemke"}
-        See the module documentation.
+    method : {"nsgs", "lemke", "prox"}
+        See the module documentation (``"prox"`` is the robust mode).
     tol : float
         Tolerance on ``error`` for ``success`` (``"nsgs"``), or on Lemke's LCP error measures
         (``"lemke"``).
@@ -184,6 +198,9 @@ def solve(
     facets : int, optional
         ``"lemke"`` only: tangent directions per frictional contact, in +/- pairs: even and at
         least 4 in 3D (default 8); exactly 2 in 2D (the default, and exact).
+    eta : float, optional
+        ``"prox"`` only: the initial proximal parameter relative to W's mean diagonal (> 0,
+        default 1).
 
     Returns
     -------
@@ -201,9 +218,15 @@ def solve(
     dim = int(dim)
     if method not in _METHODS:
         raise InvalidParameterError(
-            f"unknown method {method!r}: expected 'nsgs' (exact friction disk) or 'lemke' "
-            "(polyhedral cone)"
+            f"unknown method {method!r}: expected 'nsgs' (exact friction disk), 'lemke' "
+            "(polyhedral cone) or 'prox' (robust mode)"
         )
+    if method == "prox" and relaxation != 1.0:
+        raise InvalidParameterError("relaxation applies to method='nsgs' only")
+    if method != "prox" and eta is not None:
+        raise InvalidParameterError("eta applies to method='prox' only")
+    if eta is not None and not (np.isfinite(eta) and eta > 0):
+        raise InvalidParameterError(f"eta must be a positive finite number, got {eta}")
     if method == "lemke":
         if initial is not None:
             raise InvalidParameterError(
@@ -250,6 +273,18 @@ def solve(
         raise InvalidParameterError(f"max_iter must be at least 1, got {max_iter}")
     if not 0 < relaxation < 2:
         raise InvalidParameterError(f"relaxation must lie in (0, 2), got {relaxation}")
+    if method == "prox":
+        out = _core.contact_solve_prox(
+            Wa,
+            qa,
+            mua,
+            dim,
+            float(tol),
+            None if max_iter is None else int(max_iter),
+            1.0 if eta is None else float(eta),
+            init,
+        )
+        return ContactResult(out)
     out = _core.contact_solve(
         Wa,
         qa,

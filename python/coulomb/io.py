@@ -2,23 +2,29 @@
 
 The Siconos text format is read by the Rust core (``coulomb._core``); see
 ``../shared/data/siconos-lcp/SOURCE.md`` and ``../shared/data/siconos-fc/SOURCE.md`` for the
-layout (dense column-major, sparse-block and CSparse storage).
+layout (dense column-major, sparse-block and CSparse storage). FCLib's HDF5 files are read by
+:func:`read_fclib` with h5py (the optional extra ``coulomb[hdf5]``); the layout is described
+in ``../shared/data/fclib/SOURCE.md``.
 """
 
 from __future__ import annotations
 
 import os
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from . import _core
+from ._assembly import assemble
+from .errors import ProblemFormatError
 
 __all__ = [
     "FrictionContactProblem",
     "GlobalFrictionContactProblem",
     "LcpProblem",
+    "read_fclib",
     "read_siconos_fc",
     "read_siconos_lcp",
 ]
@@ -56,12 +62,13 @@ def _name(path: str | os.PathLike[str]) -> str:
 class FrictionContactProblem:
     """A local friction-contact problem ``u = W r + q`` with Coulomb's law at each contact.
 
-    ``W`` is dense ``(dim nc, dim nc)``, ``q`` has ``dim nc`` entries (contact by contact,
-    normal first) and ``mu`` one per contact. Solve it with
-    ``coulomb.contact.solve(p.W, p.q, p.mu, p.dim)``.
+    ``W`` is ``(dim nc, dim nc)``: a dense array from :func:`read_siconos_fc`, a
+    ``scipy.sparse.csr_matrix`` from :func:`read_fclib`; ``q`` has ``dim nc`` entries (contact
+    by contact, normal first) and ``mu`` one per contact. Solve it with
+    ``coulomb.contact.solve(p.W, p.q, p.mu, p.dim)`` (a sparse W is densified there for now).
     """
 
-    W: NDArray[np.float64]
+    W: Any
     q: NDArray[np.float64]
     mu: NDArray[np.float64]
     dim: int
@@ -110,3 +117,161 @@ def read_siconos_fc(
     return FrictionContactProblem(
         W=d["W"], q=d["q"], mu=d["mu"], dim=int(d["dim"]), name=_name(path)
     )
+
+
+def _fclib_matrix(group: Any, name: str, path: str) -> Any:
+    """A CSparse matrix group of an FCLib file as a scipy.sparse CSR matrix (``nz >= 0``:
+    triplets with i = row, p = column; ``nz = -1``: CSC; ``nz = -2``: CSR)."""
+    import scipy.sparse as sp
+
+    try:
+        g = group[name]
+        nz = int(g["nz"][0])
+        m = int(g["m"][0])
+        n = int(g["n"][0])
+        p = np.asarray(g["p"][:], dtype=np.int64)
+        i = np.asarray(g["i"][:], dtype=np.int64)
+        x = np.asarray(g["x"][:], dtype=np.float64)
+    except (KeyError, IndexError, TypeError, ValueError) as exc:
+        raise ProblemFormatError(f"{path}: matrix {name} is missing or malformed: {exc}") from None
+    try:
+        if nz >= 0:
+            if min(len(p), len(i), len(x)) < nz:
+                raise ValueError(f"fewer than nz = {nz} stored entries")
+            mat = sp.coo_matrix((x[:nz], (i[:nz], p[:nz])), shape=(m, n)).tocsr()
+        elif nz == -1:
+            mat = sp.csc_matrix((x[: p[-1]], i[: p[-1]], p), shape=(m, n)).tocsr()
+        elif nz == -2:
+            mat = sp.csr_matrix((x[: p[-1]], i[: p[-1]], p), shape=(m, n))
+        else:
+            raise ValueError(f"unknown storage nz = {nz}")
+        mat.check_format(full_check=True)
+    except (ValueError, IndexError) as exc:
+        raise ProblemFormatError(f"{path}: matrix {name}: {exc}") from None
+    if not np.isfinite(mat.data).all():
+        raise ProblemFormatError(f"{path}: matrix {name} has NaN or infinite entries")
+    mat.sum_duplicates()
+    return mat
+
+
+def _fclib_vector(group: Any, name: str, n: int, path: str) -> NDArray[np.float64]:
+    try:
+        v = np.asarray(group["vectors"][name][:], dtype=np.float64).reshape(-1)
+    except (KeyError, TypeError, ValueError) as exc:
+        raise ProblemFormatError(f"{path}: vector {name} is missing or malformed: {exc}") from None
+    if v.shape[0] != n:
+        raise ProblemFormatError(f"{path}: vector {name} has {v.shape[0]} entries, expected {n}")
+    if not np.isfinite(v).all():
+        raise ProblemFormatError(f"{path}: vector {name} has NaN or infinite entries")
+    return v
+
+
+def _symmetric_from_triangle(M: Any) -> Any:
+    """LMGC90 writes a symmetric M by one triangle only: when every off-diagonal entry lies
+    strictly in one triangle, return ``T + T^T - diag(T)``; otherwise M unchanged."""
+    import scipy.sparse as sp
+
+    coo = M.tocoo()
+    off = coo.row != coo.col
+    if not off.any():
+        return M
+    upper = coo.row[off] < coo.col[off]
+    if upper.all() or not upper.any():
+        return (M + M.T - sp.diags(M.diagonal())).tocsr()
+    return M
+
+
+def read_fclib(path: str | os.PathLike[str]) -> FrictionContactProblem:
+    """Read an FCLib HDF5 friction-contact problem as a local problem ``u = W r + q``.
+
+    - ``/fclib_local``: W as stored (triplet, CSC or CSR), returned as a
+      ``scipy.sparse.csr_matrix``; q and mu as stored.
+    - ``/fclib_global`` (``M v = H r + f``, ``u = H^T v + w``): reduced to the local problem
+      ``W = H^T M^-1 H``, ``q = H^T M^-1 f + w`` by :func:`coulomb.contact.assemble` (Cholesky
+      of M in Rust; W returned as CSR). An M stored by one triangle only (as LMGC90 writes it)
+      is completed symmetrically first. Global problems with equality constraints (a G
+      matrix) are refused.
+    - ``/fclib_global_rolling`` (rolling friction) and local problems with equality
+      multipliers (V, R) are refused: coulomb does not model them.
+
+    ``dim`` is FCLib's spacedim (2 or 3). The name is the file's stem.
+
+    Raises
+    ------
+    ImportError
+        When h5py (the optional extra ``coulomb[hdf5]``) or scipy is missing.
+    FileNotFoundError
+        For a missing file.
+    coulomb.errors.ProblemFormatError
+        For a file that is not a readable FCLib problem, or one of the unsupported kinds above.
+    """
+    try:
+        import h5py
+    except ImportError as exc:
+        raise ImportError(
+            "reading FCLib files needs h5py: install the optional extra, "
+            "pip install 'coulomb[hdf5]'"
+        ) from exc
+    try:
+        import scipy.sparse  # noqa: F401
+    except ImportError as exc:
+        raise ImportError("reading FCLib files needs scipy (pip install scipy)") from exc
+    p = os.fspath(path)
+    if not os.path.exists(p):
+        raise FileNotFoundError(p)
+    try:
+        f = h5py.File(p, "r")
+    except OSError as exc:
+        raise ProblemFormatError(f"{p}: not an HDF5 file: {exc}") from None
+    with f:
+        if "fclib_global_rolling" in f:
+            raise ProblemFormatError(
+                f"{p}: rolling-friction problems (fclib_global_rolling) are not supported"
+            )
+        kinds = [k for k in ("fclib_local", "fclib_global") if k in f]
+        if not kinds:
+            raise ProblemFormatError(
+                f"{p}: no fclib_local or fclib_global group (found {sorted(f.keys())})"
+            )
+        kind = kinds[0]
+        g = f[kind]
+        try:
+            dim = int(g["spacedim"][0])
+        except (KeyError, IndexError, TypeError, ValueError) as exc:
+            raise ProblemFormatError(f"{p}: spacedim is missing or malformed: {exc}") from None
+        if dim not in (2, 3):
+            raise ProblemFormatError(f"{p}: spacedim must be 2 or 3, got {dim}")
+        if kind == "fclib_local":
+            if "V" in g or "R" in g:
+                raise ProblemFormatError(
+                    f"{p}: local problems with equality multipliers (V, R) are not supported"
+                )
+            W = _fclib_matrix(g, "W", p)
+            m = W.shape[0]
+            if W.shape != (m, m) or m % dim != 0:
+                raise ProblemFormatError(f"{p}: W has shape {W.shape}, not square of dim * nc")
+            q = _fclib_vector(g, "q", m, p)
+            mu = _fclib_vector(g, "mu", m // dim, p)
+        else:
+            if "G" in g:
+                raise ProblemFormatError(
+                    f"{p}: global problems with equality constraints (G) are not supported"
+                )
+            M = _fclib_matrix(g, "M", p)
+            M = _symmetric_from_triangle(M)
+            H = _fclib_matrix(g, "H", p)
+            ndof, m = H.shape
+            if M.shape != (ndof, ndof) or m % dim != 0:
+                raise ProblemFormatError(
+                    f"{p}: M {M.shape} and H {H.shape} do not fit (M ndof x ndof, H ndof x dim nc)"
+                )
+            force = _fclib_vector(g, "f", ndof, p)
+            w = _fclib_vector(g, "w", m, p)
+            mu = _fclib_vector(g, "mu", m // dim, p)
+            import scipy.sparse as sp
+
+            Wd, q = assemble(M, H, force=force, extra=w)
+            W = sp.csr_matrix(Wd)
+    if (mu < 0).any():
+        raise ProblemFormatError(f"{p}: negative friction coefficient")
+    return FrictionContactProblem(W=W, q=q, mu=mu, dim=dim, name=_name(p))

@@ -3,6 +3,8 @@
 //! each error kind into its own Python exception (defined in `coulomb.errors`), and add no
 //! numerics of their own.
 
+mod contact_extra;
+
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
 
@@ -595,6 +597,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(contact_solve, m)?)?;
     m.add_function(wrap_pyfunction!(read_siconos_fc, m)?)?;
     m.add_function(wrap_pyfunction!(simd_level, m)?)?;
+    contact_extra::register(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }
