@@ -39,3 +39,15 @@ def contact_solve(
 ) -> dict[str, Any]: ...
 def read_siconos_fc(path: str) -> dict[str, Any]: ...
 def simd_level() -> str: ...
+def step_simulate(
+    scene: dict[str, Any],
+    h: float,
+    steps: int,
+    solver: str = "nsgs",
+    tol: float = 1e-12,
+    max_iter: int | None = None,
+    relaxation: float = 1.0,
+    facets: int | None = None,
+    gap_tolerance: float = 1e-9,
+    warm_start: bool = True,
+) -> dict[str, Any]: ...

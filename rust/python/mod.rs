@@ -14,6 +14,8 @@ use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyDict, PyType};
 
+mod step;
+
 use crate::contact::{self, ContactProblem, ContactSolution, NsgsSettings, PolyhedralSettings};
 use crate::error::CoulombError;
 use crate::io::siconos::{NumericsMatrix, SiconosFcFile};
@@ -498,6 +500,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(contact_solve, m)?)?;
     m.add_function(wrap_pyfunction!(read_siconos_fc, m)?)?;
     m.add_function(wrap_pyfunction!(simd_level, m)?)?;
+    step::register(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }
