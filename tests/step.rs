@@ -482,3 +482,19 @@ fn bad_scenes_are_refused() {
     assert!(simulate(&good, &StepSettings::new(0.0, 1)).is_err());
     assert!(simulate(&good, &StepSettings::new(-1e-3, 1)).is_err());
 }
+
+/// A frictionless contact found by the search but not closing within the step must get a
+/// zero impulse and a solved status, and leave free flight untouched (nothing is applied to
+/// distant bodies). Regression: the contact solvers' natural-map measure misjudged such a
+/// step (mu = 0, zero tangential velocity) and NSGS ran to its iteration limit.
+#[test]
+fn imminent_frictionless_contact_that_does_not_close_gets_nothing() {
+    let h = 1e-3;
+    let body = particle(2, 1.0, &[0.0, 0.0015], &[0.0, -1.0]);
+    let scene = point_on_plane(2, body, &[0.0, -G], &[0.0, 1.0], 0.0, 0.5);
+    let tr = run(&scene, h, h);
+    assert_eq!(tr.steps[0].active, 1);
+    assert_eq!(tr.steps[0].status, Some(ContactStatus::Solved));
+    assert_eq!(tr.contacts[0].impulse, [0.0; 3]);
+    assert_eq!(v_at(&tr, 1)[1], -1.0 - G * h);
+}

@@ -166,3 +166,38 @@ def test_plot_draws_three_panels():
 def test_exported_names():
     for name in ("Scene", "Particle", "RigidBody2D", "RigidBody3D", "HalfSpace", "Trajectory"):
         assert hasattr(coulomb, name)
+
+
+def test_simulate_releases_the_gil():
+    import sys
+    import threading
+
+    from coulomb import _core
+
+    scene = Scene(dim=3)
+    cube = scene.add(RigidBody3D(mass=2.0, inertia=(1 / 3, 1 / 3, 1 / 3),
+                                 position=(0.0, 0.0, 0.5)))
+    floor = scene.add(HalfSpace((0, 0, 0), (0, 0, 1)))
+    scene.contact(scene.attach(cube, Box((0.5, 0.5, 0.5))), floor, mu=0.5)
+    spec = scene._spec()
+    counter = [0]
+    seen = {}
+
+    def run():
+        seen["before"] = counter[0]
+        seen["result"] = _core.step_simulate(spec, 1e-3, 40_000)
+        seen["after"] = counter[0]
+
+    # see test_gil.py: a GIL-holding call of this length lets the main thread count to ~600
+    old = sys.getswitchinterval()
+    sys.setswitchinterval(1e-4)
+    try:
+        t = threading.Thread(target=run)
+        t.start()
+        while t.is_alive():
+            counter[0] += 1
+        t.join()
+    finally:
+        sys.setswitchinterval(old)
+    assert seen["result"]["stopped"] is None
+    assert seen["after"] - seen["before"] > 20_000
