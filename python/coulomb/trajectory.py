@@ -43,7 +43,7 @@ class Trajectory(Result):
     """States, impulses and per-step checks of a simulation (see the module documentation)."""
 
     @classmethod
-    def _from_core(cls, raw: dict[str, Any], scene: Scene, h: float, solver: str,
+    def _from_core(cls, raw: dict[str, Any], scene: Scene | None, h: float, solver: str,
                    gap_tolerance: float) -> Trajectory:
         tr = cls(raw)
         tr["gap_tolerance"] = gap_tolerance
@@ -61,6 +61,8 @@ class Trajectory(Result):
 
     def body(self, index: int) -> Result:
         """Coordinates ``q`` and velocities ``v`` of one body (in the order added)."""
+        if self._scene is None:
+            raise TypeError("body() needs a Scene; a generalized-coordinate Model has none")
         sq, sv = self._scene.layout()[index]
         return Result(q=self["q"][:, sq], v=self["v"][:, sv])
 
@@ -78,7 +80,8 @@ class Trajectory(Result):
         lines = [
             f"Trajectory({n} steps of h = {self['h']:.3g} s to t = {self['t'][-1]:.6g} s, "
             f"solver {self['solver']!r}",
-            f"  bodies: {len(self._scene.bodies)}, q: {self['q'].shape}, v: {self['v'].shape}",
+            f"  bodies: {len(self._scene.bodies) if self._scene else 'generalized model'}, "
+            f"q: {self['q'].shape}, v: {self['v'].shape}",
             f"  contact records: {len(self['contact_step'])}, steps by status: {{{st}}}",
             f"  min gap: {np.min(self['min_gap']):.3e} m, energy: "
             f"{self['total_energy'][0]:.6g} J -> {self['total_energy'][-1]:.6g} J",
@@ -160,8 +163,8 @@ class Trajectory(Result):
         if np.any(cone > impulse_tol * scale):
             v.append(f"friction cone violated by up to {cone.max():.3e} N s")
         # velocities at contacts are of the size of |v| or of what one step of the loads adds
-        vel = max(float(np.max(np.abs(self["v"]), initial=0.0)),
-                  float(np.linalg.norm(self._scene.gravity)) * self["h"])
+        gravity = float(np.linalg.norm(self._scene.gravity)) if self._scene else 0.0
+        vel = max(float(np.max(np.abs(self["v"]), initial=0.0)), gravity * self["h"])
         comp = self["complementarity"]
         if np.any(comp > complementarity_tol * max(scale * vel, 1e-300)):
             v.append(f"complementarity product up to {comp.max():.3e}")
