@@ -30,7 +30,7 @@ def main() -> None:
         gain = float(np.max(np.diff(tr.total_energy)))
         print(f"  h = {h:6.0e}: P_n = {pn:.5f}, P_t = {pt:.5f}, end slip after step 1 "
               f"{slip:.1e} m/s, largest energy change per step {gain:+.1e} J, "
-              f"solver statuses {sorted(set(tr.status))}")
+              f"solver statuses {sorted(set(tr.solver_status))}")
     print(tr.check())
 
 

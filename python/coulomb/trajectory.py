@@ -7,7 +7,8 @@ States (``N + 1`` rows, times ``t_0 .. t_N``): ``t``, ``q``, ``v``, ``kinetic_en
 candidates are below ``-gap_tolerance``).
 
 Steps (``N`` rows, step k from ``t_k`` to ``t_{k+1}``): ``active`` contacts, the contact
-solver's ``status``, ``error`` and ``iterations``, ``momentum_residual``
+solver's ``solver_status`` (``"no_contact"`` when none was active), ``solver_error`` and
+``iterations``, ``momentum_residual``
 (``||M (v_{k+1} - v_free) - G P||`` over ``max(||G P||, ||M v_free||, ||M v_{k+1}||)``),
 ``min_normal_impulse``, ``cone_violation``
 (``max(||P_t|| - mu P_n, 0)``), ``complementarity`` (``max |P_n (J_n v_{k+1} + e v_n^-)|``,
@@ -18,6 +19,9 @@ Contacts (one row per active contact per step): ``contact_step``, ``contact_id``
 steps: the candidate pair of features), ``contact_impulse`` (normal first, N s),
 ``contact_velocity`` (``J v_{k+1}`` in the contact frame), ``contact_approach``,
 ``contact_gap`` and ``contact_closed``.
+
+Like every coulomb result it has ``success``, ``status`` (``"completed"``,
+``"solver_failures"`` or ``"stopped"``) and a one-line ``message``.
 """
 
 from __future__ import annotations
@@ -50,10 +54,18 @@ class Trajectory(Result):
         tr["total_energy"] = tr["kinetic_energy"] + tr["potential_energy"]
         tr["h"] = h
         tr["solver"] = solver
-        tr["status"] = np.asarray(tr["status"], dtype=object)
-        tr["success"] = tr["stopped"] is None and all(
-            s in ("solved", "no_contact") for s in tr["status"]
-        )
+        tr["solver_status"] = np.asarray(tr.pop("status"), dtype=object)
+        tr["solver_error"] = tr.pop("error")
+        failed = int(np.sum([s not in ("solved", "no_contact") for s in tr["solver_status"]]))
+        n = len(tr["t"]) - 1
+        if tr["stopped"] is not None:
+            tr["status"], tr["message"] = "stopped", f"stopped early: {tr['stopped']}"
+        elif failed:
+            tr["status"] = "solver_failures"
+            tr["message"] = f"{n} steps; {failed} contact solves missed their tolerance"
+        else:
+            tr["status"], tr["message"] = "completed", f"{n} steps, every contact solve solved"
+        tr["success"] = tr["status"] == "completed"
         object.__setattr__(tr, "_scene", scene)
         return tr
 
@@ -74,7 +86,7 @@ class Trajectory(Result):
 
     def __repr__(self) -> str:
         n = len(self["t"]) - 1
-        statuses, counts = np.unique(self["status"], return_counts=True)
+        statuses, counts = np.unique(self["solver_status"], return_counts=True)
         st = ", ".join(f"{s}: {c}" for s, c in zip(statuses, counts, strict=True))
         worst = self._worst()
         lines = [
@@ -101,7 +113,7 @@ class Trajectory(Result):
 
         return {
             "momentum_residual": mx(self["momentum_residual"]),
-            "solver_error": mx(self["error"]),
+            "solver_error": mx(self["solver_error"]),
             "cone_violation": mx(self["cone_violation"]),
             "complementarity": mx(self["complementarity"]),
             "energy_gain": float(np.max(self.energy_gain(), initial=0.0)),
@@ -147,11 +159,12 @@ class Trajectory(Result):
         for name in ("q", "v", "contact_impulse"):
             if not np.all(np.isfinite(self[name])):
                 v.append(f"{name} has non-finite values")
-        bad = [(k, s) for k, s in enumerate(self["status"]) if s not in ("solved", "no_contact")]
+        bad = [(k, s) for k, s in enumerate(self["solver_status"])
+               if s not in ("solved", "no_contact")]
         if bad:
             k, s = bad[0]
             v.append(f"{len(bad)} contact solves did not succeed (first: step {k}, {s}, "
-                     f"error {self['error'][k]:.2e})")
+                     f"error {self['solver_error'][k]:.2e})")
         scale = float(np.max(np.abs(self["contact_impulse"]), initial=0.0))
         res = self["momentum_residual"]
         if np.any(res > momentum_tol):

@@ -141,14 +141,19 @@ def test_solver_options_pass_through():
     b = scene.simulate(0.05, 1e-3, solver="nsgs", max_iter=3, warm_start=False)
     assert a.success
     assert a.check().ok
-    # three sweeps are not enough for four coupled corners: the status says so
-    assert not b.success or np.all(b.iterations <= 3)
+    # three cold sweeps are not enough for four coupled sliding corners: the status says so
+    assert np.all(b.iterations <= 3)
+    assert (b.success, b.status) == (False, "solver_failures")
+    assert set(b.solver_status) == {"iteration_limit"}
+    assert any("contact solves did not succeed" in v for v in b.check().violations)
     with pytest.raises(InvalidParameterError):
         scene.simulate(0.05, 1e-3, solver="lemke", facets=3)
 
 
 def test_repr_is_readable():
     tr = ball_scene(e=0.5).simulate(0.5, 1e-3)
+    assert (tr.success, tr.status) == (True, "completed")
+    assert tr.message == "500 steps, every contact solve solved"
     text = repr(tr)
     assert text.startswith("Trajectory(500 steps of h = 0.001 s")
     assert "min gap" in text and "energy" in text
