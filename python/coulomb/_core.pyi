@@ -50,4 +50,5 @@ def step_simulate(
     facets: int | None = None,
     gap_tolerance: float = 1e-9,
     warm_start: bool = True,
+    fallback: bool = True,
 ) -> dict[str, Any]: ...

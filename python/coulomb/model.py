@@ -406,6 +406,7 @@ class Scene:
         facets: int | None = None,
         gap_tolerance: float = 1e-9,
         warm_start: bool = True,
+        fallback: bool = True,
     ) -> Trajectory:
         """Runs ``ceil(t_end / h)`` steps of the impulse time stepper from the initial state.
 
@@ -428,6 +429,10 @@ class Scene:
             open and carries unknowns only if it could close within the step (gap term).
         warm_start : bool
             Start NSGS from the previous step's impulses.
+        fallback : bool
+            When NSGS misses its tolerance (it can stall on singular, strongly coupled W),
+            also solve by the polyhedral Lemke and keep the answer with the smaller exact-disk
+            error (such steps are marked in ``fallback``).
         """
         t_end = _positive("t_end", t_end)
         h = _positive("h", h)
@@ -454,6 +459,7 @@ class Scene:
         raw = _core.step_simulate(
             spec, h, steps, solver=solver, tol=tol, max_iter=max_iter, relaxation=relaxation,
             facets=facets, gap_tolerance=gap_tolerance, warm_start=warm_start,
+            fallback=fallback,
         )
         return Trajectory._from_core(raw, scene=self, h=h, solver=solver,
                                      gap_tolerance=gap_tolerance)
@@ -577,6 +583,7 @@ class Model:
         facets: int | None = None,
         gap_tolerance: float = 1e-9,
         warm_start: bool = True,
+        fallback: bool = True,
     ) -> Trajectory:
         """Runs ``ceil(t_end / h)`` impulse steps; options as :meth:`Scene.simulate`."""
         from . import contact as _contact
@@ -594,7 +601,7 @@ class Model:
         rec: dict[str, list[Any]] = {k: [] for k in (
             "t", "q", "v", "kinetic_energy", "potential_energy", "min_gap", "negative_gaps",
             "active", "status", "error", "iterations", "momentum_residual",
-            "min_normal_impulse", "cone_violation", "complementarity", "resumed",
+            "min_normal_impulse", "cone_violation", "complementarity", "resumed", "fallback",
             "contact_step", "contact_id", "contact_impulse", "contact_velocity",
             "contact_approach", "contact_gap", "contact_closed")}
 
@@ -623,7 +630,7 @@ class Model:
                     approach[i], landed[i], warm[i] = 0.0, False, 0.0
                     continue
                 active.append((i, g, rows, vn_k, g <= gap_tolerance))
-            resumed = False
+            resumed = used_fallback = False
             v_next = v_free.copy()
             gp = np.zeros(q.size)
             status, err, iters, mn, cone, comp = "no_contact", 0.0, 0, 0.0, 0.0, 0.0
@@ -653,6 +660,14 @@ class Model:
                                          max_iter=max_iter, facets=facets,
                                          initial=init if (warm_start and solver == "nsgs")
                                          else None)
+                    if not res.success and fallback and solver == "nsgs":
+                        alt = _contact.solve(W, qc, mus, dim=dim, method="lemke",
+                                             tol=max(tol, 1e-9))
+                        if alt.error < res.error:
+                            used_fallback = True
+                            res = alt
+                            if alt.error <= max(tol, 1e-9):
+                                res["status"] = "solved"
                     r = res.impulse.reshape(-1)
                     status, err, iters = res.status, res.error, res.iterations
                     mn, cone = res.min_normal_impulse, res.cone_violation
@@ -682,7 +697,7 @@ class Model:
             for key, val in (("active", len(active)), ("status", status), ("error", err),
                              ("iterations", iters), ("min_normal_impulse", mn),
                              ("cone_violation", cone), ("complementarity", comp),
-                             ("resumed", resumed)):
+                             ("resumed", resumed), ("fallback", used_fallback)):
                 rec[key].append(val)
             v = v_next
             q = q + h * v
@@ -700,7 +715,7 @@ class Model:
                 raw[key] = np.array(val, dtype=np.float64).reshape(len(val), dim)
             elif key == "status":
                 raw[key] = list(val)
-            elif key in ("resumed", "contact_closed"):
+            elif key in ("resumed", "fallback", "contact_closed"):
                 raw[key] = np.array(val, dtype=bool)
             elif key in ("active", "iterations", "negative_gaps", "contact_step", "contact_id"):
                 raw[key] = np.array(val, dtype=np.int64)

@@ -136,7 +136,7 @@ fn matrix<'py, T: numpy::Element>(
 /// size `h`; returns the trajectory as a dict of arrays.
 #[pyfunction]
 #[pyo3(signature = (scene, h, steps, solver="nsgs", tol=1e-12, max_iter=None, relaxation=1.0,
-                    facets=None, gap_tolerance=1e-9, warm_start=true))]
+                    facets=None, gap_tolerance=1e-9, warm_start=true, fallback=true))]
 #[allow(clippy::too_many_arguments)]
 pub(super) fn step_simulate<'py>(
     py: Python<'py>,
@@ -150,6 +150,7 @@ pub(super) fn step_simulate<'py>(
     facets: Option<usize>,
     gap_tolerance: f64,
     warm_start: bool,
+    fallback: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let scene = scene_from_dict(scene)?;
     let solver = match solver {
@@ -184,6 +185,7 @@ pub(super) fn step_simulate<'py>(
         solver,
         gap_tolerance,
         warm_start,
+        fallback,
     };
     let (tr, seconds) = guarded(py, usize::MAX, || {
         let start = std::time::Instant::now();
@@ -243,6 +245,10 @@ pub(super) fn step_simulate<'py>(
     d.set_item(
         "resumed",
         PyArray1::from_vec(py, s.iter().map(|r| r.resumed).collect::<Vec<_>>()),
+    )?;
+    d.set_item(
+        "fallback",
+        PyArray1::from_vec(py, s.iter().map(|r| r.fallback).collect::<Vec<_>>()),
     )?;
     let c = &tr.contacts;
     let nrec = c.len();

@@ -6,7 +6,7 @@
 use super::{det3, BodyKind, Pair, Scene, StepSettings, StepSolver};
 use crate::contact::{
     measure, solve_nsgs, solve_polyhedral, ContactMeasures, ContactProblem, ContactSolution,
-    ContactStatus, NsgsSettings,
+    ContactStatus, NsgsSettings, PolyhedralSettings,
 };
 use crate::error::Result;
 
@@ -37,6 +37,9 @@ pub struct StepRecord {
     /// (that step stopped the approach with the gap term; this one gives the rebound back), so
     /// energy is judged across the two steps.
     pub resumed: bool,
+    /// NSGS missed its tolerance and the polyhedral Lemke's answer, better on the exact-disk
+    /// error, was used instead (see [`super::StepSettings::fallback`]).
+    pub fallback: bool,
 }
 
 /// One active contact in one step.
@@ -680,6 +683,7 @@ impl Stepper {
             cone_violation: 0.0,
             complementarity: 0.0,
             resumed: false,
+            fallback: false,
         };
         for x in &mut self.gp {
             *x = 0.0;
@@ -776,7 +780,30 @@ impl Stepper {
                             initial,
                             ..s.clone()
                         };
-                        solve_nsgs(&problem, &settings)?
+                        let first = solve_nsgs(&problem, &settings)?;
+                        if first.success() || !self.settings.fallback {
+                            first
+                        } else {
+                            // NSGS can stall on singular, strongly coupled W (e.g. a rod
+                            // lying on two contacts with mu = 2): Lemke's pivoting on the
+                            // polyhedral cone (exact in 2D) decides; keep the better answer
+                            let mut lemke = PolyhedralSettings::for_dim(dim);
+                            lemke.lemke.tol = s.tol.max(1e-9);
+                            let second = solve_polyhedral(&problem, &lemke)?;
+                            if second.measures.error < first.measures.error {
+                                record.fallback = true;
+                                ContactSolution {
+                                    status: if second.measures.error <= s.tol.max(1e-9) {
+                                        ContactStatus::Solved
+                                    } else {
+                                        second.status
+                                    },
+                                    ..second
+                                }
+                            } else {
+                                first
+                            }
+                        }
                     }
                     StepSolver::Lemke(s) => solve_polyhedral(&problem, s)?,
                 }

@@ -138,7 +138,8 @@ def test_solver_options_pass_through():
     floor = scene.add(HalfSpace((0, 0, 0), (0, 0, 1)))
     scene.contact(scene.attach(cube, Box((0.5, 0.5, 0.5))), floor, mu=0.5)
     a = scene.simulate(0.05, 1e-3, solver="lemke", facets=16)
-    b = scene.simulate(0.05, 1e-3, solver="nsgs", max_iter=3, warm_start=False)
+    b = scene.simulate(0.05, 1e-3, solver="nsgs", max_iter=3, warm_start=False,
+                       fallback=False)
     assert a.success
     assert a.check().ok
     # three cold sweeps are not enough for four coupled sliding corners: the status says so
@@ -146,6 +147,10 @@ def test_solver_options_pass_through():
     assert (b.success, b.status) == (False, "solver_failures")
     assert set(b.solver_status) == {"iteration_limit"}
     assert any("contact solves did not succeed" in v for v in b.check().violations)
+    # with the Lemke fallback every step is decided
+    c = scene.simulate(0.05, 1e-3, solver="nsgs", max_iter=3, warm_start=False)
+    assert c.success and c.fallback.all()
+    assert c.check().ok
     with pytest.raises(InvalidParameterError):
         scene.simulate(0.05, 1e-3, solver="lemke", facets=3)
 
