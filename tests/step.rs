@@ -404,6 +404,41 @@ fn resting_box_with_four_redundant_corners() {
     }
 }
 
+/// the seed's rod (m = 1, l = 1, J = 1/12, mu = 2, theta = 45 deg), lower end on the floor
+/// sliding left at 1 m/s.
+fn painleve_rod() -> Scene {
+    let th = 45f64.to_radians();
+    let (m, l, j, mu) = (1.0, 1.0, 1.0 / 12.0, 2.0);
+    let y = 0.5 * l * th.sin();
+    Scene {
+        dim: 2,
+        gravity: vec![0.0, -G],
+        bodies: vec![Body {
+            kind: BodyKind::Planar,
+            mass: m,
+            inertia: vec![j],
+            q0: vec![0.0, y, th],
+            v0: vec![-1.0, 0.0, 0.0],
+            force: vec![0.0; 2],
+        }],
+        shapes: vec![Shape {
+            body: 0,
+            points: vec![vec![-0.5 * l, 0.0], vec![0.5 * l, 0.0]],
+            radius: 0.0,
+        }],
+        half_spaces: vec![HalfSpace {
+            point: vec![0.0, 0.0],
+            normal: vec![0.0, 1.0],
+        }],
+        pairs: vec![Pair::ShapeHalfSpace {
+            shape: 0,
+            half_space: 0,
+            mu,
+            e: 0.0,
+        }],
+    }
+}
+
 /// Painleve's rod (m = 1, l = 1, J = 1/12, mu = 2, theta = 45 deg), the lower end on the floor
 /// sliding left at 1 m/s: no smooth sliding mode exists (A = -0.5, b = -9.81); the impulse step
 /// jams the end within one step by a tangential impulse, energy never increases, and the jam
@@ -411,38 +446,9 @@ fn resting_box_with_four_redundant_corners() {
 /// system with W = [[2.5, -1.5], [-1.5, 2.5]]).
 #[test]
 fn painleve_rod_jams_within_one_step() {
-    let th = 45f64.to_radians();
-    let (m, l, j, mu) = (1.0, 1.0, 1.0 / 12.0, 2.0);
     let mut first = vec![];
     for h in [1e-2, 1e-3, 1e-4] {
-        let y = 0.5 * l * th.sin();
-        let scene = Scene {
-            dim: 2,
-            gravity: vec![0.0, -G],
-            bodies: vec![Body {
-                kind: BodyKind::Planar,
-                mass: m,
-                inertia: vec![j],
-                q0: vec![0.0, y, th],
-                v0: vec![-1.0, 0.0, 0.0],
-                force: vec![0.0; 2],
-            }],
-            shapes: vec![Shape {
-                body: 0,
-                points: vec![vec![-0.5 * l, 0.0], vec![0.5 * l, 0.0]],
-                radius: 0.0,
-            }],
-            half_spaces: vec![HalfSpace {
-                point: vec![0.0, 0.0],
-                normal: vec![0.0, 1.0],
-            }],
-            pairs: vec![Pair::ShapeHalfSpace {
-                shape: 0,
-                half_space: 0,
-                mu,
-                e: 0.0,
-            }],
-        };
+        let scene = painleve_rod();
         let tr = run(&scene, h, 0.05);
         every_step_solved(&tr);
         let c = tr.contacts[0];
@@ -481,4 +487,43 @@ fn bad_scenes_are_refused() {
     assert!(simulate(&s, &StepSettings::new(1e-3, 1)).is_err());
     assert!(simulate(&good, &StepSettings::new(0.0, 1)).is_err());
     assert!(simulate(&good, &StepSettings::new(-1e-3, 1)).is_err());
+}
+
+/// A frictionless contact found by the search but not closing within the step must get a
+/// zero impulse and a solved status, and leave free flight untouched (nothing is applied to
+/// distant bodies). Regression: the contact solvers' natural-map measure misjudged such a
+/// step (mu = 0, zero tangential velocity) and NSGS ran to its iteration limit.
+#[test]
+fn imminent_frictionless_contact_that_does_not_close_gets_nothing() {
+    let h = 1e-3;
+    let body = particle(2, 1.0, &[0.0, 0.0015], &[0.0, -1.0]);
+    let scene = point_on_plane(2, body, &[0.0, -G], &[0.0, 1.0], 0.0, 0.5);
+    let tr = run(&scene, h, h);
+    assert_eq!(tr.steps[0].active, 1);
+    assert_eq!(tr.steps[0].status, Some(ContactStatus::Solved));
+    assert_eq!(tr.contacts[0].impulse, [0.0; 3]);
+    assert_eq!(v_at(&tr, 1)[1], -1.0 - G * h);
+}
+
+/// After the jam the rod falls flat on both ends (mu = 2, W singular): NSGS can stall there,
+/// and the Lemke fallback must leave every step solved, with no energy gain.
+#[test]
+fn painleve_rod_falls_flat_with_every_step_solved() {
+    for h in [1e-2, 1e-4] {
+        let tr = run(&painleve_rod(), h, 3.0);
+        every_step_solved(&tr);
+        assert!(
+            tr.steps.iter().any(|s| s.fallback),
+            "{h}: NSGS no longer stalls?"
+        );
+        let q = q_at(&tr, tr.t.len() - 1);
+        assert!(q[1].abs() < 1e-7 && q[2].abs() < 1e-7, "lies flat: {q:?}");
+        for k in 0..tr.steps.len() {
+            let e = |j: usize| tr.kinetic_energy[j] + tr.potential_energy[j];
+            let base = if tr.steps[k].resumed { k - 1 } else { k };
+            let work = (tr.potential_energy[k + 1] - tr.potential_energy[base]).abs();
+            let slack = if tr.steps[k].resumed { work } else { 0.0 };
+            assert!(e(k + 1) <= e(base) + slack + 1e-9, "{h} {k}");
+        }
+    }
 }

@@ -9,6 +9,11 @@ lcp
     Linear complementarity problems (Lemke, projected Gauss-Seidel, enumeration).
 contact
     Frictional contact over a frozen Delassus matrix (nonsmooth Gauss-Seidel, exact cone).
+model
+    Scenes (bodies, contact shapes, half-spaces, pairs) and ``Scene.simulate``: the seed's
+    impulse time stepper, run in Rust.
+trajectory
+    The simulation result with the seed's per-step checks (``Trajectory.check``) and plots.
 io
     Readers for benchmark problem files (Siconos).
 painleve
@@ -25,22 +30,54 @@ validate
 
 from __future__ import annotations
 
-from . import contact, errors, io, lcp, painleve, regularized, study
+from . import contact, errors, io, lcp, model, painleve, regularized, study, trajectory
 from ._core import __version__
 from ._result import Result
 from .contact import ContactResult
 from .lcp import LcpResult
+from .model import (
+    Box,
+    Disk,
+    GapContact,
+    HalfSpace,
+    Model,
+    Particle,
+    Point,
+    Polygon,
+    RigidBody2D,
+    RigidBody3D,
+    Scene,
+    Segment,
+    Sphere,
+)
+from .trajectory import Trajectory
 
 __all__ = [
+    "Box",
     "ContactResult",
+    "Disk",
+    "GapContact",
+    "HalfSpace",
     "LcpResult",
+    "Model",
+    "Particle",
+    "Point",
+    "Polygon",
     "Result",
+    "RigidBody2D",
+    "RigidBody3D",
+    "Scene",
+    "Segment",
+    "Sphere",
+    "Trajectory",
     "__version__",
     "contact",
     "errors",
     "io",
     "lcp",
+    "model",
     "painleve",
     "regularized",
     "study",
+    "trajectory",
 ]

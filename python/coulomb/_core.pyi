@@ -67,3 +67,16 @@ def contact_post_velocity(
     m: _Triplets, g: _Triplets, v_free: NDArray[np.float64], r: NDArray[np.float64]
 ) -> NDArray[np.float64]: ...
 def simd_level() -> str: ...
+def step_simulate(
+    scene: dict[str, Any],
+    h: float,
+    steps: int,
+    solver: str = "nsgs",
+    tol: float = 1e-12,
+    max_iter: int | None = None,
+    relaxation: float = 1.0,
+    facets: int | None = None,
+    gap_tolerance: float = 1e-9,
+    warm_start: bool = True,
+    fallback: bool = True,
+) -> dict[str, Any]: ...

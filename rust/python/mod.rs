@@ -16,6 +16,8 @@ use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyDict, PyType};
 
+mod step;
+
 use crate::contact::{
     self, BlockCsr, ContactProblem, ContactSolution, NsgsSettings, PolyhedralSettings,
 };
@@ -598,6 +600,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read_siconos_fc, m)?)?;
     m.add_function(wrap_pyfunction!(simd_level, m)?)?;
     contact_extra::register(m)?;
+    step::register(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -348,10 +348,14 @@ pub struct StepSettings {
     pub gap_tolerance: f64,
     /// start each contact solve from the previous step's impulses of the same contacts.
     pub warm_start: bool,
+    /// when NSGS misses its tolerance, also solve by the polyhedral Lemke (tolerance
+    /// `max(tol, 1e-9)`) and keep the answer with the smaller exact-disk error; the step is
+    /// then solved if that error is within the tolerance.
+    pub fallback: bool,
 }
 
 impl StepSettings {
-    /// NSGS with tolerance 1e-12, gap tolerance 1e-9 m, warm start.
+    /// NSGS with tolerance 1e-12 (Lemke fallback), gap tolerance 1e-9 m, warm start.
     pub fn new(h: f64, steps: usize) -> Self {
         Self {
             h,
@@ -362,6 +366,7 @@ impl StepSettings {
             }),
             gap_tolerance: 1e-9,
             warm_start: true,
+            fallback: true,
         }
     }
 

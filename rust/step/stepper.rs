@@ -6,7 +6,7 @@
 use super::{det3, BodyKind, Pair, Scene, StepSettings, StepSolver};
 use crate::contact::{
     measure, solve_nsgs, solve_polyhedral, ContactMeasures, ContactProblem, ContactSolution,
-    ContactStatus, NsgsSettings,
+    ContactStatus, NsgsSettings, PolyhedralSettings,
 };
 use crate::error::Result;
 
@@ -24,7 +24,8 @@ pub struct StepRecord {
     pub error: f64,
     /// the contact solver's sweeps or pivots.
     pub iterations: usize,
-    /// `||M (v_{k+1} - v_free) - G P|| / ||G P||` (the absolute norm when `G P = 0`).
+    /// `||M (v_{k+1} - v_free) - G P||` divided by `max(||G P||, ||M v_free||, ||M v_{k+1}||)`
+    /// (the absolute norm when all are zero).
     pub momentum_residual: f64,
     /// `min_i P_{n,i}` over the active contacts (0 without contacts).
     pub min_normal_impulse: f64,
@@ -36,6 +37,9 @@ pub struct StepRecord {
     /// (that step stopped the approach with the gap term; this one gives the rebound back), so
     /// energy is judged across the two steps.
     pub resumed: bool,
+    /// NSGS missed its tolerance and the polyhedral Lemke's answer, better on the exact-disk
+    /// error, was used instead (see [`super::StepSettings::fallback`]).
+    pub fallback: bool,
 }
 
 /// One active contact in one step.
@@ -193,6 +197,8 @@ pub struct Stepper {
     warm: Vec<f64>,
     /// the approach velocity remembered when an open contact pushed (<= 0), per candidate.
     approach: Vec<f64>,
+    /// whether the candidate's last step was open and pushed (it closed the contact).
+    landed: Vec<bool>,
     gp: Vec<f64>,
     v_next: Vec<f64>,
 }
@@ -404,6 +410,7 @@ impl Stepper {
             mu: Vec::new(),
             warm: vec![0.0; nc * dim],
             approach: vec![0.0; nc],
+            landed: vec![false; nc],
             candidates,
         })
     }
@@ -627,6 +634,7 @@ impl Stepper {
             let closing = (-vn_k).max(-vn_free).max(0.0);
             if geo.gap > tol_gap + 2.0 * h * closing {
                 self.approach[c] = 0.0;
+                self.landed[c] = false;
                 for x in &mut self.warm[c * dim..(c + 1) * dim] {
                     *x = 0.0;
                 }
@@ -675,6 +683,7 @@ impl Stepper {
             cone_violation: 0.0,
             complementarity: 0.0,
             resumed: false,
+            fallback: false,
         };
         for x in &mut self.gp {
             *x = 0.0;
@@ -723,7 +732,7 @@ impl Stepper {
                 let bound = if ai.closed {
                     // Newton: 0 <= P_n ⊥ J_n v_{k+1} + e v_n^- >= 0
                     let vminus = ai.vn_k.min(self.approach[ai.cand]).min(0.0);
-                    if self.approach[ai.cand] < ai.vn_k.min(0.0) {
+                    if self.landed[ai.cand] {
                         record.resumed = true;
                     }
                     self.active[i].approach = vminus;
@@ -771,7 +780,30 @@ impl Stepper {
                             initial,
                             ..s.clone()
                         };
-                        solve_nsgs(&problem, &settings)?
+                        let first = solve_nsgs(&problem, &settings)?;
+                        if first.success() || !self.settings.fallback {
+                            first
+                        } else {
+                            // NSGS can stall on singular, strongly coupled W (e.g. a rod
+                            // lying on two contacts with mu = 2): Lemke's pivoting on the
+                            // polyhedral cone (exact in 2D) decides; keep the better answer
+                            let mut lemke = PolyhedralSettings::for_dim(dim);
+                            lemke.lemke.tol = s.tol.max(1e-9);
+                            let second = solve_polyhedral(&problem, &lemke)?;
+                            if second.measures.error < first.measures.error {
+                                record.fallback = true;
+                                ContactSolution {
+                                    status: if second.measures.error <= s.tol.max(1e-9) {
+                                        ContactStatus::Solved
+                                    } else {
+                                        second.status
+                                    },
+                                    ..second
+                                }
+                            } else {
+                                first
+                            }
+                        }
                     }
                     StepSolver::Lemke(s) => solve_polyhedral(&problem, s)?,
                 }
@@ -802,21 +834,30 @@ impl Stepper {
             solution = Some(sol);
         }
 
-        // momentum balance: ||M (v_{k+1} - v_free) - G P|| / ||G P||
-        let (mut res2, mut gp2) = (0.0, 0.0);
+        // momentum balance: ||M (v_{k+1} - v_free) - G P|| relative to the momenta involved,
+        // max(||G P||, ||M v_free||, ||M v_{k+1}||) (rounding is relative to the largest)
+        let mut res2 = 0.0;
+        let (mut gp2, mut mf2, mut mn2) = (0.0, 0.0, 0.0);
         for (bi, b) in self.bodies.iter().enumerate() {
             let m = &self.frozen[bi].m;
             for a in 0..b.nv {
-                let mdv: f64 = (0..b.nv)
-                    .map(|c| m[a * 6 + c] * (v_next[b.off_v + c] - self.v_free[b.off_v + c]))
-                    .sum();
+                let (mut mdv, mut mf, mut mn) = (0.0, 0.0, 0.0);
+                for c in 0..b.nv {
+                    let (vn, vf) = (v_next[b.off_v + c], self.v_free[b.off_v + c]);
+                    mdv += m[a * 6 + c] * (vn - vf);
+                    mf += m[a * 6 + c] * vf;
+                    mn += m[a * 6 + c] * vn;
+                }
                 let r = mdv - self.gp[b.off_v + a];
                 res2 += r * r;
                 gp2 += self.gp[b.off_v + a] * self.gp[b.off_v + a];
+                mf2 += mf * mf;
+                mn2 += mn * mn;
             }
         }
-        record.momentum_residual = if gp2.sqrt() > TINY {
-            (res2 / gp2).sqrt()
+        let scale2 = gp2.max(mf2).max(mn2);
+        record.momentum_residual = if scale2.sqrt() > TINY {
+            (res2 / scale2).sqrt()
         } else {
             res2.sqrt()
         };
@@ -828,8 +869,10 @@ impl Stepper {
                 self.warm[a.cand * dim..(a.cand + 1) * dim].copy_from_slice(p);
                 if a.closed {
                     self.approach[a.cand] = 0.0;
-                } else if p[0] > 0.0 && a.vn_k < 0.0 {
+                    self.landed[a.cand] = false;
+                } else if p[0] > 0.0 {
                     self.approach[a.cand] = self.approach[a.cand].min(a.vn_k);
+                    self.landed[a.cand] = true;
                 }
                 let mut impulse = [0.0; 3];
                 impulse[..dim].copy_from_slice(p);

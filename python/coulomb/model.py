@@ -1,0 +1,725 @@
+r"""Scenes: bodies, contact shapes, half-spaces and contact pairs, simulated by the seed's
+impulse time stepper (the whole loop runs in Rust, with the GIL released).
+
+A planar scene (``dim=2``) has particles ``(x, y)`` and planar rigid bodies ``(x, y, theta)``;
+a spatial scene (``dim=3``) has particles ``(x, y, z)`` and spatial rigid bodies (position, unit
+quaternion ``(w, x, y, z)``; velocities: linear, then the angular velocity in the world frame;
+inertia in the body frame). Contact shapes are sets of body-frame points with a radius
+(:class:`Point`, :class:`Sphere`/:class:`Disk`, :class:`Segment` ends, :class:`Box` and
+:class:`Polygon` corners); a pair is a shape against a static :class:`HalfSpace` (floor, ramp,
+wall) or a sphere against a sphere, each with its friction coefficient ``mu`` and Newton
+restitution coefficient ``e``.
+
+>>> import coulomb
+>>> scene = coulomb.Scene(dim=2, gravity=(0.0, -9.81))
+>>> ball = scene.add(coulomb.Particle(mass=0.5, position=(0.0, 0.0), velocity=(0.0, -3.0)))
+>>> floor = scene.add(coulomb.HalfSpace(point=(0.0, 0.0), normal=(0.0, 1.0)))
+>>> scene.contact(scene.attach(ball, coulomb.Point()), floor, mu=0.0, e=0.6)
+>>> tr = scene.simulate(t_end=0.002, h=0.001)
+>>> round(float(tr.v[-1, 1]), 12)  # Newton: v_n^+ = -e v_n^- (then one step of gravity)
+1.79019
+
+Every step solves, with M and the Jacobians frozen at ``q_k``,
+``v_{k+1} = v_free + M^-1 G P`` and ``q_{k+1} = q_k + h v_{k+1}``; see :mod:`coulomb.trajectory`
+for the record and its checks.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+import numpy as np
+
+from . import _core
+from .errors import InvalidParameterError, NonFiniteError, ShapeError
+from .trajectory import Trajectory
+
+__all__ = [
+    "Body",
+    "Box",
+    "Disk",
+    "GapContact",
+    "HalfSpace",
+    "Model",
+    "Particle",
+    "Point",
+    "Polygon",
+    "RigidBody2D",
+    "RigidBody3D",
+    "Scene",
+    "Segment",
+    "Shape",
+    "Sphere",
+]
+
+Solver = Literal["nsgs", "lemke"]
+
+
+def _vector(name: str, value: Any, n: int) -> list[float]:
+    arr = np.asarray(value, dtype=np.float64).reshape(-1) if value is not None else None
+    if arr is None or arr.shape != (n,):
+        got = None if arr is None else arr.shape
+        raise ShapeError(f"{name} must have {n} entries, got shape {got}")
+    if not np.all(np.isfinite(arr)):
+        raise NonFiniteError(f"{name} has a non-finite entry: {arr.tolist()}")
+    return arr.tolist()
+
+
+def _positive(name: str, value: float) -> float:
+    v = float(value)
+    if not math.isfinite(v):
+        raise NonFiniteError(f"{name} must be finite, got {v}")
+    if v <= 0.0:
+        raise InvalidParameterError(f"{name} must be > 0, got {v}")
+    return v
+
+
+# --- bodies --------------------------------------------------------------------------------
+
+
+@dataclass(eq=False)
+class Body:
+    """Base class of the bodies; use :class:`Particle`, :class:`RigidBody2D` or
+    :class:`RigidBody3D`."""
+
+    mass: float
+    force: Sequence[float] | None = field(default=None, kw_only=True)
+    name: str = field(default="", kw_only=True)
+
+    kind = ""
+
+    def _spec(self, dim: int) -> dict[str, Any]:
+        raise NotImplementedError
+
+
+@dataclass(eq=False)
+class Particle(Body):
+    """A point mass (kg) at ``position`` moving with ``velocity`` (``dim`` entries each)."""
+
+    position: Sequence[float] = (0.0, 0.0)
+    velocity: Sequence[float] | None = None
+
+    kind = "particle"
+
+    def _spec(self, dim: int) -> dict[str, Any]:
+        v = self.velocity if self.velocity is not None else np.zeros(dim)
+        return {
+            "kind": "particle",
+            "mass": _positive("mass", self.mass),
+            "inertia": [],
+            "q0": _vector("position", self.position, dim),
+            "v0": _vector("velocity", v, dim),
+        }
+
+
+@dataclass(eq=False)
+class RigidBody2D(Body):
+    """A planar rigid body: mass (kg), central inertia (kg m^2), position ``(x, y)``, angle
+    ``theta`` (rad), velocity ``(vx, vy)`` and angular velocity ``omega`` (rad/s)."""
+
+    inertia: float = 1.0
+    position: Sequence[float] = (0.0, 0.0)
+    angle: float = 0.0
+    velocity: Sequence[float] = (0.0, 0.0)
+    angular_velocity: float = 0.0
+
+    kind = "planar"
+
+    def _spec(self, dim: int) -> dict[str, Any]:
+        if dim != 2:
+            raise InvalidParameterError("a RigidBody2D needs a planar scene (dim=2)")
+        pos = _vector("position", self.position, 2)
+        vel = _vector("velocity", self.velocity, 2)
+        th = _vector("angle", [self.angle], 1)
+        om = _vector("angular_velocity", [self.angular_velocity], 1)
+        return {
+            "kind": "planar",
+            "mass": _positive("mass", self.mass),
+            "inertia": [_positive("inertia", self.inertia)],
+            "q0": pos + th,
+            "v0": vel + om,
+        }
+
+
+@dataclass(eq=False)
+class RigidBody3D(Body):
+    """A spatial rigid body: mass (kg), body-frame inertia (3 principal moments or a symmetric
+    positive definite 3x3 tensor, kg m^2), position, orientation as a quaternion
+    ``(w, x, y, z)`` (normalised here), velocity and world-frame angular velocity."""
+
+    inertia: Sequence[float] | np.ndarray = (1.0, 1.0, 1.0)
+    position: Sequence[float] = (0.0, 0.0, 0.0)
+    orientation: Sequence[float] = (1.0, 0.0, 0.0, 0.0)
+    velocity: Sequence[float] = (0.0, 0.0, 0.0)
+    angular_velocity: Sequence[float] = (0.0, 0.0, 0.0)
+
+    kind = "spatial"
+
+    def _spec(self, dim: int) -> dict[str, Any]:
+        if dim != 3:
+            raise InvalidParameterError("a RigidBody3D needs a spatial scene (dim=3)")
+        j = np.asarray(self.inertia, dtype=np.float64)
+        if j.shape == (3,):
+            j = np.diag(j)
+        if j.shape != (3, 3):
+            raise ShapeError(f"inertia must be 3 moments or 3x3, got shape {j.shape}")
+        if not np.all(np.isfinite(j)):
+            raise NonFiniteError("inertia has a non-finite entry")
+        if not np.allclose(j, j.T, rtol=1e-12, atol=0.0):
+            raise InvalidParameterError("inertia must be symmetric")
+        if np.linalg.eigvalsh(j).min() <= 0.0:
+            raise InvalidParameterError("inertia must be positive definite")
+        quat = np.asarray(_vector("orientation", self.orientation, 4))
+        norm = float(np.linalg.norm(quat))
+        if norm == 0.0:
+            raise InvalidParameterError("orientation quaternion must be nonzero")
+        return {
+            "kind": "spatial",
+            "mass": _positive("mass", self.mass),
+            "inertia": j.reshape(-1).tolist(),
+            "q0": _vector("position", self.position, 3) + (quat / norm).tolist(),
+            "v0": _vector("velocity", self.velocity, 3)
+            + _vector("angular_velocity", self.angular_velocity, 3),
+        }
+
+
+# --- shapes --------------------------------------------------------------------------------
+
+
+@dataclass(eq=False)
+class Shape:
+    """Base class of contact shapes: body-frame points with a common radius."""
+
+    def _points(self, dim: int) -> tuple[list[list[float]], float]:
+        raise NotImplementedError
+
+
+@dataclass(eq=False)
+class Point(Shape):
+    """A single body-frame point (default the centre of mass)."""
+
+    offset: Sequence[float] | None = None
+
+    def _points(self, dim: int) -> tuple[list[list[float]], float]:
+        off = self.offset if self.offset is not None else np.zeros(dim)
+        return [_vector("offset", off, dim)], 0.0
+
+
+@dataclass(eq=False)
+class Sphere(Shape):
+    """A sphere (3D) or disk (2D) of ``radius`` (m) centred at a body-frame ``center``."""
+
+    radius: float = 1.0
+    center: Sequence[float] | None = None
+
+    def _points(self, dim: int) -> tuple[list[list[float]], float]:
+        c = self.center if self.center is not None else np.zeros(dim)
+        r = float(self.radius)
+        if not math.isfinite(r) or r < 0.0:
+            raise InvalidParameterError(f"radius must be finite and >= 0, got {r}")
+        return [_vector("center", c, dim)], r
+
+
+Disk = Sphere
+
+
+@dataclass(eq=False)
+class Segment(Shape):
+    """A segment's (rod's) two end points ``a``, ``b`` in the body frame, with a radius."""
+
+    a: Sequence[float] = (-0.5, 0.0)
+    b: Sequence[float] = (0.5, 0.0)
+    radius: float = 0.0
+
+    def _points(self, dim: int) -> tuple[list[list[float]], float]:
+        r = float(self.radius)
+        if not math.isfinite(r) or r < 0.0:
+            raise InvalidParameterError(f"radius must be finite and >= 0, got {r}")
+        return [_vector("a", self.a, dim), _vector("b", self.b, dim)], r
+
+
+@dataclass(eq=False)
+class Box(Shape):
+    """A box's corners (4 in 2D, 8 in 3D) from its half extents, centred at the body origin."""
+
+    half_extents: Sequence[float] = (0.5, 0.5)
+
+    def _points(self, dim: int) -> tuple[list[list[float]], float]:
+        he = np.asarray(_vector("half_extents", self.half_extents, dim))
+        if np.any(he <= 0.0):
+            raise InvalidParameterError(f"half_extents must be > 0, got {he.tolist()}")
+        signs = np.array(np.meshgrid(*([[-1.0, 1.0]] * dim), indexing="ij")).reshape(dim, -1).T
+        return (signs * he).tolist(), 0.0
+
+
+@dataclass(eq=False)
+class Polygon(Shape):
+    """A polygon's (or point cloud's) body-frame vertices, with a radius."""
+
+    vertices: Sequence[Sequence[float]] = ()
+    radius: float = 0.0
+
+    def _points(self, dim: int) -> tuple[list[list[float]], float]:
+        if len(self.vertices) == 0:
+            raise ShapeError("a polygon needs at least one vertex")
+        r = float(self.radius)
+        if not math.isfinite(r) or r < 0.0:
+            raise InvalidParameterError(f"radius must be finite and >= 0, got {r}")
+        return [_vector(f"vertex {i}", v, dim) for i, v in enumerate(self.vertices)], r
+
+
+@dataclass(eq=False)
+class HalfSpace:
+    """A static half-space ``{x : n . (x - point) <= 0}``: its boundary is a floor, ramp or
+    wall, ``normal`` pointing out of it (towards the bodies)."""
+
+    point: Sequence[float] = (0.0, 0.0)
+    normal: Sequence[float] = (0.0, 1.0)
+
+    @classmethod
+    def ramp(cls, angle_deg: float, dim: int = 2) -> HalfSpace:
+        """A ramp through the origin descending towards +x at ``angle_deg``."""
+        th = math.radians(angle_deg)
+        if dim == 2:
+            return cls((0.0, 0.0), (math.sin(th), math.cos(th)))
+        return cls((0.0, 0.0, 0.0), (math.sin(th), 0.0, math.cos(th)))
+
+
+# --- scene ---------------------------------------------------------------------------------
+
+
+def _index(items: list[Any], obj: Any, what: str) -> int:
+    for i, x in enumerate(items):
+        if x is obj:
+            return i
+    raise InvalidParameterError(f"this {what} was not added to the scene")
+
+
+class Scene:
+    """A planar (``dim=2``) or spatial (``dim=3``) scene under uniform gravity (m/s^2)."""
+
+    def __init__(self, dim: int = 2, gravity: Sequence[float] | None = None) -> None:
+        if dim not in (2, 3):
+            raise InvalidParameterError(f"dim must be 2 (planar) or 3 (spatial), got {dim}")
+        self.dim = int(dim)
+        g = gravity if gravity is not None else [0.0] * (dim - 1) + [-9.81]
+        self.gravity = _vector("gravity", g, dim)
+        self.bodies: list[Body] = []
+        self.half_spaces: list[HalfSpace] = []
+        self.shapes: list[tuple[Body, Shape]] = []
+        self.pairs: list[tuple[str, Any, Any, float, float]] = []
+
+    def add(self, item: Body | HalfSpace) -> Any:
+        """Adds a body or a half-space; returns it (use it as a handle)."""
+        if isinstance(item, Body):
+            item._spec(self.dim)  # checked now, before any work
+            self.bodies.append(item)
+        elif isinstance(item, HalfSpace):
+            _vector("half-space point", item.point, self.dim)
+            n = np.asarray(_vector("half-space normal", item.normal, self.dim))
+            if not np.any(n != 0.0):
+                raise InvalidParameterError("a half-space's normal must be nonzero")
+            self.half_spaces.append(item)
+        else:
+            raise InvalidParameterError(f"cannot add {type(item).__name__} to a scene")
+        return item
+
+    def attach(self, body: Body, shape: Shape) -> Shape:
+        """Attaches a contact shape to a body; returns the shape (a handle for contacts)."""
+        _index(self.bodies, body, "body")
+        if any(s is shape for _, s in self.shapes):
+            raise InvalidParameterError("this shape is already attached to a body")
+        shape._points(self.dim)
+        self.shapes.append((body, shape))
+        return shape
+
+    def contact(self, shape: Shape, other: Shape | HalfSpace, mu: float = 0.0,
+                e: float = 0.0) -> None:
+        """Declares that ``shape`` may touch ``other`` (a half-space, or a sphere on another
+        body), with friction coefficient ``mu >= 0`` and Newton restitution ``e`` in [0, 1]."""
+        mu, e = float(mu), float(e)
+        if not (math.isfinite(mu) and mu >= 0.0):
+            raise InvalidParameterError(f"mu must be finite and >= 0, got {mu}")
+        if not (math.isfinite(e) and 0.0 <= e <= 1.0):
+            raise InvalidParameterError(f"e must be in [0, 1], got {e}")
+        a = _index([s for _, s in self.shapes], shape, "shape")
+        if isinstance(other, HalfSpace):
+            self.pairs.append(("half_space", a, _index(self.half_spaces, other, "half-space"),
+                               mu, e))
+            return
+        b = _index([s for _, s in self.shapes], other, "shape")
+        if not (isinstance(shape, Sphere) and isinstance(other, Sphere)):
+            raise InvalidParameterError("shape-shape contacts are sphere vs sphere only")
+        if self.shapes[a][0] is self.shapes[b][0]:
+            raise InvalidParameterError("both spheres are on the same body")
+        self.pairs.append(("sphere", a, b, mu, e))
+
+    def _spec(self) -> dict[str, Any]:
+        bodies = []
+        for b in self.bodies:
+            spec = b._spec(self.dim)
+            f = b.force if b.force is not None else np.zeros(self.dim)
+            spec["force"] = _vector("force", f, self.dim)
+            bodies.append(spec)
+        shapes = []
+        for body, shape in self.shapes:
+            pts, r = shape._points(self.dim)
+            shapes.append({"body": _index(self.bodies, body, "body"), "points": pts,
+                           "radius": r})
+        return {
+            "dim": self.dim,
+            "gravity": self.gravity,
+            "bodies": bodies,
+            "shapes": shapes,
+            "half_spaces": [
+                {"point": _vector("point", h.point, self.dim),
+                 "normal": _vector("normal", h.normal, self.dim)}
+                for h in self.half_spaces
+            ],
+            "pairs": [{"kind": k, "a": a, "b": b, "mu": mu, "e": e}
+                      for k, a, b, mu, e in self.pairs],
+        }
+
+    def layout(self) -> list[tuple[slice, slice]]:
+        """The slices of each body's coordinates and velocities in ``q`` and ``v``."""
+        out = []
+        iq = iv = 0
+        for b in self.bodies:
+            nq = {"particle": self.dim, "planar": 3, "spatial": 7}[b.kind]
+            nv = {"particle": self.dim, "planar": 3, "spatial": 6}[b.kind]
+            out.append((slice(iq, iq + nq), slice(iv, iv + nv)))
+            iq, iv = iq + nq, iv + nv
+        return out
+
+    def simulate(
+        self,
+        t_end: float,
+        h: float,
+        solver: Solver = "nsgs",
+        *,
+        tol: float | None = None,
+        max_iter: int | None = None,
+        relaxation: float = 1.0,
+        facets: int | None = None,
+        gap_tolerance: float = 1e-9,
+        warm_start: bool = True,
+        fallback: bool = True,
+    ) -> Trajectory:
+        """Runs ``ceil(t_end / h)`` steps of the impulse time stepper from the initial state.
+
+        Parameters
+        ----------
+        t_end, h : float
+            Duration and time step (s), both > 0.
+        solver : {"nsgs", "lemke"}
+            The contact solver of every step: nonsmooth Gauss-Seidel on the exact friction disk
+            (warm-started from the previous step's impulses of the same contacts) or the
+            polyhedral-cone LCP by Lemke's method (``facets`` directions in 3D, default 8).
+        tol : float, optional
+            The contact solver's tolerance (default 1e-12 for NSGS, 1e-9 for Lemke).
+        max_iter : int, optional
+            NSGS sweeps (default 1000) or Lemke pivots (default ``max(1000, 50 n)``).
+        relaxation : float
+            NSGS relaxation in (0, 2).
+        gap_tolerance : float
+            A contact with gap at most this (m) is closed (restitution applies); above it, it is
+            open and carries unknowns only if it could close within the step (gap term).
+        warm_start : bool
+            Start NSGS from the previous step's impulses.
+        fallback : bool
+            When NSGS misses its tolerance (it can stall on singular, strongly coupled W),
+            also solve by the polyhedral Lemke and keep the answer with the smaller exact-disk
+            error (such steps are marked in ``fallback``).
+        """
+        t_end = _positive("t_end", t_end)
+        h = _positive("h", h)
+        if solver not in ("nsgs", "lemke"):
+            raise InvalidParameterError(
+                f"unknown solver {solver!r}: expected 'nsgs' (exact friction disk) or 'lemke' "
+                "(polyhedral cone)"
+            )
+        if tol is None:
+            tol = 1e-12 if solver == "nsgs" else 1e-9
+        tol = _positive("tol", tol)
+        if not (0.0 < relaxation < 2.0):
+            raise InvalidParameterError(f"relaxation must lie in (0, 2), got {relaxation}")
+        if max_iter is not None and int(max_iter) < 1:
+            raise InvalidParameterError(f"max_iter must be >= 1, got {max_iter}")
+        gap_tolerance = float(gap_tolerance)
+        if not (math.isfinite(gap_tolerance) and gap_tolerance >= 0.0):
+            raise InvalidParameterError(f"gap_tolerance must be finite and >= 0, got "
+                                        f"{gap_tolerance}")
+        if not self.bodies:
+            raise InvalidParameterError("the scene has no bodies")
+        steps = max(1, math.ceil(t_end / h - 1e-9))
+        spec = self._spec()
+        raw = _core.step_simulate(
+            spec, h, steps, solver=solver, tol=tol, max_iter=max_iter, relaxation=relaxation,
+            facets=facets, gap_tolerance=gap_tolerance, warm_start=warm_start,
+            fallback=fallback,
+        )
+        return Trajectory._from_core(raw, scene=self, h=h, solver=solver,
+                                     gap_tolerance=gap_tolerance)
+
+
+# --- user-defined models in generalized coordinates -----------------------------------------
+
+
+def _numeric_jacobian(fun: Callable[[np.ndarray], Any], q: np.ndarray, rows: int) -> np.ndarray:
+    """Central differences of ``fun`` at q, step ``1e-6 max(1, |q_i|)`` per coordinate."""
+    jac = np.empty((rows, q.size))
+    for i in range(q.size):
+        d = 1e-6 * max(1.0, abs(q[i]))
+        qp, qm = q.copy(), q.copy()
+        qp[i] += d
+        qm[i] -= d
+        jac[:, i] = (np.atleast_1d(fun(qp)) - np.atleast_1d(fun(qm))).reshape(rows) / (2 * d)
+    return jac
+
+
+@dataclass(eq=False)
+class GapContact:
+    """A contact of a generalized-coordinate :class:`Model`: the gap ``g(q)`` (> 0 when
+    separated), its normal Jacobian ``J_n(q) = dg/dq`` (``nv`` entries; central differences of
+    ``gap`` when omitted), and for friction either the tangential Jacobian ``J_t(q)``
+    (``(dim - 1, nv)``) or a tangential position ``s(q)`` (``dim - 1`` entries) whose central
+    differences give it. ``mu >= 0`` and Newton's ``e`` in [0, 1]."""
+
+    gap: Callable[[np.ndarray], float]
+    normal_jacobian: Callable[[np.ndarray], Any] | None = None
+    tangent_jacobian: Callable[[np.ndarray], Any] | None = None
+    tangent_position: Callable[[np.ndarray], Any] | None = None
+    mu: float = 0.0
+    e: float = 0.0
+
+
+class Model:
+    r"""A model in generalized coordinates q (``v = dq/dt``, so ``nq = nv``):
+
+    ``M(q) dv = f(q, v, t) dt + J_n^T dP_n + J_t^T dP_t``
+
+    with the mass matrix ``mass_matrix`` (an SPD array or a callable ``M(q)``), the forces
+    ``force(q, v, t)`` (default none) and the contacts (:class:`GapContact`). The same impulse
+    step as :meth:`Scene.simulate`, run as a Python loop around the Rust contact solver
+    (:func:`coulomb.contact.solve`). ``potential(q)`` (optional) adds the potential energy to
+    the trajectory's total energy.
+    """
+
+    def __init__(
+        self,
+        dim: int,
+        mass_matrix: Any,
+        q0: Sequence[float],
+        v0: Sequence[float] | None = None,
+        force: Callable[[np.ndarray, np.ndarray, float], Any] | None = None,
+        contacts: Sequence[GapContact] = (),
+        potential: Callable[[np.ndarray], float] | None = None,
+    ) -> None:
+        if dim not in (2, 3):
+            raise InvalidParameterError(f"dim must be 2 (planar) or 3 (spatial), got {dim}")
+        self.dim = int(dim)
+        q = np.asarray(q0, dtype=np.float64).reshape(-1)
+        self.q0 = np.asarray(_vector("q0", q, q.size))
+        n = self.q0.size
+        self.v0 = np.asarray(_vector("v0", v0 if v0 is not None else np.zeros(n), n))
+        self.mass_matrix = mass_matrix
+        self.force = force
+        self.potential = potential
+        for i, c in enumerate(contacts):
+            if not isinstance(c, GapContact):
+                raise InvalidParameterError(f"contact {i} must be a GapContact")
+            if not (math.isfinite(c.mu) and c.mu >= 0.0):
+                raise InvalidParameterError(f"contact {i}: mu must be finite and >= 0")
+            if not (0.0 <= c.e <= 1.0):
+                raise InvalidParameterError(f"contact {i}: e must be in [0, 1], got {c.e}")
+            if c.mu > 0 and c.tangent_jacobian is None and c.tangent_position is None:
+                raise InvalidParameterError(
+                    f"contact {i} has friction: give tangent_jacobian or tangent_position")
+        self.contacts = list(contacts)
+        self._mass(self.q0)  # checked before any work
+
+    def _mass(self, q: np.ndarray) -> np.ndarray:
+        m = self.mass_matrix(q) if callable(self.mass_matrix) else self.mass_matrix
+        m = np.asarray(m, dtype=np.float64)
+        n = q.size
+        if m.shape != (n, n):
+            raise ShapeError(f"M(q) must be {n} x {n}, got {m.shape}")
+        if not np.all(np.isfinite(m)):
+            raise NonFiniteError("M(q) has a non-finite entry")
+        if not np.allclose(m, m.T, rtol=1e-10, atol=0.0):
+            raise InvalidParameterError("M(q) must be symmetric")
+        try:
+            np.linalg.cholesky(m)
+        except np.linalg.LinAlgError as exc:
+            raise InvalidParameterError("M(q) must be positive definite") from exc
+        return m
+
+    def _frame(self, c: GapContact, q: np.ndarray) -> tuple[float, np.ndarray]:
+        """The gap and the rows ``[J_n; J_t]`` (dim x nv) of one contact at q."""
+        n = q.size
+        g = float(c.gap(q))
+        jn = (np.asarray(c.normal_jacobian(q), dtype=np.float64).reshape(n)
+              if c.normal_jacobian is not None else _numeric_jacobian(c.gap, q, 1)[0])
+        rows = np.zeros((self.dim, n))
+        rows[0] = jn
+        if c.tangent_jacobian is not None:
+            rows[1:] = np.asarray(c.tangent_jacobian(q), dtype=np.float64).reshape(
+                self.dim - 1, n)
+        elif c.tangent_position is not None:
+            rows[1:] = _numeric_jacobian(c.tangent_position, q, self.dim - 1)
+        return g, rows
+
+    def simulate(
+        self,
+        t_end: float,
+        h: float,
+        solver: Solver = "nsgs",
+        *,
+        tol: float | None = None,
+        max_iter: int | None = None,
+        facets: int | None = None,
+        gap_tolerance: float = 1e-9,
+        warm_start: bool = True,
+        fallback: bool = True,
+    ) -> Trajectory:
+        """Runs ``ceil(t_end / h)`` impulse steps; options as :meth:`Scene.simulate`."""
+        from . import contact as _contact
+
+        t_end, h = _positive("t_end", t_end), _positive("h", h)
+        if solver not in ("nsgs", "lemke"):
+            raise InvalidParameterError(f"unknown solver {solver!r}")
+        tol = _positive("tol", tol if tol is not None else (1e-12 if solver == "nsgs" else 1e-9))
+        steps = max(1, math.ceil(t_end / h - 1e-9))
+        dim, nc = self.dim, len(self.contacts)
+        q, v = self.q0.copy(), self.v0.copy()
+        warm = np.zeros((nc, dim))
+        approach = np.zeros(nc)
+        landed = np.zeros(nc, dtype=bool)
+        rec: dict[str, list[Any]] = {k: [] for k in (
+            "t", "q", "v", "kinetic_energy", "potential_energy", "min_gap", "negative_gaps",
+            "active", "status", "error", "iterations", "momentum_residual",
+            "min_normal_impulse", "cone_violation", "complementarity", "resumed", "fallback",
+            "contact_step", "contact_id", "contact_impulse", "contact_velocity",
+            "contact_approach", "contact_gap", "contact_closed")}
+
+        def push_state(t: float, m: np.ndarray, gaps: list[float]) -> None:
+            rec["t"].append(t)
+            rec["q"].append(q.copy())
+            rec["v"].append(v.copy())
+            rec["kinetic_energy"].append(0.5 * float(v @ m @ v))
+            rec["potential_energy"].append(float(self.potential(q)) if self.potential else 0.0)
+            rec["min_gap"].append(min(gaps, default=math.inf))
+            rec["negative_gaps"].append(sum(g < -gap_tolerance for g in gaps))
+
+        stopped = None
+        m = self._mass(q)
+        frames = [self._frame(c, q) for c in self.contacts]
+        push_state(0.0, m, [g for g, _ in frames])
+        for k in range(steps):
+            t = k * h
+            f = (np.asarray(self.force(q, v, t), dtype=np.float64).reshape(q.size)
+                 if self.force else np.zeros(q.size))
+            v_free = v + h * np.linalg.solve(m, f)
+            active = []
+            for i, (g, rows) in enumerate(frames):
+                vn_k, vn_free = float(rows[0] @ v), float(rows[0] @ v_free)
+                if g > gap_tolerance + 2 * h * max(0.0, -vn_k, -vn_free):
+                    approach[i], landed[i], warm[i] = 0.0, False, 0.0
+                    continue
+                active.append((i, g, rows, vn_k, g <= gap_tolerance))
+            resumed = used_fallback = False
+            v_next = v_free.copy()
+            gp = np.zeros(q.size)
+            status, err, iters, mn, cone, comp = "no_contact", 0.0, 0, 0.0, 0.0, 0.0
+            if active:
+                G = np.vstack([rows for _, _, rows, _, _ in active])  # (dim na, nv)
+                minv_gt = np.linalg.solve(m, G.T)
+                W = G @ minv_gt
+                W = 0.5 * (W + W.T)
+                qc = G @ v_free
+                used = []
+                for a, (i, g, _, vn_k, closed) in enumerate(active):
+                    if closed:
+                        vminus = min(vn_k, approach[i], 0.0)
+                        resumed = resumed or bool(landed[i])
+                        qc[a * dim] += self.contacts[i].e * vminus
+                        used.append(vminus)
+                    else:
+                        qc[a * dim] += g / h
+                        used.append(vn_k)
+                mus = np.array([self.contacts[i].mu for i, *_ in active])
+                if np.all(qc[::dim] >= 0.0):
+                    r = np.zeros(len(active) * dim)
+                    status = "solved"
+                else:
+                    init = np.concatenate([warm[i] for i, *_ in active])
+                    res = _contact.solve(W, qc, mus, dim=dim, method=solver, tol=tol,
+                                         max_iter=max_iter, facets=facets,
+                                         initial=init if (warm_start and solver == "nsgs")
+                                         else None)
+                    if not res.success and fallback and solver == "nsgs":
+                        alt = _contact.solve(W, qc, mus, dim=dim, method="lemke",
+                                             tol=max(tol, 1e-9))
+                        if alt.error < res.error:
+                            used_fallback = True
+                            res = alt
+                            if alt.error <= max(tol, 1e-9):
+                                res["status"] = "solved"
+                    r = res.impulse.reshape(-1)
+                    status, err, iters = res.status, res.error, res.iterations
+                    mn, cone = res.min_normal_impulse, res.cone_violation
+                    comp = res.max_complementarity
+                gp = G.T @ r
+                v_next = v_free + minv_gt @ r
+                for a, (i, g, rows, vn_k, closed) in enumerate(active):
+                    p = r[a * dim:(a + 1) * dim]
+                    warm[i] = p
+                    if closed:
+                        approach[i], landed[i] = 0.0, False
+                    elif p[0] > 0.0:
+                        approach[i] = min(approach[i], vn_k)
+                        landed[i] = True
+                    rec["contact_step"].append(k)
+                    rec["contact_id"].append(i)
+                    rec["contact_impulse"].append(p.copy())
+                    rec["contact_velocity"].append(rows @ v_next)
+                    rec["contact_approach"].append(used[a])
+                    rec["contact_gap"].append(g)
+                    rec["contact_closed"].append(closed)
+            mdv = m @ (v_next - v_free)
+            scale = max(np.linalg.norm(gp), np.linalg.norm(m @ v_free),
+                        np.linalg.norm(m @ v_next))
+            res_norm = float(np.linalg.norm(mdv - gp))
+            rec["momentum_residual"].append(res_norm / scale if scale > 1e-300 else res_norm)
+            for key, val in (("active", len(active)), ("status", status), ("error", err),
+                             ("iterations", iters), ("min_normal_impulse", mn),
+                             ("cone_violation", cone), ("complementarity", comp),
+                             ("resumed", resumed), ("fallback", used_fallback)):
+                rec[key].append(val)
+            v = v_next
+            q = q + h * v
+            if not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))):
+                stopped = f"step {k} produced a non-finite state"
+                break
+            m = self._mass(q)
+            frames = [self._frame(c, q) for c in self.contacts]
+            push_state((k + 1) * h, m, [g for g, _ in frames])
+        raw: dict[str, Any] = {"dim": dim, "stopped": stopped, "solve_time": float("nan")}
+        for key, val in rec.items():
+            if key in ("q", "v"):
+                raw[key] = np.array(val, dtype=np.float64).reshape(len(val), q.size)
+            elif key in ("contact_impulse", "contact_velocity"):
+                raw[key] = np.array(val, dtype=np.float64).reshape(len(val), dim)
+            elif key == "status":
+                raw[key] = list(val)
+            elif key in ("resumed", "fallback", "contact_closed"):
+                raw[key] = np.array(val, dtype=bool)
+            elif key in ("active", "iterations", "negative_gaps", "contact_step", "contact_id"):
+                raw[key] = np.array(val, dtype=np.int64)
+            else:
+                raw[key] = np.array(val, dtype=np.float64)
+        return Trajectory._from_core(raw, scene=None, h=h, solver=solver,
+                                     gap_tolerance=gap_tolerance)

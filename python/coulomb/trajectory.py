@@ -1,0 +1,228 @@
+r"""The result of :meth:`coulomb.Scene.simulate`: states, impulses and the seed's per-step
+checks ("Time-step accuracy and validation").
+
+States (``N + 1`` rows, times ``t_0 .. t_N``): ``t``, ``q``, ``v``, ``kinetic_energy``,
+``potential_energy`` (of gravity and the constant forces, ``-sum (m g + F) . x``),
+``total_energy``, ``min_gap`` (over every candidate contact) and ``negative_gaps`` (how many
+candidates are below ``-gap_tolerance``).
+
+Steps (``N`` rows, step k from ``t_k`` to ``t_{k+1}``): ``active`` contacts, the contact
+solver's ``solver_status`` (``"no_contact"`` when none was active), ``solver_error`` and
+``iterations``, ``momentum_residual``
+(``||M (v_{k+1} - v_free) - G P||`` over ``max(||G P||, ||M v_free||, ||M v_{k+1}||)``),
+``min_normal_impulse``, ``cone_violation``
+(``max(||P_t|| - mu P_n, 0)``), ``complementarity`` (``max |P_n (J_n v_{k+1} + e v_n^-)|``,
+or with the gap term ``g / h`` for an open contact) and ``resumed`` (a closed contact took its
+restitution from the approach velocity of the step that closed it) and ``fallback`` (NSGS missed
+its tolerance and the polyhedral Lemke's better answer was used).
+
+Contacts (one row per active contact per step): ``contact_step``, ``contact_id`` (stable over
+steps: the candidate pair of features), ``contact_impulse`` (normal first, N s),
+``contact_velocity`` (``J v_{k+1}`` in the contact frame), ``contact_approach``,
+``contact_gap`` and ``contact_closed``.
+
+Like every coulomb result it has ``success``, ``status`` (``"completed"``,
+``"solver_failures"`` or ``"stopped"``) and a one-line ``message``.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ._result import Result
+from .errors import CoulombError
+
+if TYPE_CHECKING:
+    from .model import Scene
+
+__all__ = ["Trajectory", "TrajectoryCheckError"]
+
+
+class TrajectoryCheckError(CoulombError, AssertionError):
+    """A trajectory failed :meth:`Trajectory.check` with ``strict=True``."""
+
+
+class Trajectory(Result):
+    """States, impulses and per-step checks of a simulation (see the module documentation)."""
+
+    @classmethod
+    def _from_core(cls, raw: dict[str, Any], scene: Scene | None, h: float, solver: str,
+                   gap_tolerance: float) -> Trajectory:
+        tr = cls(raw)
+        tr["gap_tolerance"] = gap_tolerance
+        tr["total_energy"] = tr["kinetic_energy"] + tr["potential_energy"]
+        tr["h"] = h
+        tr["solver"] = solver
+        tr["solver_status"] = np.asarray(tr.pop("status"), dtype=object)
+        tr["solver_error"] = tr.pop("error")
+        failed = int(np.sum([s not in ("solved", "no_contact") for s in tr["solver_status"]]))
+        n = len(tr["t"]) - 1
+        if tr["stopped"] is not None:
+            tr["status"], tr["message"] = "stopped", f"stopped early: {tr['stopped']}"
+        elif failed:
+            tr["status"] = "solver_failures"
+            tr["message"] = f"{n} steps; {failed} contact solves missed their tolerance"
+        else:
+            tr["status"], tr["message"] = "completed", f"{n} steps, every contact solve solved"
+        tr["success"] = tr["status"] == "completed"
+        object.__setattr__(tr, "_scene", scene)
+        return tr
+
+    # -- access ----------------------------------------------------------------------------
+
+    def body(self, index: int) -> Result:
+        """Coordinates ``q`` and velocities ``v`` of one body (in the order added)."""
+        if self._scene is None:
+            raise TypeError("body() needs a Scene; a generalized-coordinate Model has none")
+        sq, sv = self._scene.layout()[index]
+        return Result(q=self["q"][:, sq], v=self["v"][:, sv])
+
+    def normal_impulse_per_step(self) -> np.ndarray:
+        """The sum of the normal impulses of every step (``N`` entries, N s)."""
+        out = np.zeros(len(self["t"]) - 1)
+        np.add.at(out, self["contact_step"], self["contact_impulse"][:, 0])
+        return out
+
+    def __repr__(self) -> str:
+        n = len(self["t"]) - 1
+        statuses, counts = np.unique(self["solver_status"], return_counts=True)
+        st = ", ".join(f"{s}: {c}" for s, c in zip(statuses, counts, strict=True))
+        worst = self._worst()
+        lines = [
+            f"Trajectory({n} steps of h = {self['h']:.3g} s to t = {self['t'][-1]:.6g} s, "
+            f"solver {self['solver']!r}",
+            f"  bodies: {len(self._scene.bodies) if self._scene else 'generalized model'}, "
+            f"q: {self['q'].shape}, v: {self['v'].shape}",
+            f"  contact records: {len(self['contact_step'])}, steps by status: {{{st}}}",
+            f"  min gap: {np.min(self['min_gap']):.3e} m, energy: "
+            f"{self['total_energy'][0]:.6g} J -> {self['total_energy'][-1]:.6g} J",
+            "  worst: " + ", ".join(f"{k} {v:.2e}" for k, v in worst.items()),
+        ]
+        if self["stopped"] is not None:
+            lines.append(f"  STOPPED: {self['stopped']}")
+        return "\n".join(lines) + ")"
+
+    __str__ = __repr__
+
+    # -- checks ----------------------------------------------------------------------------
+
+    def _worst(self) -> dict[str, float]:
+        def mx(a: np.ndarray) -> float:
+            return float(np.max(a)) if len(a) else 0.0
+
+        return {
+            "momentum_residual": mx(self["momentum_residual"]),
+            "solver_error": mx(self["solver_error"]),
+            "cone_violation": mx(self["cone_violation"]),
+            "complementarity": mx(self["complementarity"]),
+            "energy_gain": float(np.max(self.energy_gain(), initial=0.0)),
+        }
+
+    def energy_gain(self) -> np.ndarray:
+        """Per step, how much the total energy rose (J, negative when it fell). A step that
+        gives back a rebound (``resumed``) is judged across it and the step that closed the
+        contact, less the O(h) change of potential energy over those two steps."""
+        e = self["total_energy"]
+        gain = np.diff(e)
+        for k in np.flatnonzero(self["resumed"]):
+            if k >= 1:
+                work = abs(self["potential_energy"][k + 1] - self["potential_energy"][k - 1])
+                gain[k] = e[k + 1] - e[k - 1] - work
+        return gain
+
+    def check(
+        self,
+        strict: bool = False,
+        *,
+        momentum_tol: float = 1e-10,
+        impulse_tol: float = 1e-10,
+        complementarity_tol: float = 1e-8,
+        energy_tol: float = 1e-9,
+        gap_tol: float | None = None,
+    ) -> Result:
+        """Every violation of the seed's checks, as a summary.
+
+        Tolerances are relative: ``impulse_tol`` to the largest impulse,
+        ``complementarity_tol`` to the largest impulse times the velocity scale (``max |v|``
+        or ``|g| h``), ``energy_tol`` to
+        ``max(1, max |E|)``; ``gap_tol`` (m) is how deep a gap may go below zero (default the
+        simulation's ``gap_tolerance``). Checks: no
+        NaN or infinity, every contact solve succeeded, momentum balance, normal impulses
+        ``>= 0``, friction cone, complementarity, no penetration beyond ``gap_tol``, and no
+        energy gain (at impacts with ``e <= 1`` included). With ``strict=True`` a violation
+        raises :class:`TrajectoryCheckError`.
+        """
+        v: list[str] = []
+        if self["stopped"] is not None:
+            v.append(f"stopped early: {self['stopped']}")
+        for name in ("q", "v", "contact_impulse"):
+            if not np.all(np.isfinite(self[name])):
+                v.append(f"{name} has non-finite values")
+        bad = [(k, s) for k, s in enumerate(self["solver_status"])
+               if s not in ("solved", "no_contact")]
+        if bad:
+            k, s = bad[0]
+            v.append(f"{len(bad)} contact solves did not succeed (first: step {k}, {s}, "
+                     f"error {self['solver_error'][k]:.2e})")
+        scale = float(np.max(np.abs(self["contact_impulse"]), initial=0.0))
+        res = self["momentum_residual"]
+        if np.any(res > momentum_tol):
+            v.append(f"momentum residual up to {res.max():.2e} > {momentum_tol:.1e}")
+        mn = self["min_normal_impulse"]
+        if np.any(mn < -impulse_tol * scale):
+            v.append(f"negative normal impulse down to {mn.min():.3e} N s")
+        cone = self["cone_violation"]
+        if np.any(cone > impulse_tol * scale):
+            v.append(f"friction cone violated by up to {cone.max():.3e} N s")
+        # velocities at contacts are of the size of |v| or of what one step of the loads adds
+        gravity = float(np.linalg.norm(self._scene.gravity)) if self._scene else 0.0
+        vel = max(float(np.max(np.abs(self["v"]), initial=0.0)), gravity * self["h"])
+        comp = self["complementarity"]
+        if np.any(comp > complementarity_tol * max(scale * vel, 1e-300)):
+            v.append(f"complementarity product up to {comp.max():.3e}")
+        if gap_tol is None:
+            gap_tol = self["gap_tolerance"]
+        gaps = self["min_gap"]
+        if np.any(gaps < -gap_tol):
+            k = int(np.argmin(gaps))
+            v.append(f"penetration: min gap {gaps[k]:.3e} m at t = {self['t'][k]:.6g} s "
+                     f"({int(np.sum(gaps < -gap_tol))} states)")
+        etol = energy_tol * max(1.0, float(np.max(np.abs(self["total_energy"]))))
+        gain = self.energy_gain()
+        if np.any(gain > etol):
+            k = int(np.argmax(gain))
+            v.append(f"energy gained in {int(np.sum(gain > etol))} steps, up to "
+                     f"{gain[k]:.3e} J (step {k}, t = {self['t'][k]:.6g} s)")
+        out = Result(ok=not v, violations=v, **self._worst())
+        if strict and v:
+            raise TrajectoryCheckError("; ".join(v))
+        return out
+
+    # -- plots -----------------------------------------------------------------------------
+
+    def plot(self, axes: Any = None) -> Any:
+        """Coordinates, energy and normal impulses against time (needs matplotlib, the
+        ``plot`` extra). Returns the figure."""
+        try:
+            import matplotlib.pyplot as plt
+        except ImportError as exc:  # pragma: no cover - depends on the environment
+            raise ImportError(
+                "Trajectory.plot needs matplotlib: pip install 'coulomb[plot]'"
+            ) from exc
+        if axes is None:
+            fig, axes = plt.subplots(3, 1, sharex=True, figsize=(7, 8))
+        else:
+            fig = axes[0].figure
+        t = self["t"]
+        axes[0].plot(t, self["q"])
+        axes[0].set_ylabel("q")
+        axes[1].plot(t, self["kinetic_energy"], label="kinetic")
+        axes[1].plot(t, self["total_energy"], label="total")
+        axes[1].set_ylabel("energy (J)")
+        axes[1].legend()
+        axes[2].step(t[:-1], self.normal_impulse_per_step(), where="post")
+        axes[2].set_ylabel("normal impulse per step (N s)")
+        axes[2].set_xlabel("t (s)")
+        return fig
