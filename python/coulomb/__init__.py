@@ -20,6 +20,8 @@ painleve
     Painleve's sliding rod: the seed's A(theta), b and which smooth contact modes exist.
 regularized
     The tanh-smoothed friction law on a ramp (stiff ODE), to compare with exact Coulomb friction.
+extremes
+    The stability suite at the extremes (mass ratios, friction, restitution, steps, units).
 study
     Sweeps of the settings a user trades (error against cost, Pareto fronts, orders).
 errors
@@ -30,7 +32,18 @@ validate
 
 from __future__ import annotations
 
-from . import contact, errors, io, lcp, model, painleve, regularized, study, trajectory
+from . import (
+    contact,
+    errors,
+    extremes,
+    io,
+    lcp,
+    model,
+    painleve,
+    regularized,
+    study,
+    trajectory,
+)
 from ._core import __version__
 from ._result import Result
 from .contact import ContactResult
@@ -73,6 +86,7 @@ __all__ = [
     "__version__",
     "contact",
     "errors",
+    "extremes",
     "io",
     "lcp",
     "model",
