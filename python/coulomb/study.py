@@ -39,7 +39,9 @@ __all__ = [
     "contact_tolerance",
     "convergence_order",
     "nsgs_tolerance",
+    "painleve_jam",
     "pareto_front",
+    "ramp",
     "regularized_ramp",
     "sweep",
 ]
@@ -429,6 +431,70 @@ def nsgs_tolerance(
     }
 
 
+def ramp(
+    h: float = 1e-3,
+    solver: str = "nsgs",
+    tol: float | None = None,
+    facets: int | None = None,
+    warm_start: bool = True,
+    t_end: float = 4.0,
+) -> dict[str, Any]:
+    """The seed's ramp (20 deg, mu = 0.4, v0 = 1 m/s down the slope) stepped at ``h``:
+    ``stop_distance`` (exact 1.5053 m), ``stop_time`` (exact 3.0112 s), ``creep`` (motion after
+    the stop; exact 0) and the stepper's work."""
+    from .model import HalfSpace, Particle, Point, Scene
+
+    th = math.radians(20.0)
+    scene = Scene(dim=2, gravity=(0.0, -9.81))
+    block = scene.add(
+        Particle(mass=1.0, position=(0.0, 0.0), velocity=(math.cos(th), -math.sin(th)))
+    )
+    scene.contact(scene.attach(block, Point()), scene.add(HalfSpace.ramp(20.0)), mu=0.4)
+    tr = scene.simulate(
+        t_end,
+        h,
+        solver,
+        tol=tol,
+        facets=facets,
+        warm_start=warm_start,  # type: ignore[arg-type]
+    )
+    still = np.flatnonzero(np.all(np.abs(tr.v) < 1e-12, axis=1))
+    k = int(still[0]) if len(still) else len(tr.t) - 1
+    s = tr.q[:, 0] * math.cos(th) - tr.q[:, 1] * math.sin(th)
+    return {
+        "stop_distance": float(s[k]),
+        "stop_time": float(tr.t[k]),
+        "creep": float(abs(s[-1] - s[k])),
+        "iterations": int(np.sum(tr.iterations)),
+        "success": bool(tr.success),
+    }
+
+
+def painleve_jam(h: float = 1e-3, solver: str = "nsgs") -> dict[str, Any]:
+    """The seed's Painleve rod (m = 1, l = 1, J = 1/12, mu = 2, 45 deg, end sliding left at
+    1 m/s): the first step's impulse, which jams the end. Its limit as h -> 0 stops the end
+    exactly: ``P_n = 0.375``, ``P_t = 0.625`` N s."""
+    from .model import HalfSpace, RigidBody2D, Scene, Segment
+
+    th = math.radians(45.0)
+    scene = Scene(dim=2, gravity=(0.0, -9.81))
+    rod = scene.add(
+        RigidBody2D(
+            mass=1.0,
+            inertia=1.0 / 12.0,
+            position=(0.0, 0.5 * math.sin(th)),
+            angle=th,
+            velocity=(-1.0, 0.0),
+        )
+    )
+    floor = scene.add(HalfSpace((0.0, 0.0), (0.0, 1.0)))
+    scene.contact(scene.attach(rod, Segment((-0.5, 0.0), (0.5, 0.0))), floor, mu=2.0)
+    tr = scene.simulate(3 * h, h, solver)  # type: ignore[arg-type]
+    first = tr.contact_step == 0
+    pn, pt = tr.contact_impulse[first][0]
+    return {"P_n": float(pn), "P_t": float(pt), "success": bool(tr.success)}
+
+
 #: Named studies for ``coulomb study NAME``: the run, its grid, its reference, and the
 #: setting whose convergence order is reported.
 PRESETS: dict[str, dict[str, Any]] = {
@@ -449,6 +515,24 @@ PRESETS: dict[str, dict[str, Any]] = {
         "quantities": ["normal_impulse"],
         "order": "tol",
         "about": "NSGS on a 12-contact chain: impulse error against tolerance",
+    },
+    "ramp-h": {
+        "run": ramp,
+        "grid": {"h": [1e-1, 3e-2, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4], "solver": ["nsgs", "lemke"]},
+        "reference": {
+            "stop_distance": 1.0
+            / (2.0 * 9.81 * (0.4 * math.cos(math.radians(20.0)) - math.sin(math.radians(20.0))))
+        },
+        "order": "h",
+        "order_where": {"solver": "nsgs"},
+        "about": "the seed's ramp: stop-distance error against step size and solver",
+    },
+    "painleve-h": {
+        "run": painleve_jam,
+        "grid": {"h": [1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5, 1e-5]},
+        "reference": {"P_n": 0.375, "P_t": 0.625},
+        "order": "h",
+        "about": "Painleve's rod: the jam impulse against step size (limit 0.375, 0.625 N s)",
     },
     "regularized-ramp": {
         "run": regularized_ramp,

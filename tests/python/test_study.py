@@ -166,3 +166,36 @@ def test_cli_study(tmp_path) -> None:
         [sys.executable, "-m", "coulomb.cli", "study", "--list"], capture_output=True, text=True
     )
     assert "nsgs-tolerance" in listing.stdout
+
+
+def test_ramp_front_falls_with_h_at_first_order() -> None:
+    s = study.run_preset("ramp-h")
+    for solver in ("nsgs", "lemke"):
+        rows = [r for r in s.records if r["solver"] == solver]
+        errors = [r["error"] for r in rows]  # h decreasing along the grid
+        assert all(a > b for a, b in itertools.pairwise(errors)), (solver, errors)
+        assert 0.9 < s.order("h", where={"solver": solver}) < 1.1
+        assert all(r["creep"] < 1e-9 and r["success"] for r in rows)
+
+
+def test_painleve_jam_impulse_converges_at_first_order() -> None:
+    s = study.run_preset("painleve-h")
+    assert 0.9 < s.order("h") < 1.1
+    assert s.records[-1]["error"] < 5e-4
+    assert all(r["success"] for r in s.records)
+
+
+def test_fifty_ramp_settings_with_progress() -> None:
+    grid = {
+        "h": [1e-1, 5e-2, 2e-2, 1e-2, 5e-3, 2e-3, 1e-3],
+        "solver": ["nsgs", "lemke"],
+        "tol": [1e-6, 1e-9],
+        "warm_start": [True, False],
+    }
+    points = [dict(zip(grid, v, strict=True)) for v in itertools.product(*grid.values())][:50]
+    lines: list[str] = []
+    s = study.sweep(study.ramp, points, reference={"stop_distance": 1.5053}, progress=lines.append)
+    assert len(s) == 50 and len(lines) == 50 and lines[-1].startswith("[50/50]")
+    assert all(r["success"] for r in s.records)
+    front = s.pareto()
+    assert front and all(math.isfinite(r["error"]) for r in front)
