@@ -56,8 +56,12 @@ def _study(args: argparse.Namespace) -> int:
             executor.shutdown()
     preset = study.PRESETS[args.name]
     print(s)
-    order = s.order(preset["order"], where=preset.get("order_where"))
-    print(f"measured order of the error in {preset['order']}: {order:.3f}")
+    worst = max(r["error"] for r in s.records)
+    if worst <= 1e-12:
+        print(f"the error is at most {worst:.1e} at every point: exact, no order to measure")
+    else:
+        order = s.order(preset["order"], where=preset.get("order_where"))
+        print(f"measured order of the error in {preset['order']}: {order:.3f}")
     if args.csv:
         print(f"wrote {s.to_csv(args.csv)}")
     if args.json:

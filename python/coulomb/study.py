@@ -38,6 +38,7 @@ __all__ = [
     "Study",
     "contact_tolerance",
     "convergence_order",
+    "floor_impact",
     "nsgs_tolerance",
     "painleve_jam",
     "pareto_front",
@@ -495,6 +496,23 @@ def painleve_jam(h: float = 1e-3, solver: str = "nsgs") -> dict[str, Any]:
     return {"P_n": float(pn), "P_t": float(pt), "success": bool(tr.success)}
 
 
+def floor_impact(h: float = 1e-3, phase: float = 0.3, speed: float = 3.0) -> dict[str, Any]:
+    """The seed's floor impact (m = 0.5 kg, e = 0.6) at ``speed`` m/s, the impact falling
+    ``phase`` of the way into a step: the rebound (exact: ``0.6 speed``) and impulse (exact:
+    ``0.8 speed`` N s)."""
+    from .model import HalfSpace, Particle, Point, Scene
+
+    scene = Scene(dim=2, gravity=(0.0, 0.0))
+    ball = scene.add(Particle(mass=0.5, position=(0.0, phase * speed * h), velocity=(0.0, -speed)))
+    scene.contact(scene.attach(ball, Point()), scene.add(HalfSpace((0.0, 0.0), (0.0, 1.0))), e=0.6)
+    tr = scene.simulate(4 * h, h)
+    return {
+        "rebound": float(tr.v[-1, 1]),
+        "impulse": float(tr.contact_impulse[:, 0].sum()),
+        "success": bool(tr.success),
+    }
+
+
 #: Named studies for ``coulomb study NAME``: the run, its grid, its reference, and the
 #: setting whose convergence order is reported.
 PRESETS: dict[str, dict[str, Any]] = {
@@ -526,6 +544,14 @@ PRESETS: dict[str, dict[str, Any]] = {
         "order": "h",
         "order_where": {"solver": "nsgs"},
         "about": "the seed's ramp: stop-distance error against step size and solver",
+    },
+    "impact-h": {
+        "run": floor_impact,
+        "grid": {"h": [1e-1, 1e-2, 1e-3, 1e-4, 1e-5], "phase": [0.0, 0.3, 0.9]},
+        "reference": {"rebound": 1.8, "impulse": 2.4},
+        "order": "h",
+        "about": "the seed's floor impact (e = 0.6): rebound and impulse against step size and "
+        "where in the step the impact falls (exact at every h)",
     },
     "painleve-h": {
         "run": painleve_jam,

@@ -199,3 +199,10 @@ def test_fifty_ramp_settings_with_progress() -> None:
     assert all(r["success"] for r in s.records)
     front = s.pareto()
     assert front and all(math.isfinite(r["error"]) for r in front)
+
+
+def test_impact_is_exact_at_every_step_size_and_phase() -> None:
+    s = study.run_preset("impact-h")
+    assert len(s) == 15
+    assert max(r["error"] for r in s.records) < 1e-12
+    assert all(r["success"] for r in s.records)
