@@ -51,4 +51,6 @@ def step_simulate(
     gap_tolerance: float = 1e-9,
     warm_start: bool = True,
     fallback: bool = True,
+    drift: str = "none",
+    drift_bias: float = 0.2,
 ) -> dict[str, Any]: ...

@@ -407,6 +407,8 @@ class Scene:
         gap_tolerance: float = 1e-9,
         warm_start: bool = True,
         fallback: bool = True,
+        drift: Literal["none", "bias", "projection"] = "none",
+        drift_bias: float = 0.2,
     ) -> Trajectory:
         """Runs ``ceil(t_end / h)`` steps of the impulse time stepper from the initial state.
 
@@ -433,6 +435,14 @@ class Scene:
             When NSGS misses its tolerance (it can stall on singular, strongly coupled W),
             also solve by the polyhedral Lemke and keep the answer with the smaller exact-disk
             error (such steps are marked in ``fallback``).
+        drift : {"none", "bias", "projection"}
+            The position-drift correction (a velocity-level step does not enforce
+            ``g(q_{k+1}) >= 0`` exactly): none; a velocity bias, a closed contact with ``g < 0``
+            getting ``J_n v_{k+1} + e v_n^- + drift_bias g / h >= 0`` (pushes a fraction
+            ``drift_bias`` in (0, 1] of the penetration out per step, adding kinetic energy);
+            or a post-step projection of the step's penetrating contacts onto ``g >= 0`` by the
+            M-smallest displacement (velocities untouched; its size per step is in
+            ``projection``).
         """
         t_end = _positive("t_end", t_end)
         h = _positive("h", h)
@@ -452,6 +462,11 @@ class Scene:
         if not (math.isfinite(gap_tolerance) and gap_tolerance >= 0.0):
             raise InvalidParameterError(f"gap_tolerance must be finite and >= 0, got "
                                         f"{gap_tolerance}")
+        if drift not in ("none", "bias", "projection"):
+            raise InvalidParameterError(
+                f"unknown drift correction {drift!r}: expected 'none', 'bias' or 'projection'")
+        if drift == "bias" and not (0.0 < float(drift_bias) <= 1.0):
+            raise InvalidParameterError(f"drift_bias must lie in (0, 1], got {drift_bias}")
         if not self.bodies:
             raise InvalidParameterError("the scene has no bodies")
         steps = max(1, math.ceil(t_end / h - 1e-9))
@@ -459,7 +474,7 @@ class Scene:
         raw = _core.step_simulate(
             spec, h, steps, solver=solver, tol=tol, max_iter=max_iter, relaxation=relaxation,
             facets=facets, gap_tolerance=gap_tolerance, warm_start=warm_start,
-            fallback=fallback,
+            fallback=fallback, drift=drift, drift_bias=float(drift_bias),
         )
         return Trajectory._from_core(raw, scene=self, h=h, solver=solver,
                                      gap_tolerance=gap_tolerance)

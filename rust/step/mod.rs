@@ -35,8 +35,9 @@
 //! sphere vs sphere (every point of one shape against every point of the other).
 //!
 //! Drift: a velocity-level condition does not enforce `g(q_{k+1}) >= 0` exactly (seed,
-//! "Position drift and restitution"). Gaps are monitored in every step's record; no correction
-//! is applied.
+//! "Position drift and restitution"). Gaps are monitored in every step's record, and
+//! [`Drift`] chooses a correction: none (the default), a velocity bias, or a post-step
+//! projection onto `g >= 0`.
 
 mod stepper;
 
@@ -335,6 +336,23 @@ pub enum StepSolver {
     Lemke(PolyhedralSettings),
 }
 
+/// The position-drift correction (seed: "Monitor the gap and use an appropriate correction";
+/// "Position projection should be documented and checked for its effect on constraints and
+/// energy").
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Drift {
+    /// none: closed contacts keep whatever penetration the linearised update leaves.
+    None,
+    /// a velocity bias: a closed contact with `g < 0` gets `0 <= P_n ⊥ J_n v_{k+1} + e v_n^- +
+    /// beta g / h >= 0`, pushing a fraction `beta` in (0, 1] of the penetration out per step
+    /// (Baumgarte-like; it adds the kinetic energy of that push).
+    VelocityBias(f64),
+    /// a post-step projection: after `q_{k+1} = q_k + h v_{k+1}`, the contacts of the step with
+    /// `g(q_{k+1}) < -gap_tolerance` are pushed out by the M-smallest displacement
+    /// `Δq = M^{-1} J_n^T λ`, `0 <= λ ⊥ J_n M^{-1} J_n^T λ + g >= 0` (velocities untouched).
+    Projection,
+}
+
 /// Settings of [`simulate`].
 #[derive(Clone, Debug)]
 pub struct StepSettings {
@@ -352,6 +370,8 @@ pub struct StepSettings {
     /// `max(tol, 1e-9)`) and keep the answer with the smaller exact-disk error; the step is
     /// then solved if that error is within the tolerance.
     pub fallback: bool,
+    /// the drift correction.
+    pub drift: Drift,
 }
 
 impl StepSettings {
@@ -367,6 +387,7 @@ impl StepSettings {
             gap_tolerance: 1e-9,
             warm_start: true,
             fallback: true,
+            drift: Drift::None,
         }
     }
 
@@ -383,6 +404,13 @@ impl StepSettings {
                 "gap_tolerance must be finite and >= 0, got {}",
                 self.gap_tolerance
             )));
+        }
+        if let Drift::VelocityBias(beta) = self.drift {
+            if !(beta > 0.0 && beta <= 1.0) {
+                return Err(bad(format!(
+                    "the drift velocity bias must lie in (0, 1], got {beta}"
+                )));
+            }
         }
         Ok(())
     }

@@ -3,12 +3,13 @@
 // index loops mirror the equations (a: velocity component, j: contact-frame component)
 #![allow(clippy::needless_range_loop)]
 
-use super::{det3, BodyKind, Pair, Scene, StepSettings, StepSolver};
+use super::{det3, BodyKind, Drift, Pair, Scene, StepSettings, StepSolver};
 use crate::contact::{
     measure, solve_nsgs, solve_polyhedral, ContactMeasures, ContactProblem, ContactSolution,
     ContactStatus, NsgsSettings, PolyhedralSettings,
 };
 use crate::error::Result;
+use crate::lcp::{solve_lemke, LcpRef, LemkeSettings};
 
 /// below this a norm counts as zero when forming a relative residual.
 const TINY: f64 = 1e-300;
@@ -40,6 +41,8 @@ pub struct StepRecord {
     /// NSGS missed its tolerance and the polyhedral Lemke's answer, better on the exact-disk
     /// error, was used instead (see [`super::StepSettings::fallback`]).
     pub fallback: bool,
+    /// the largest position change of the drift projection (m or rad), 0 without it.
+    pub projection: f64,
 }
 
 /// One active contact in one step.
@@ -172,6 +175,9 @@ struct Geometry {
     nsides: usize,
 }
 
+/// (gap, (body, normal column) per side, sides) of a penetrating contact to project out.
+type Penetration = (f64, [(usize, [f64; 6]); 2], usize);
+
 /// The stepper: a scene's state and the workspaces reused by every step.
 pub struct Stepper {
     dim: usize,
@@ -269,6 +275,31 @@ fn quat_to_rot(q: &[f64]) -> [f64; 9] {
         2.0 * (y * z + w * x),
         1.0 - 2.0 * (x * x + y * y),
     ]
+}
+
+/// `q <- exp(phi / 2) ⊗ q` for a unit quaternion `(w, x, y, z)` and a world-frame rotation
+/// vector phi, renormalised.
+fn rotate(q: &mut [f64], phi: [f64; 3]) {
+    let angle = dot(phi, phi).sqrt();
+    if angle == 0.0 {
+        return;
+    }
+    let (s, c) = (0.5 * angle).sin_cos();
+    let k = s / angle;
+    let dv = [k * phi[0], k * phi[1], k * phi[2]];
+    let ov = [q[1], q[2], q[3]];
+    let cr = cross(dv, ov);
+    let mut nq = [
+        c * q[0] - dot(dv, ov),
+        c * ov[0] + q[0] * dv[0] + cr[0],
+        c * ov[1] + q[0] * dv[1] + cr[1],
+        c * ov[2] + q[0] * dv[2] + cr[2],
+    ];
+    let norm = nq.iter().map(|x| x * x).sum::<f64>().sqrt();
+    for x in &mut nq {
+        *x /= norm;
+    }
+    q.copy_from_slice(&nq);
 }
 
 /// An orthonormal contact frame, normal first: in 2D the tangent is the normal turned by
@@ -684,6 +715,7 @@ impl Stepper {
             complementarity: 0.0,
             resumed: false,
             fallback: false,
+            projection: 0.0,
         };
         for x in &mut self.gp {
             *x = 0.0;
@@ -736,7 +768,11 @@ impl Stepper {
                         record.resumed = true;
                     }
                     self.active[i].approach = vminus;
-                    cand.e * vminus
+                    let bias = match self.settings.drift {
+                        Drift::VelocityBias(beta) if ai.gap < 0.0 => beta * ai.gap / h,
+                        _ => 0.0,
+                    };
+                    cand.e * vminus + bias
                 } else {
                     // imminent: 0 <= P_n ⊥ J_n v_{k+1} + g / h >= 0
                     self.active[i].approach = ai.vn_k;
@@ -914,35 +950,110 @@ impl Stepper {
                         q[k] += h * v[k];
                     }
                     // q <- exp(h ω / 2) ⊗ q: the exact rotation by the world-frame h ω
-                    let w = [v[3], v[4], v[5]];
-                    let angle = dot(w, w).sqrt() * h;
-                    if angle > 0.0 {
-                        let (s, c) = (0.5 * angle).sin_cos();
-                        let k = s / (angle / h);
-                        let d = [c, k * w[0], k * w[1], k * w[2]];
-                        let o = [q[3], q[4], q[5], q[6]];
-                        let dv = [d[1], d[2], d[3]];
-                        let ov = [o[1], o[2], o[3]];
-                        let cr = cross(dv, ov);
-                        let nw = d[0] * o[0] - dot(dv, ov);
-                        let mut nq = [
-                            nw,
-                            d[0] * ov[0] + o[0] * dv[0] + cr[0],
-                            d[0] * ov[1] + o[0] * dv[1] + cr[1],
-                            d[0] * ov[2] + o[0] * dv[2] + cr[2],
-                        ];
-                        let norm = nq.iter().map(|x| x * x).sum::<f64>().sqrt();
-                        for x in &mut nq {
-                            *x /= norm;
-                        }
-                        q[3..7].copy_from_slice(&nq);
-                    }
+                    rotate(&mut q[3..7], [h * v[3], h * v[4], h * v[5]]);
                 }
             }
+        }
+        if self.settings.drift == Drift::Projection && nc > 0 {
+            record.projection = self.project()?;
         }
         self.step_index += 1;
         self.t = self.step_index as f64 * h;
         Ok(record)
+    }
+
+    /// The post-step projection of [`Drift::Projection`] over this step's active contacts:
+    /// `0 <= λ ⊥ W_nn λ + g >= 0` at `q_{k+1}`, `Δq = M^{-1} J_n^T λ`. Returns the largest
+    /// coordinate change.
+    fn project(&mut self) -> Result<f64> {
+        self.freeze();
+        let tol_gap = self.settings.gap_tolerance;
+        let mut rows: Vec<Penetration> = Vec::new();
+        for a in &self.active {
+            let geo = self.geometry(a.cand);
+            if geo.gap >= -tol_gap {
+                continue;
+            }
+            let mut cols = [(0usize, [0.0; 6]); 2];
+            for s in 0..geo.nsides {
+                let (body, sign, r) = geo.sides[s];
+                let mut col = self.column(body, r, geo.normal);
+                for x in &mut col {
+                    *x *= sign;
+                }
+                cols[s] = (body, col);
+            }
+            rows.push((geo.gap, cols, geo.nsides));
+        }
+        if rows.is_empty() {
+            return Ok(0.0);
+        }
+        let n = rows.len();
+        // W_nn = J_n M^{-1} J_n^T
+        let mut w = vec![0.0; n * n];
+        for (i, ri) in rows.iter().enumerate() {
+            for (j, rj) in rows.iter().enumerate() {
+                let mut s = 0.0;
+                for &(bi, ci) in &ri.1[..ri.2] {
+                    for &(bj, cj) in &rj.1[..rj.2] {
+                        if bi != bj {
+                            continue;
+                        }
+                        let minv = &self.frozen[bi].minv;
+                        let nv = self.bodies[bi].nv;
+                        for a in 0..nv {
+                            for c in 0..nv {
+                                s += ci[a] * minv[a * 6 + c] * cj[c];
+                            }
+                        }
+                    }
+                }
+                w[i * n + j] = s;
+            }
+        }
+        let g: Vec<f64> = rows.iter().map(|r| r.0).collect();
+        let lcp = LcpRef::new(n, &w, &g)?;
+        let sol = solve_lemke(&lcp, &LemkeSettings::default())?;
+        if !sol.z.iter().all(|z| z.is_finite()) {
+            return Ok(0.0);
+        }
+        // Δv-like displacement per body, then applied to the coordinates
+        let mut dq = vec![0.0; self.nv];
+        for (i, r) in rows.iter().enumerate() {
+            let lam = sol.z[i];
+            for &(b, col) in &r.1[..r.2] {
+                let body = &self.bodies[b];
+                let minv = &self.frozen[b].minv;
+                for a in 0..body.nv {
+                    dq[body.off_v + a] +=
+                        (0..body.nv).map(|c| minv[a * 6 + c] * col[c]).sum::<f64>() * lam;
+                }
+            }
+        }
+        let largest = dq.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        self.displace(&dq);
+        Ok(largest)
+    }
+
+    /// `q <- q ⊕ dq` with dq in velocity coordinates (a rotation vector for spatial bodies).
+    fn displace(&mut self, dq: &[f64]) {
+        for b in &self.bodies {
+            let q = &mut self.q[b.off_q..];
+            let d = &dq[b.off_v..b.off_v + b.nv];
+            match b.kind {
+                BodyKind::Particle | BodyKind::Planar => {
+                    for k in 0..b.nv {
+                        q[k] += d[k];
+                    }
+                }
+                BodyKind::Spatial => {
+                    for k in 0..3 {
+                        q[k] += d[k];
+                    }
+                    rotate(&mut q[3..7], [d[3], d[4], d[5]]);
+                }
+            }
+        }
     }
 
     fn push_state(&mut self, out: &mut Trajectory) {
