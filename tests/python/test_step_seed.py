@@ -216,3 +216,12 @@ def test_drift_corrections_measured_effect():
         painleve_scene().simulate(0.1, 1e-3, drift="bias", drift_bias=0.0)
     with pytest.raises(coulomb.errors.InvalidParameterError):
         painleve_scene().simulate(0.1, 1e-3, drift="baumgarte")
+
+
+def test_validation_rows_all_pass():
+    from coulomb import _step_figures
+
+    rows = list(_step_figures.rows())
+    assert len(rows) == 12
+    for case, quantity, expected, computed, tol in rows:
+        assert abs(computed - expected) <= tol, (case, quantity, expected, computed)
