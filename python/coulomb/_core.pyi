@@ -53,4 +53,5 @@ def step_simulate(
     fallback: bool = True,
     drift: str = "none",
     drift_bias: float = 0.2,
+    restitution: str = "newton",
 ) -> dict[str, Any]: ...

@@ -12,7 +12,8 @@ use super::{guarded, to_py};
 use crate::contact::{NsgsSettings, PolyhedralSettings};
 use crate::error::CoulombError;
 use crate::step::{
-    simulate, Body, BodyKind, Drift, HalfSpace, Pair, Scene, Shape, StepSettings, StepSolver,
+    simulate, Body, BodyKind, Drift, HalfSpace, Pair, Restitution, Scene, Shape, StepSettings,
+    StepSolver,
 };
 
 fn item<'py, T: FromPyObjectOwned<'py>>(d: &Bound<'py, PyDict>, key: &str) -> PyResult<T> {
@@ -137,7 +138,7 @@ fn matrix<'py, T: numpy::Element>(
 #[pyfunction]
 #[pyo3(signature = (scene, h, steps, solver="nsgs", tol=1e-12, max_iter=None, relaxation=1.0,
                     facets=None, gap_tolerance=1e-9, warm_start=true, fallback=true,
-                    drift="none", drift_bias=0.2))]
+                    drift="none", drift_bias=0.2, restitution="newton"))]
 #[allow(clippy::too_many_arguments)]
 pub(super) fn step_simulate<'py>(
     py: Python<'py>,
@@ -154,6 +155,7 @@ pub(super) fn step_simulate<'py>(
     fallback: bool,
     drift: &str,
     drift_bias: f64,
+    restitution: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let scene = scene_from_dict(scene)?;
     let solver = match solver {
@@ -195,6 +197,18 @@ pub(super) fn step_simulate<'py>(
             ))
         }
     };
+    let restitution = match restitution {
+        "newton" => Restitution::Newton,
+        "poisson" => Restitution::Poisson,
+        other => {
+            return Err(to_py(
+                py,
+                CoulombError::InvalidParameter(format!(
+                    "unknown restitution law {other:?}: expected 'newton' or 'poisson'"
+                )),
+            ))
+        }
+    };
     let settings = StepSettings {
         h,
         steps,
@@ -203,6 +217,7 @@ pub(super) fn step_simulate<'py>(
         warm_start,
         fallback,
         drift,
+        restitution,
     };
     let (tr, seconds) = guarded(py, usize::MAX, || {
         let start = std::time::Instant::now();

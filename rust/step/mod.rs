@@ -353,6 +353,20 @@ pub enum Drift {
     Projection,
 }
 
+/// The impact law at closed contacts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Restitution {
+    /// Newton's: `0 <= P_n ⊥ J_n v_{k+1} + e v_n^- >= 0` (the seed's velocity-level
+    /// condition).
+    Newton,
+    /// Poisson's: an impact phase on `v_k` alone, the compression impulse `P_comp` (the
+    /// contact problem with `e = 0` on the approach velocity `v_n^-`, friction included), then
+    /// the normal restitution impulse `P_rest = e P_comp` (each pair's `e` as `e_P`; friction is
+    /// not re-solved during restitution), after which the step's smooth phase is inelastic. For
+    /// a single frictionless impact it agrees with Newton's law (seed).
+    Poisson,
+}
+
 /// Settings of [`simulate`].
 #[derive(Clone, Debug)]
 pub struct StepSettings {
@@ -372,6 +386,8 @@ pub struct StepSettings {
     pub fallback: bool,
     /// the drift correction.
     pub drift: Drift,
+    /// the impact law at closed contacts.
+    pub restitution: Restitution,
 }
 
 impl StepSettings {
@@ -388,6 +404,7 @@ impl StepSettings {
             warm_start: true,
             fallback: true,
             drift: Drift::None,
+            restitution: Restitution::Newton,
         }
     }
 

@@ -3,7 +3,7 @@
 // index loops mirror the equations (a: velocity component, j: contact-frame component)
 #![allow(clippy::needless_range_loop)]
 
-use super::{det3, BodyKind, Drift, Pair, Scene, StepSettings, StepSolver};
+use super::{det3, BodyKind, Drift, Pair, Restitution, Scene, StepSettings, StepSolver};
 use crate::contact::{
     measure, solve_nsgs, solve_polyhedral, ContactMeasures, ContactProblem, ContactSolution,
     ContactStatus, NsgsSettings, PolyhedralSettings,
@@ -161,6 +161,8 @@ struct Active {
     closed: bool,
     vn_k: f64,
     approach: f64,
+    /// Poisson: the compression impulse already applied by landing steps.
+    carried: f64,
     sides: [Side; 2],
     nsides: usize,
 }
@@ -198,6 +200,7 @@ pub struct Stepper {
     active: Vec<Active>,
     w: Vec<f64>,
     qc: Vec<f64>,
+    q1: Vec<f64>,
     mu: Vec<f64>,
     /// the last impulse of every candidate (`dim` each), for warm starts.
     warm: Vec<f64>,
@@ -205,6 +208,8 @@ pub struct Stepper {
     approach: Vec<f64>,
     /// whether the candidate's last step was open and pushed (it closed the contact).
     landed: Vec<bool>,
+    /// the normal impulse of those landing steps (Poisson's compression carried over).
+    landing: Vec<f64>,
     gp: Vec<f64>,
     v_next: Vec<f64>,
 }
@@ -438,10 +443,12 @@ impl Stepper {
             active: Vec::with_capacity(nc),
             w: Vec::new(),
             qc: Vec::new(),
+            q1: Vec::new(),
             mu: Vec::new(),
             warm: vec![0.0; nc * dim],
             approach: vec![0.0; nc],
             landed: vec![false; nc],
+            landing: vec![0.0; nc],
             candidates,
         })
     }
@@ -666,6 +673,7 @@ impl Stepper {
             if geo.gap > tol_gap + 2.0 * h * closing {
                 self.approach[c] = 0.0;
                 self.landed[c] = false;
+                self.landing[c] = 0.0;
                 for x in &mut self.warm[c * dim..(c + 1) * dim] {
                     *x = 0.0;
                 }
@@ -729,6 +737,10 @@ impl Stepper {
             self.w.resize(n * n, 0.0);
             self.qc.clear();
             self.qc.resize(n, 0.0);
+            self.q1.clear();
+            self.q1.resize(n, 0.0);
+            let poisson = self.settings.restitution == Restitution::Poisson;
+            let mut poisson_impact = false;
             self.mu.clear();
             for i in 0..nc {
                 let ai = self.active[i];
@@ -752,13 +764,18 @@ impl Stepper {
                         }
                     }
                 }
-                // q_c = G^T v_free, then the normal's restitution or gap term
+                // q_c = G^T v_free (and q_1 = G^T v_k for Poisson's impact phase), then the
+                // normal's restitution or gap term
                 for si in &ai.sides[..ai.nsides] {
                     let b = &self.bodies[si.body];
                     for al in 0..dim {
-                        self.qc[i * dim + al] += (0..b.nv)
-                            .map(|a| si.g[a * 3 + al] * self.v_free[b.off_v + a])
-                            .sum::<f64>();
+                        let (mut f, mut k) = (0.0, 0.0);
+                        for a in 0..b.nv {
+                            f += si.g[a * 3 + al] * self.v_free[b.off_v + a];
+                            k += si.g[a * 3 + al] * self.v[b.off_v + a];
+                        }
+                        self.qc[i * dim + al] += f;
+                        self.q1[i * dim + al] += k;
                     }
                 }
                 let bound = if ai.closed {
@@ -772,78 +789,57 @@ impl Stepper {
                         Drift::VelocityBias(beta) if ai.gap < 0.0 => beta * ai.gap / h,
                         _ => 0.0,
                     };
-                    cand.e * vminus + bias
+                    if poisson {
+                        // the impact phase compresses on J_n v_k; what a landing step already
+                        // pushed counts in the compression impulse
+                        self.active[i].carried = self.landing[ai.cand];
+                        poisson_impact |= ai.vn_k < 0.0 || self.landed[ai.cand];
+                        bias
+                    } else {
+                        cand.e * vminus + bias
+                    }
                 } else {
                     // imminent: 0 <= P_n ⊥ J_n v_{k+1} + g / h >= 0
                     self.active[i].approach = ai.vn_k;
+                    self.q1[i * dim] += ai.gap / h;
                     ai.gap / h
                 };
                 self.qc[i * dim] += bound;
             }
-            let problem = ContactProblem::new(dim, &self.w, &self.qc, &self.mu)?;
-            // r = 0 solves the problem exactly when no contact's normal would close
-            // (u = q, u_n >= 0, and 0 lies in every cone): no solve needed
-            let separating = (0..nc).all(|i| self.qc[i * dim] >= 0.0);
-            let sol = if separating {
-                let r = vec![0.0; n];
-                let (velocity, measures) = measure(&problem, &r)?;
-                ContactSolution {
-                    impulse: r,
-                    velocity,
-                    status: ContactStatus::Solved,
-                    message: "no contact closes: zero impulses".into(),
-                    iterations: 0,
-                    measures: ContactMeasures {
-                        error: 0.0,
-                        error_q: 0.0,
-                        ..measures
-                    },
+            let initial = if self.settings.warm_start {
+                let mut init = vec![0.0; n];
+                for (i, a) in self.active.iter().enumerate() {
+                    init[i * dim..(i + 1) * dim]
+                        .copy_from_slice(&self.warm[a.cand * dim..(a.cand + 1) * dim]);
                 }
+                Some(init)
             } else {
-                match &self.settings.solver {
-                    StepSolver::Nsgs(s) => {
-                        let initial = if self.settings.warm_start {
-                            let mut init = vec![0.0; n];
-                            for (i, a) in self.active.iter().enumerate() {
-                                init[i * dim..(i + 1) * dim]
-                                    .copy_from_slice(&self.warm[a.cand * dim..(a.cand + 1) * dim]);
-                            }
-                            Some(init)
-                        } else {
-                            None
-                        };
-                        let settings = NsgsSettings {
-                            initial,
-                            ..s.clone()
-                        };
-                        let first = solve_nsgs(&problem, &settings)?;
-                        if first.success() || !self.settings.fallback {
-                            first
-                        } else {
-                            // NSGS can stall on singular, strongly coupled W (e.g. a rod
-                            // lying on two contacts with mu = 2): Lemke's pivoting on the
-                            // polyhedral cone (exact in 2D) decides; keep the better answer
-                            let mut lemke = PolyhedralSettings::for_dim(dim);
-                            lemke.lemke.tol = s.tol.max(1e-9);
-                            let second = solve_polyhedral(&problem, &lemke)?;
-                            if second.measures.error < first.measures.error {
-                                record.fallback = true;
-                                ContactSolution {
-                                    status: if second.measures.error <= s.tol.max(1e-9) {
-                                        ContactStatus::Solved
-                                    } else {
-                                        second.status
-                                    },
-                                    ..second
-                                }
-                            } else {
-                                first
-                            }
-                        }
-                    }
-                    StepSolver::Lemke(s) => solve_polyhedral(&problem, s)?,
-                }
+                None
             };
+            // Poisson: an impact phase on v_k alone (compression, e = 0, then the normal
+            // restitution impulse e P_comp), before the step's inelastic solve
+            let mut p_impact = vec![];
+            if poisson_impact {
+                let problem = ContactProblem::new(dim, &self.w, &self.q1, &self.mu)?;
+                let comp =
+                    solve_step_problem(&self.settings, &problem, initial.clone(), &mut record)?;
+                p_impact = comp.impulse;
+                for (i, a) in self.active.iter().enumerate() {
+                    let e = self.candidates[a.cand].e;
+                    p_impact[i * dim] = (1.0 + e) * p_impact[i * dim] + e * a.carried;
+                }
+                // the smooth phase starts from v_free + M^{-1} G P_impact
+                let mut wp = vec![0.0; n];
+                problem.mul_w(&p_impact, &mut wp);
+                for (q, d) in self.qc.iter_mut().zip(&wp) {
+                    *q += d;
+                }
+            }
+            let problem = ContactProblem::new(dim, &self.w, &self.qc, &self.mu)?;
+            let mut sol = solve_step_problem(&self.settings, &problem, initial, &mut record)?;
+            for (p, d) in sol.impulse.iter_mut().zip(&p_impact) {
+                *p += d;
+            }
             record.status = Some(sol.status);
             record.error = sol.measures.error;
             record.iterations = sol.iterations;
@@ -906,9 +902,11 @@ impl Stepper {
                 if a.closed {
                     self.approach[a.cand] = 0.0;
                     self.landed[a.cand] = false;
+                    self.landing[a.cand] = 0.0;
                 } else if p[0] > 0.0 {
                     self.approach[a.cand] = self.approach[a.cand].min(a.vn_k);
                     self.landed[a.cand] = true;
+                    self.landing[a.cand] += p[0];
                 }
                 let mut impulse = [0.0; 3];
                 impulse[..dim].copy_from_slice(p);
@@ -1068,6 +1066,69 @@ impl Stepper {
         out.min_gap.push(g);
         out.negative_gaps.push(neg);
     }
+}
+
+/// One contact solve of a step: zero impulses when no contact closes, else the chosen solver
+/// (NSGS with the Lemke fallback, or Lemke).
+fn solve_step_problem(
+    settings: &StepSettings,
+    problem: &ContactProblem<'_>,
+    initial: Option<Vec<f64>>,
+    record: &mut StepRecord,
+) -> Result<ContactSolution> {
+    // r = 0 solves the problem exactly when no contact's normal would close
+    // (u = q, u_n >= 0, and 0 lies in every cone): no solve needed
+    let separating = (0..problem.nc).all(|i| problem.q[i * problem.dim] >= 0.0);
+    Ok(if separating {
+        let r = vec![0.0; problem.size()];
+        let (velocity, measures) = measure(problem, &r)?;
+        ContactSolution {
+            impulse: r,
+            velocity,
+            status: ContactStatus::Solved,
+            message: "no contact closes: zero impulses".into(),
+            iterations: 0,
+            measures: ContactMeasures {
+                error: 0.0,
+                error_q: 0.0,
+                ..measures
+            },
+        }
+    } else {
+        match &settings.solver {
+            StepSolver::Nsgs(s) => {
+                let nsgs = NsgsSettings {
+                    initial,
+                    ..s.clone()
+                };
+                let first = solve_nsgs(problem, &nsgs)?;
+                if first.success() || !settings.fallback {
+                    first
+                } else {
+                    // NSGS can stall on singular, strongly coupled W (e.g. a rod
+                    // lying on two contacts with mu = 2): Lemke's pivoting on the
+                    // polyhedral cone (exact in 2D) decides; keep the better answer
+                    let mut lemke = PolyhedralSettings::for_dim(problem.dim);
+                    lemke.lemke.tol = s.tol.max(1e-9);
+                    let second = solve_polyhedral(problem, &lemke)?;
+                    if second.measures.error < first.measures.error {
+                        record.fallback = true;
+                        ContactSolution {
+                            status: if second.measures.error <= s.tol.max(1e-9) {
+                                ContactStatus::Solved
+                            } else {
+                                second.status
+                            },
+                            ..second
+                        }
+                    } else {
+                        first
+                    }
+                }
+            }
+            StepSolver::Lemke(s) => solve_polyhedral(problem, s)?,
+        }
+    })
 }
 
 /// Runs `settings.steps` steps of the impulse time stepper on `scene` from its initial state.

@@ -225,3 +225,19 @@ def test_validation_rows_all_pass():
     assert len(rows) == 12
     for case, quantity, expected, computed, tol in rows:
         assert abs(computed - expected) <= tol, (case, quantity, expected, computed)
+
+
+@pytest.mark.parametrize("frac", [0.0, 0.5])
+def test_poisson_restitution(frac):
+    # a single frictionless impact: Poisson's law agrees with Newton's (seed)
+    h = 1e-3
+    tr = point_scene((0.0, frac * 3.0 * h), (0.0, -3.0), e=0.6, mass=0.5,
+                     gravity=(0.0, 0.0)).simulate(4 * h, h, restitution="poisson")
+    assert tr.v[-1, 1] == pytest.approx(1.8, abs=1e-12)
+    assert tr.contact_impulse[:, 0].sum() == pytest.approx(2.4, abs=1e-12)
+    # with friction (m = 2, v = (1, -3), mu = 0.2, e = 0.5) friction acts in compression only
+    sc = point_scene((0.0, 0.0), (1.0, -3.0), mu=0.2, e=0.5, mass=2.0, gravity=(0.0, 0.0))
+    assert sc.simulate(h, h, restitution="poisson").v[-1] == pytest.approx([0.4, 1.5], abs=1e-12)
+    assert sc.simulate(h, h).v[-1] == pytest.approx([0.1, 1.5], abs=1e-12)
+    with pytest.raises(coulomb.errors.InvalidParameterError):
+        sc.simulate(h, h, restitution="stronge")
