@@ -21,7 +21,15 @@ restitution coefficient ``e``.
 
 Every step solves, with M and the Jacobians frozen at ``q_k``,
 ``v_{k+1} = v_free + M^-1 G P`` and ``q_{k+1} = q_k + h v_{k+1}``; see :mod:`coulomb.trajectory`
-for the record and its checks.
+for the record and its checks. A closed contact gets Newton's condition
+``0 <= P_n ⊥ J_n v_{k+1} + e v_n^- >= 0`` (or Poisson's law, ``restitution="poisson"``); an
+imminently closing one the gap term ``J_n v_{k+1} + g / h >= 0`` (it may close within the step,
+not pass through), and the step after it closes gives back the rebound ``-e v_n^-`` of the
+approach velocity it remembered, so the rebound is exact wherever in the step the impact falls.
+
+:class:`Model` takes a user-defined model in generalized coordinates instead (``M(q)``,
+``f(q, v, t)`` and :class:`GapContact` gap functions with Jacobians), stepped by a Python loop
+around the same Rust contact solver.
 """
 
 from __future__ import annotations

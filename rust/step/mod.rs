@@ -24,8 +24,14 @@
 //! - a contact that is far (neither of the above) carries no unknowns (seed: "A contact
 //!   search must first identify closed or imminently closing contacts").
 //!
-//! The friction law is Coulomb's with the exact disk (NSGS) or the polyhedral cone (Lemke), as
-//! [`crate::contact`] solves it. Frictionless contacts (`mu = 0`) get no tangential impulse.
+//! [`Restitution::Poisson`] replaces Newton's condition by an impact phase on `v_k`
+//! (compression, then the normal impulse `e P_comp`) followed by an inelastic smooth phase.
+//!
+//! The friction law is Coulomb's with the exact disk (NSGS, warm-started by contact identity,
+//! with a Lemke fallback when it misses its tolerance) or the polyhedral cone (Lemke), as
+//! [`crate::contact`] solves it. Frictionless contacts (`mu = 0`) get no tangential impulse
+//! (they still carry the tangential row in W: [`crate::contact::ContactProblem`] has one `dim`
+//! for all contacts).
 //!
 //! Bodies ([`BodyKind`]): particles (2D or 3D), planar rigid bodies `(x, y, theta)`, spatial
 //! rigid bodies (position, unit quaternion `(w, x, y, z)`; velocity: linear, then the angular
