@@ -79,4 +79,7 @@ def step_simulate(
     gap_tolerance: float = 1e-9,
     warm_start: bool = True,
     fallback: bool = True,
+    drift: str = "none",
+    drift_bias: float = 0.2,
+    restitution: str = "newton",
 ) -> dict[str, Any]: ...

@@ -21,7 +21,15 @@ restitution coefficient ``e``.
 
 Every step solves, with M and the Jacobians frozen at ``q_k``,
 ``v_{k+1} = v_free + M^-1 G P`` and ``q_{k+1} = q_k + h v_{k+1}``; see :mod:`coulomb.trajectory`
-for the record and its checks.
+for the record and its checks. A closed contact gets Newton's condition
+``0 <= P_n ⊥ J_n v_{k+1} + e v_n^- >= 0`` (or Poisson's law, ``restitution="poisson"``); an
+imminently closing one the gap term ``J_n v_{k+1} + g / h >= 0`` (it may close within the step,
+not pass through), and the step after it closes gives back the rebound ``-e v_n^-`` of the
+approach velocity it remembered, so the rebound is exact wherever in the step the impact falls.
+
+:class:`Model` takes a user-defined model in generalized coordinates instead (``M(q)``,
+``f(q, v, t)`` and :class:`GapContact` gap functions with Jacobians), stepped by a Python loop
+around the same Rust contact solver.
 """
 
 from __future__ import annotations
@@ -407,6 +415,9 @@ class Scene:
         gap_tolerance: float = 1e-9,
         warm_start: bool = True,
         fallback: bool = True,
+        drift: Literal["none", "bias", "projection"] = "none",
+        drift_bias: float = 0.2,
+        restitution: Literal["newton", "poisson"] = "newton",
     ) -> Trajectory:
         """Runs ``ceil(t_end / h)`` steps of the impulse time stepper from the initial state.
 
@@ -433,6 +444,21 @@ class Scene:
             When NSGS misses its tolerance (it can stall on singular, strongly coupled W),
             also solve by the polyhedral Lemke and keep the answer with the smaller exact-disk
             error (such steps are marked in ``fallback``).
+        drift : {"none", "bias", "projection"}
+            The position-drift correction (a velocity-level step does not enforce
+            ``g(q_{k+1}) >= 0`` exactly): none; a velocity bias, a closed contact with ``g < 0``
+            getting ``J_n v_{k+1} + e v_n^- + drift_bias g / h >= 0`` (pushes a fraction
+            ``drift_bias`` in (0, 1] of the penetration out per step, adding kinetic energy);
+            or a post-step projection of the step's penetrating contacts onto ``g >= 0`` by the
+            M-smallest displacement (velocities untouched; its size per step is in
+            ``projection``).
+        restitution : {"newton", "poisson"}
+            The impact law at closed contacts, with each pair's ``e``: Newton's velocity-level
+            condition ``J_n v_{k+1} + e v_n^- >= 0``, or Poisson's (an impact phase on ``v_k``:
+            the compression impulse with friction, then the normal restitution impulse
+            ``e P_comp``; friction is not re-solved during restitution). They agree on a
+            single frictionless impact; with friction Poisson's keeps more tangential speed
+            (m = 2, v = (1, -3), mu = 0.2, e = 0.5: v_t^+ = 0.4 against Newton's 0.1).
         """
         t_end = _positive("t_end", t_end)
         h = _positive("h", h)
@@ -452,6 +478,14 @@ class Scene:
         if not (math.isfinite(gap_tolerance) and gap_tolerance >= 0.0):
             raise InvalidParameterError(f"gap_tolerance must be finite and >= 0, got "
                                         f"{gap_tolerance}")
+        if drift not in ("none", "bias", "projection"):
+            raise InvalidParameterError(
+                f"unknown drift correction {drift!r}: expected 'none', 'bias' or 'projection'")
+        if drift == "bias" and not (0.0 < float(drift_bias) <= 1.0):
+            raise InvalidParameterError(f"drift_bias must lie in (0, 1], got {drift_bias}")
+        if restitution not in ("newton", "poisson"):
+            raise InvalidParameterError(
+                f"unknown restitution law {restitution!r}: expected 'newton' or 'poisson'")
         if not self.bodies:
             raise InvalidParameterError("the scene has no bodies")
         steps = max(1, math.ceil(t_end / h - 1e-9))
@@ -459,7 +493,8 @@ class Scene:
         raw = _core.step_simulate(
             spec, h, steps, solver=solver, tol=tol, max_iter=max_iter, relaxation=relaxation,
             facets=facets, gap_tolerance=gap_tolerance, warm_start=warm_start,
-            fallback=fallback,
+            fallback=fallback, drift=drift, drift_bias=float(drift_bias),
+            restitution=restitution,
         )
         return Trajectory._from_core(raw, scene=self, h=h, solver=solver,
                                      gap_tolerance=gap_tolerance)

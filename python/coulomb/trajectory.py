@@ -14,7 +14,8 @@ solver's ``solver_status`` (``"no_contact"`` when none was active), ``solver_err
 (``max(||P_t|| - mu P_n, 0)``), ``complementarity`` (``max |P_n (J_n v_{k+1} + e v_n^-)|``,
 or with the gap term ``g / h`` for an open contact) and ``resumed`` (a closed contact took its
 restitution from the approach velocity of the step that closed it) and ``fallback`` (NSGS missed
-its tolerance and the polyhedral Lemke's better answer was used).
+its tolerance and the polyhedral Lemke's better answer was used), and ``projection`` (the
+largest coordinate change of the drift projection, 0 without it).
 
 Contacts (one row per active contact per step): ``contact_step``, ``contact_id`` (stable over
 steps: the candidate pair of features), ``contact_impulse`` (normal first, N s),

@@ -12,7 +12,8 @@ use super::{guarded, to_py};
 use crate::contact::{NsgsSettings, PolyhedralSettings};
 use crate::error::CoulombError;
 use crate::step::{
-    simulate, Body, BodyKind, HalfSpace, Pair, Scene, Shape, StepSettings, StepSolver,
+    simulate, Body, BodyKind, Drift, HalfSpace, Pair, Restitution, Scene, Shape, StepSettings,
+    StepSolver,
 };
 
 fn item<'py, T: FromPyObjectOwned<'py>>(d: &Bound<'py, PyDict>, key: &str) -> PyResult<T> {
@@ -136,7 +137,8 @@ fn matrix<'py, T: numpy::Element>(
 /// size `h`; returns the trajectory as a dict of arrays.
 #[pyfunction]
 #[pyo3(signature = (scene, h, steps, solver="nsgs", tol=1e-12, max_iter=None, relaxation=1.0,
-                    facets=None, gap_tolerance=1e-9, warm_start=true, fallback=true))]
+                    facets=None, gap_tolerance=1e-9, warm_start=true, fallback=true,
+                    drift="none", drift_bias=0.2, restitution="newton"))]
 #[allow(clippy::too_many_arguments)]
 pub(super) fn step_simulate<'py>(
     py: Python<'py>,
@@ -151,6 +153,9 @@ pub(super) fn step_simulate<'py>(
     gap_tolerance: f64,
     warm_start: bool,
     fallback: bool,
+    drift: &str,
+    drift_bias: f64,
+    restitution: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let scene = scene_from_dict(scene)?;
     let solver = match solver {
@@ -179,6 +184,31 @@ pub(super) fn step_simulate<'py>(
             ))
         }
     };
+    let drift = match drift {
+        "none" => Drift::None,
+        "bias" => Drift::VelocityBias(drift_bias),
+        "projection" => Drift::Projection,
+        other => {
+            return Err(to_py(
+                py,
+                CoulombError::InvalidParameter(format!(
+                    "unknown drift correction {other:?}: expected 'none', 'bias' or 'projection'"
+                )),
+            ))
+        }
+    };
+    let restitution = match restitution {
+        "newton" => Restitution::Newton,
+        "poisson" => Restitution::Poisson,
+        other => {
+            return Err(to_py(
+                py,
+                CoulombError::InvalidParameter(format!(
+                    "unknown restitution law {other:?}: expected 'newton' or 'poisson'"
+                )),
+            ))
+        }
+    };
     let settings = StepSettings {
         h,
         steps,
@@ -186,6 +216,8 @@ pub(super) fn step_simulate<'py>(
         gap_tolerance,
         warm_start,
         fallback,
+        drift,
+        restitution,
     };
     let (tr, seconds) = guarded(py, usize::MAX, || {
         let start = std::time::Instant::now();
@@ -249,6 +281,10 @@ pub(super) fn step_simulate<'py>(
     d.set_item(
         "fallback",
         PyArray1::from_vec(py, s.iter().map(|r| r.fallback).collect::<Vec<_>>()),
+    )?;
+    d.set_item(
+        "projection",
+        PyArray1::from_vec(py, col_f(|r| r.projection)),
     )?;
     let c = &tr.contacts;
     let nrec = c.len();

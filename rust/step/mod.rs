@@ -24,8 +24,14 @@
 //! - a contact that is far (neither of the above) carries no unknowns (seed: "A contact
 //!   search must first identify closed or imminently closing contacts").
 //!
-//! The friction law is Coulomb's with the exact disk (NSGS) or the polyhedral cone (Lemke), as
-//! [`crate::contact`] solves it. Frictionless contacts (`mu = 0`) get no tangential impulse.
+//! [`Restitution::Poisson`] replaces Newton's condition by an impact phase on `v_k`
+//! (compression, then the normal impulse `e P_comp`) followed by an inelastic smooth phase.
+//!
+//! The friction law is Coulomb's with the exact disk (NSGS, warm-started by contact identity,
+//! with a Lemke fallback when it misses its tolerance) or the polyhedral cone (Lemke), as
+//! [`crate::contact`] solves it. Frictionless contacts (`mu = 0`) get no tangential impulse
+//! (they still carry the tangential row in W: [`crate::contact::ContactProblem`] has one `dim`
+//! for all contacts).
 //!
 //! Bodies ([`BodyKind`]): particles (2D or 3D), planar rigid bodies `(x, y, theta)`, spatial
 //! rigid bodies (position, unit quaternion `(w, x, y, z)`; velocity: linear, then the angular
@@ -35,8 +41,9 @@
 //! sphere vs sphere (every point of one shape against every point of the other).
 //!
 //! Drift: a velocity-level condition does not enforce `g(q_{k+1}) >= 0` exactly (seed,
-//! "Position drift and restitution"). Gaps are monitored in every step's record; no correction
-//! is applied.
+//! "Position drift and restitution"). Gaps are monitored in every step's record, and
+//! [`Drift`] chooses a correction: none (the default), a velocity bias, or a post-step
+//! projection onto `g >= 0`.
 
 mod stepper;
 
@@ -335,6 +342,37 @@ pub enum StepSolver {
     Lemke(PolyhedralSettings),
 }
 
+/// The position-drift correction (seed: "Monitor the gap and use an appropriate correction";
+/// "Position projection should be documented and checked for its effect on constraints and
+/// energy").
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Drift {
+    /// none: closed contacts keep whatever penetration the linearised update leaves.
+    None,
+    /// a velocity bias: a closed contact with `g < 0` gets `0 <= P_n ⊥ J_n v_{k+1} + e v_n^- +
+    /// beta g / h >= 0`, pushing a fraction `beta` in (0, 1] of the penetration out per step
+    /// (Baumgarte-like; it adds the kinetic energy of that push).
+    VelocityBias(f64),
+    /// a post-step projection: after `q_{k+1} = q_k + h v_{k+1}`, the contacts of the step with
+    /// `g(q_{k+1}) < -gap_tolerance` are pushed out by the M-smallest displacement
+    /// `Δq = M^{-1} J_n^T λ`, `0 <= λ ⊥ J_n M^{-1} J_n^T λ + g >= 0` (velocities untouched).
+    Projection,
+}
+
+/// The impact law at closed contacts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Restitution {
+    /// Newton's: `0 <= P_n ⊥ J_n v_{k+1} + e v_n^- >= 0` (the seed's velocity-level
+    /// condition).
+    Newton,
+    /// Poisson's: an impact phase on `v_k` alone, the compression impulse `P_comp` (the
+    /// contact problem with `e = 0` on the approach velocity `v_n^-`, friction included), then
+    /// the normal restitution impulse `P_rest = e P_comp` (each pair's `e` as `e_P`; friction is
+    /// not re-solved during restitution), after which the step's smooth phase is inelastic. For
+    /// a single frictionless impact it agrees with Newton's law (seed).
+    Poisson,
+}
+
 /// Settings of [`simulate`].
 #[derive(Clone, Debug)]
 pub struct StepSettings {
@@ -352,6 +390,10 @@ pub struct StepSettings {
     /// `max(tol, 1e-9)`) and keep the answer with the smaller exact-disk error; the step is
     /// then solved if that error is within the tolerance.
     pub fallback: bool,
+    /// the drift correction.
+    pub drift: Drift,
+    /// the impact law at closed contacts.
+    pub restitution: Restitution,
 }
 
 impl StepSettings {
@@ -367,6 +409,8 @@ impl StepSettings {
             gap_tolerance: 1e-9,
             warm_start: true,
             fallback: true,
+            drift: Drift::None,
+            restitution: Restitution::Newton,
         }
     }
 
@@ -383,6 +427,13 @@ impl StepSettings {
                 "gap_tolerance must be finite and >= 0, got {}",
                 self.gap_tolerance
             )));
+        }
+        if let Drift::VelocityBias(beta) = self.drift {
+            if !(beta > 0.0 && beta <= 1.0) {
+                return Err(bad(format!(
+                    "the drift velocity bias must lie in (0, 1], got {beta}"
+                )));
+            }
         }
         Ok(())
     }

@@ -3,12 +3,13 @@
 // index loops mirror the equations (a: velocity component, j: contact-frame component)
 #![allow(clippy::needless_range_loop)]
 
-use super::{det3, BodyKind, Pair, Scene, StepSettings, StepSolver};
+use super::{det3, BodyKind, Drift, Pair, Restitution, Scene, StepSettings, StepSolver};
 use crate::contact::{
     measure, solve_nsgs, solve_polyhedral, ContactMeasures, ContactProblem, ContactSolution,
     ContactStatus, NsgsSettings, PolyhedralSettings,
 };
 use crate::error::Result;
+use crate::lcp::{solve_lemke, LcpRef, LemkeSettings};
 
 /// below this a norm counts as zero when forming a relative residual.
 const TINY: f64 = 1e-300;
@@ -40,6 +41,8 @@ pub struct StepRecord {
     /// NSGS missed its tolerance and the polyhedral Lemke's answer, better on the exact-disk
     /// error, was used instead (see [`super::StepSettings::fallback`]).
     pub fallback: bool,
+    /// the largest position change of the drift projection (m or rad), 0 without it.
+    pub projection: f64,
 }
 
 /// One active contact in one step.
@@ -158,6 +161,8 @@ struct Active {
     closed: bool,
     vn_k: f64,
     approach: f64,
+    /// Poisson: the compression impulse already applied by landing steps.
+    carried: f64,
     sides: [Side; 2],
     nsides: usize,
 }
@@ -171,6 +176,9 @@ struct Geometry {
     sides: [(usize, f64, [f64; 3]); 2],
     nsides: usize,
 }
+
+/// (gap, (body, normal column) per side, sides) of a penetrating contact to project out.
+type Penetration = (f64, [(usize, [f64; 6]); 2], usize);
 
 /// The stepper: a scene's state and the workspaces reused by every step.
 pub struct Stepper {
@@ -192,6 +200,7 @@ pub struct Stepper {
     active: Vec<Active>,
     w: Vec<f64>,
     qc: Vec<f64>,
+    q1: Vec<f64>,
     mu: Vec<f64>,
     /// the last impulse of every candidate (`dim` each), for warm starts.
     warm: Vec<f64>,
@@ -199,6 +208,8 @@ pub struct Stepper {
     approach: Vec<f64>,
     /// whether the candidate's last step was open and pushed (it closed the contact).
     landed: Vec<bool>,
+    /// the normal impulse of those landing steps (Poisson's compression carried over).
+    landing: Vec<f64>,
     gp: Vec<f64>,
     v_next: Vec<f64>,
 }
@@ -269,6 +280,31 @@ fn quat_to_rot(q: &[f64]) -> [f64; 9] {
         2.0 * (y * z + w * x),
         1.0 - 2.0 * (x * x + y * y),
     ]
+}
+
+/// `q <- exp(phi / 2) ⊗ q` for a unit quaternion `(w, x, y, z)` and a world-frame rotation
+/// vector phi, renormalised.
+fn rotate(q: &mut [f64], phi: [f64; 3]) {
+    let angle = dot(phi, phi).sqrt();
+    if angle == 0.0 {
+        return;
+    }
+    let (s, c) = (0.5 * angle).sin_cos();
+    let k = s / angle;
+    let dv = [k * phi[0], k * phi[1], k * phi[2]];
+    let ov = [q[1], q[2], q[3]];
+    let cr = cross(dv, ov);
+    let mut nq = [
+        c * q[0] - dot(dv, ov),
+        c * ov[0] + q[0] * dv[0] + cr[0],
+        c * ov[1] + q[0] * dv[1] + cr[1],
+        c * ov[2] + q[0] * dv[2] + cr[2],
+    ];
+    let norm = nq.iter().map(|x| x * x).sum::<f64>().sqrt();
+    for x in &mut nq {
+        *x /= norm;
+    }
+    q.copy_from_slice(&nq);
 }
 
 /// An orthonormal contact frame, normal first: in 2D the tangent is the normal turned by
@@ -407,10 +443,12 @@ impl Stepper {
             active: Vec::with_capacity(nc),
             w: Vec::new(),
             qc: Vec::new(),
+            q1: Vec::new(),
             mu: Vec::new(),
             warm: vec![0.0; nc * dim],
             approach: vec![0.0; nc],
             landed: vec![false; nc],
+            landing: vec![0.0; nc],
             candidates,
         })
     }
@@ -635,6 +673,7 @@ impl Stepper {
             if geo.gap > tol_gap + 2.0 * h * closing {
                 self.approach[c] = 0.0;
                 self.landed[c] = false;
+                self.landing[c] = 0.0;
                 for x in &mut self.warm[c * dim..(c + 1) * dim] {
                     *x = 0.0;
                 }
@@ -684,6 +723,7 @@ impl Stepper {
             complementarity: 0.0,
             resumed: false,
             fallback: false,
+            projection: 0.0,
         };
         for x in &mut self.gp {
             *x = 0.0;
@@ -697,6 +737,10 @@ impl Stepper {
             self.w.resize(n * n, 0.0);
             self.qc.clear();
             self.qc.resize(n, 0.0);
+            self.q1.clear();
+            self.q1.resize(n, 0.0);
+            let poisson = self.settings.restitution == Restitution::Poisson;
+            let mut poisson_impact = false;
             self.mu.clear();
             for i in 0..nc {
                 let ai = self.active[i];
@@ -720,13 +764,18 @@ impl Stepper {
                         }
                     }
                 }
-                // q_c = G^T v_free, then the normal's restitution or gap term
+                // q_c = G^T v_free (and q_1 = G^T v_k for Poisson's impact phase), then the
+                // normal's restitution or gap term
                 for si in &ai.sides[..ai.nsides] {
                     let b = &self.bodies[si.body];
                     for al in 0..dim {
-                        self.qc[i * dim + al] += (0..b.nv)
-                            .map(|a| si.g[a * 3 + al] * self.v_free[b.off_v + a])
-                            .sum::<f64>();
+                        let (mut f, mut k) = (0.0, 0.0);
+                        for a in 0..b.nv {
+                            f += si.g[a * 3 + al] * self.v_free[b.off_v + a];
+                            k += si.g[a * 3 + al] * self.v[b.off_v + a];
+                        }
+                        self.qc[i * dim + al] += f;
+                        self.q1[i * dim + al] += k;
                     }
                 }
                 let bound = if ai.closed {
@@ -736,78 +785,61 @@ impl Stepper {
                         record.resumed = true;
                     }
                     self.active[i].approach = vminus;
-                    cand.e * vminus
+                    let bias = match self.settings.drift {
+                        Drift::VelocityBias(beta) if ai.gap < 0.0 => beta * ai.gap / h,
+                        _ => 0.0,
+                    };
+                    if poisson {
+                        // the impact phase compresses on J_n v_k; what a landing step already
+                        // pushed counts in the compression impulse
+                        self.active[i].carried = self.landing[ai.cand];
+                        poisson_impact |= ai.vn_k < 0.0 || self.landed[ai.cand];
+                        bias
+                    } else {
+                        cand.e * vminus + bias
+                    }
                 } else {
                     // imminent: 0 <= P_n ⊥ J_n v_{k+1} + g / h >= 0
                     self.active[i].approach = ai.vn_k;
+                    self.q1[i * dim] += ai.gap / h;
                     ai.gap / h
                 };
                 self.qc[i * dim] += bound;
             }
-            let problem = ContactProblem::new(dim, &self.w, &self.qc, &self.mu)?;
-            // r = 0 solves the problem exactly when no contact's normal would close
-            // (u = q, u_n >= 0, and 0 lies in every cone): no solve needed
-            let separating = (0..nc).all(|i| self.qc[i * dim] >= 0.0);
-            let sol = if separating {
-                let r = vec![0.0; n];
-                let (velocity, measures) = measure(&problem, &r)?;
-                ContactSolution {
-                    impulse: r,
-                    velocity,
-                    status: ContactStatus::Solved,
-                    message: "no contact closes: zero impulses".into(),
-                    iterations: 0,
-                    measures: ContactMeasures {
-                        error: 0.0,
-                        error_q: 0.0,
-                        ..measures
-                    },
+            let initial = if self.settings.warm_start {
+                let mut init = vec![0.0; n];
+                for (i, a) in self.active.iter().enumerate() {
+                    init[i * dim..(i + 1) * dim]
+                        .copy_from_slice(&self.warm[a.cand * dim..(a.cand + 1) * dim]);
                 }
+                Some(init)
             } else {
-                match &self.settings.solver {
-                    StepSolver::Nsgs(s) => {
-                        let initial = if self.settings.warm_start {
-                            let mut init = vec![0.0; n];
-                            for (i, a) in self.active.iter().enumerate() {
-                                init[i * dim..(i + 1) * dim]
-                                    .copy_from_slice(&self.warm[a.cand * dim..(a.cand + 1) * dim]);
-                            }
-                            Some(init)
-                        } else {
-                            None
-                        };
-                        let settings = NsgsSettings {
-                            initial,
-                            ..s.clone()
-                        };
-                        let first = solve_nsgs(&problem, &settings)?;
-                        if first.success() || !self.settings.fallback {
-                            first
-                        } else {
-                            // NSGS can stall on singular, strongly coupled W (e.g. a rod
-                            // lying on two contacts with mu = 2): Lemke's pivoting on the
-                            // polyhedral cone (exact in 2D) decides; keep the better answer
-                            let mut lemke = PolyhedralSettings::for_dim(dim);
-                            lemke.lemke.tol = s.tol.max(1e-9);
-                            let second = solve_polyhedral(&problem, &lemke)?;
-                            if second.measures.error < first.measures.error {
-                                record.fallback = true;
-                                ContactSolution {
-                                    status: if second.measures.error <= s.tol.max(1e-9) {
-                                        ContactStatus::Solved
-                                    } else {
-                                        second.status
-                                    },
-                                    ..second
-                                }
-                            } else {
-                                first
-                            }
-                        }
-                    }
-                    StepSolver::Lemke(s) => solve_polyhedral(&problem, s)?,
-                }
+                None
             };
+            // Poisson: an impact phase on v_k alone (compression, e = 0, then the normal
+            // restitution impulse e P_comp), before the step's inelastic solve
+            let mut p_impact = vec![];
+            if poisson_impact {
+                let problem = ContactProblem::new(dim, &self.w, &self.q1, &self.mu)?;
+                let comp =
+                    solve_step_problem(&self.settings, &problem, initial.clone(), &mut record)?;
+                p_impact = comp.impulse;
+                for (i, a) in self.active.iter().enumerate() {
+                    let e = self.candidates[a.cand].e;
+                    p_impact[i * dim] = (1.0 + e) * p_impact[i * dim] + e * a.carried;
+                }
+                // the smooth phase starts from v_free + M^{-1} G P_impact
+                let mut wp = vec![0.0; n];
+                problem.mul_w(&p_impact, &mut wp);
+                for (q, d) in self.qc.iter_mut().zip(&wp) {
+                    *q += d;
+                }
+            }
+            let problem = ContactProblem::new(dim, &self.w, &self.qc, &self.mu)?;
+            let mut sol = solve_step_problem(&self.settings, &problem, initial, &mut record)?;
+            for (p, d) in sol.impulse.iter_mut().zip(&p_impact) {
+                *p += d;
+            }
             record.status = Some(sol.status);
             record.error = sol.measures.error;
             record.iterations = sol.iterations;
@@ -870,9 +902,11 @@ impl Stepper {
                 if a.closed {
                     self.approach[a.cand] = 0.0;
                     self.landed[a.cand] = false;
+                    self.landing[a.cand] = 0.0;
                 } else if p[0] > 0.0 {
                     self.approach[a.cand] = self.approach[a.cand].min(a.vn_k);
                     self.landed[a.cand] = true;
+                    self.landing[a.cand] += p[0];
                 }
                 let mut impulse = [0.0; 3];
                 impulse[..dim].copy_from_slice(p);
@@ -914,35 +948,110 @@ impl Stepper {
                         q[k] += h * v[k];
                     }
                     // q <- exp(h ω / 2) ⊗ q: the exact rotation by the world-frame h ω
-                    let w = [v[3], v[4], v[5]];
-                    let angle = dot(w, w).sqrt() * h;
-                    if angle > 0.0 {
-                        let (s, c) = (0.5 * angle).sin_cos();
-                        let k = s / (angle / h);
-                        let d = [c, k * w[0], k * w[1], k * w[2]];
-                        let o = [q[3], q[4], q[5], q[6]];
-                        let dv = [d[1], d[2], d[3]];
-                        let ov = [o[1], o[2], o[3]];
-                        let cr = cross(dv, ov);
-                        let nw = d[0] * o[0] - dot(dv, ov);
-                        let mut nq = [
-                            nw,
-                            d[0] * ov[0] + o[0] * dv[0] + cr[0],
-                            d[0] * ov[1] + o[0] * dv[1] + cr[1],
-                            d[0] * ov[2] + o[0] * dv[2] + cr[2],
-                        ];
-                        let norm = nq.iter().map(|x| x * x).sum::<f64>().sqrt();
-                        for x in &mut nq {
-                            *x /= norm;
-                        }
-                        q[3..7].copy_from_slice(&nq);
-                    }
+                    rotate(&mut q[3..7], [h * v[3], h * v[4], h * v[5]]);
                 }
             }
+        }
+        if self.settings.drift == Drift::Projection && nc > 0 {
+            record.projection = self.project()?;
         }
         self.step_index += 1;
         self.t = self.step_index as f64 * h;
         Ok(record)
+    }
+
+    /// The post-step projection of [`Drift::Projection`] over this step's active contacts:
+    /// `0 <= λ ⊥ W_nn λ + g >= 0` at `q_{k+1}`, `Δq = M^{-1} J_n^T λ`. Returns the largest
+    /// coordinate change.
+    fn project(&mut self) -> Result<f64> {
+        self.freeze();
+        let tol_gap = self.settings.gap_tolerance;
+        let mut rows: Vec<Penetration> = Vec::new();
+        for a in &self.active {
+            let geo = self.geometry(a.cand);
+            if geo.gap >= -tol_gap {
+                continue;
+            }
+            let mut cols = [(0usize, [0.0; 6]); 2];
+            for s in 0..geo.nsides {
+                let (body, sign, r) = geo.sides[s];
+                let mut col = self.column(body, r, geo.normal);
+                for x in &mut col {
+                    *x *= sign;
+                }
+                cols[s] = (body, col);
+            }
+            rows.push((geo.gap, cols, geo.nsides));
+        }
+        if rows.is_empty() {
+            return Ok(0.0);
+        }
+        let n = rows.len();
+        // W_nn = J_n M^{-1} J_n^T
+        let mut w = vec![0.0; n * n];
+        for (i, ri) in rows.iter().enumerate() {
+            for (j, rj) in rows.iter().enumerate() {
+                let mut s = 0.0;
+                for &(bi, ci) in &ri.1[..ri.2] {
+                    for &(bj, cj) in &rj.1[..rj.2] {
+                        if bi != bj {
+                            continue;
+                        }
+                        let minv = &self.frozen[bi].minv;
+                        let nv = self.bodies[bi].nv;
+                        for a in 0..nv {
+                            for c in 0..nv {
+                                s += ci[a] * minv[a * 6 + c] * cj[c];
+                            }
+                        }
+                    }
+                }
+                w[i * n + j] = s;
+            }
+        }
+        let g: Vec<f64> = rows.iter().map(|r| r.0).collect();
+        let lcp = LcpRef::new(n, &w, &g)?;
+        let sol = solve_lemke(&lcp, &LemkeSettings::default())?;
+        if !sol.z.iter().all(|z| z.is_finite()) {
+            return Ok(0.0);
+        }
+        // Δv-like displacement per body, then applied to the coordinates
+        let mut dq = vec![0.0; self.nv];
+        for (i, r) in rows.iter().enumerate() {
+            let lam = sol.z[i];
+            for &(b, col) in &r.1[..r.2] {
+                let body = &self.bodies[b];
+                let minv = &self.frozen[b].minv;
+                for a in 0..body.nv {
+                    dq[body.off_v + a] +=
+                        (0..body.nv).map(|c| minv[a * 6 + c] * col[c]).sum::<f64>() * lam;
+                }
+            }
+        }
+        let largest = dq.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        self.displace(&dq);
+        Ok(largest)
+    }
+
+    /// `q <- q ⊕ dq` with dq in velocity coordinates (a rotation vector for spatial bodies).
+    fn displace(&mut self, dq: &[f64]) {
+        for b in &self.bodies {
+            let q = &mut self.q[b.off_q..];
+            let d = &dq[b.off_v..b.off_v + b.nv];
+            match b.kind {
+                BodyKind::Particle | BodyKind::Planar => {
+                    for k in 0..b.nv {
+                        q[k] += d[k];
+                    }
+                }
+                BodyKind::Spatial => {
+                    for k in 0..3 {
+                        q[k] += d[k];
+                    }
+                    rotate(&mut q[3..7], [d[3], d[4], d[5]]);
+                }
+            }
+        }
     }
 
     fn push_state(&mut self, out: &mut Trajectory) {
@@ -957,6 +1066,69 @@ impl Stepper {
         out.min_gap.push(g);
         out.negative_gaps.push(neg);
     }
+}
+
+/// One contact solve of a step: zero impulses when no contact closes, else the chosen solver
+/// (NSGS with the Lemke fallback, or Lemke).
+fn solve_step_problem(
+    settings: &StepSettings,
+    problem: &ContactProblem<'_>,
+    initial: Option<Vec<f64>>,
+    record: &mut StepRecord,
+) -> Result<ContactSolution> {
+    // r = 0 solves the problem exactly when no contact's normal would close
+    // (u = q, u_n >= 0, and 0 lies in every cone): no solve needed
+    let separating = (0..problem.nc).all(|i| problem.q[i * problem.dim] >= 0.0);
+    Ok(if separating {
+        let r = vec![0.0; problem.size()];
+        let (velocity, measures) = measure(problem, &r)?;
+        ContactSolution {
+            impulse: r,
+            velocity,
+            status: ContactStatus::Solved,
+            message: "no contact closes: zero impulses".into(),
+            iterations: 0,
+            measures: ContactMeasures {
+                error: 0.0,
+                error_q: 0.0,
+                ..measures
+            },
+        }
+    } else {
+        match &settings.solver {
+            StepSolver::Nsgs(s) => {
+                let nsgs = NsgsSettings {
+                    initial,
+                    ..s.clone()
+                };
+                let first = solve_nsgs(problem, &nsgs)?;
+                if first.success() || !settings.fallback {
+                    first
+                } else {
+                    // NSGS can stall on singular, strongly coupled W (e.g. a rod
+                    // lying on two contacts with mu = 2): Lemke's pivoting on the
+                    // polyhedral cone (exact in 2D) decides; keep the better answer
+                    let mut lemke = PolyhedralSettings::for_dim(problem.dim);
+                    lemke.lemke.tol = s.tol.max(1e-9);
+                    let second = solve_polyhedral(problem, &lemke)?;
+                    if second.measures.error < first.measures.error {
+                        record.fallback = true;
+                        ContactSolution {
+                            status: if second.measures.error <= s.tol.max(1e-9) {
+                                ContactStatus::Solved
+                            } else {
+                                second.status
+                            },
+                            ..second
+                        }
+                    } else {
+                        first
+                    }
+                }
+            }
+            StepSolver::Lemke(s) => solve_polyhedral(problem, s)?,
+        }
+    })
 }
 
 /// Runs `settings.steps` steps of the impulse time stepper on `scene` from its initial state.

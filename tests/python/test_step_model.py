@@ -252,3 +252,30 @@ def test_free_spinning_body_energy_drift_of_the_explicit_gyroscopic_term():
     scene.add(RigidBody3D(mass=1.0, inertia=(2.0, 2.0, 2.0), angular_velocity=(1.0, 0.5, 0.1)))
     tr = scene.simulate(10.0, 1e-3)
     assert tr.kinetic_energy[-1] == pytest.approx(tr.kinetic_energy[0], rel=1e-13)
+
+
+@pytest.mark.parametrize("solver", ["nsgs", "lemke"])
+def test_sliding_boxes_decelerate_at_mu_g_and_stop(solver):
+    # a planar box on two corners and a cube on four, pushed at 1 m/s along x with mu = 0.3:
+    # v(t) = 1 - mu g t until t = 1 / (mu g) = 0.340 s, then rest, no tipping, no lift-off
+    mu, g, h = 0.3, 9.81, 1e-3
+    scene = Scene(dim=2)
+    box = scene.add(RigidBody2D(mass=1.0, inertia=1 / 6, position=(0.0, 0.5),
+                                velocity=(1.0, 0.0)))
+    floor = scene.add(HalfSpace((0.0, 0.0), (0.0, 1.0)))
+    scene.contact(scene.attach(box, Box((0.5, 0.5))), floor, mu=mu)
+    scene3 = Scene(dim=3)
+    cube = scene3.add(RigidBody3D(mass=1.0, inertia=(1 / 6, 1 / 6, 1 / 6),
+                                  position=(0.0, 0.0, 0.5), velocity=(1.0, 0.0, 0.0)))
+    floor3 = scene3.add(HalfSpace((0.0, 0.0, 0.0), (0.0, 0.0, 1.0)))
+    scene3.contact(scene3.attach(cube, Box((0.5, 0.5, 0.5))), floor3, mu=mu)
+    for sc in (scene, scene3):
+        tr = sc.simulate(0.6, h, solver=solver)
+        assert tr.success, tr.message
+        vx = tr.v[:, 0]
+        n = int(0.3 / h)
+        np.testing.assert_allclose(np.diff(vx[:n]) / h, -mu * g, rtol=1e-9)
+        assert np.max(np.abs(tr.v[-100:])) < 1e-11
+        height = tr.q[:, 1] if sc is scene else tr.q[:, 2]
+        assert np.max(np.abs(height - 0.5)) < 1e-12
+        assert tr.check().ok, tr.check().violations
