@@ -5,8 +5,8 @@
 
 use super::{det3, BodyKind, Drift, Pair, Restitution, Scene, StepSettings, StepSolver};
 use crate::contact::{
-    measure, solve_nsgs, solve_polyhedral, ContactMeasures, ContactProblem, ContactSolution,
-    ContactStatus, NsgsSettings, PolyhedralSettings,
+    measure, solve_nsgs, solve_polyhedral, BlockCsr, ContactMeasures, ContactProblem,
+    ContactSolution, ContactStatus, NsgsSettings, PolyhedralSettings,
 };
 use crate::error::Result;
 use crate::lcp::{solve_lemke, LcpRef, LemkeSettings};
@@ -199,6 +199,15 @@ pub struct Stepper {
     v_free: Vec<f64>,
     active: Vec<Active>,
     w: Vec<f64>,
+    incidence: Vec<Vec<(usize, usize)>>,
+    /// every candidate's geometry at the state recorded last (`push_state`), and the step
+    /// index it belongs to: the next step's contact search starts from the same state.
+    geo_cache: Vec<Geometry>,
+    geo_cache_step: Option<usize>,
+    speed_bounds: Vec<[f64; 2]>,
+    coo_rows: Vec<usize>,
+    coo_cols: Vec<usize>,
+    coo_vals: Vec<f64>,
     qc: Vec<f64>,
     q1: Vec<f64>,
     mu: Vec<f64>,
@@ -442,6 +451,13 @@ impl Stepper {
             step_index: 0,
             active: Vec::with_capacity(nc),
             w: Vec::new(),
+            incidence: vec![Vec::new(); scene.bodies.len()],
+            geo_cache: Vec::new(),
+            geo_cache_step: None,
+            speed_bounds: vec![[0.0; 2]; scene.bodies.len()],
+            coo_rows: Vec::new(),
+            coo_cols: Vec::new(),
+            coo_vals: Vec::new(),
             qc: Vec::new(),
             q1: Vec::new(),
             mu: Vec::new(),
@@ -622,11 +638,14 @@ impl Stepper {
 
     /// min gap over all candidates and the number below `-gap_tolerance` at the current q
     /// (bodies must be frozen at it).
-    fn gap_summary(&self) -> (f64, usize) {
+    fn gap_summary(&mut self) -> (f64, usize) {
         let mut min_gap = f64::INFINITY;
         let mut negative = 0;
+        self.geo_cache.clear();
         for c in 0..self.candidates.len() {
-            let g = self.geometry(c).gap;
+            let geo = self.geometry(c);
+            self.geo_cache.push(geo);
+            let g = geo.gap;
             min_gap = min_gap.min(g);
             if g < -self.settings.gap_tolerance {
                 negative += 1;
@@ -665,12 +684,47 @@ impl Stepper {
 
         // contact search: closed or imminently closing contacts only
         self.active.clear();
+        let cached = self.geo_cache_step == Some(self.step_index)
+            && self.geo_cache.len() == self.candidates.len();
+        // a bound on each body's point speeds (v_k and v_free): a candidate farther than
+        // 2 h times its bound cannot close within the step, whatever its normal
+        for (bi, b) in self.bodies.iter().enumerate() {
+            let mut sb = [0.0f64; 2];
+            for v in [&self.v, &self.v_free] {
+                let vb = &v[b.off_v..b.off_v + b.nv];
+                let norm = |x: &[f64]| x.iter().map(|y| y * y).sum::<f64>().sqrt();
+                let (lin, ang) = match b.kind {
+                    BodyKind::Particle => (norm(vb), 0.0),
+                    BodyKind::Planar => (norm(&vb[..2]), vb[2].abs()),
+                    BodyKind::Spatial => (norm(&vb[..3]), norm(&vb[3..6])),
+                };
+                sb[0] = sb[0].max(lin);
+                sb[1] = sb[1].max(ang);
+            }
+            self.speed_bounds[bi] = sb;
+        }
         for c in 0..self.candidates.len() {
-            let geo = self.geometry(c);
-            let vn_k = self.normal_velocity(&geo, &self.v);
-            let vn_free = self.normal_velocity(&geo, &self.v_free);
+            let geo = if cached {
+                self.geo_cache[c]
+            } else {
+                self.geometry(c)
+            };
+            let mut reach = 0.0;
+            for &(body, _, r) in &geo.sides[..geo.nsides] {
+                let [lin, ang] = self.speed_bounds[body];
+                reach += lin + ang * dot(r, r).sqrt();
+            }
+            let far = geo.gap > tol_gap + 2.0 * h * reach;
+            let (vn_k, vn_free) = if far {
+                (0.0, 0.0)
+            } else {
+                (
+                    self.normal_velocity(&geo, &self.v),
+                    self.normal_velocity(&geo, &self.v_free),
+                )
+            };
             let closing = (-vn_k).max(-vn_free).max(0.0);
-            if geo.gap > tol_gap + 2.0 * h * closing {
+            if far || geo.gap > tol_gap + 2.0 * h * closing {
                 self.approach[c] = 0.0;
                 self.landed[c] = false;
                 self.landing[c] = 0.0;
@@ -734,7 +788,9 @@ impl Stepper {
         if nc > 0 {
             // W = G^T M^{-1} G, block (i, j) summed over the bodies both contacts touch
             self.w.clear();
-            self.w.resize(n * n, 0.0);
+            if nc < SPARSE_FROM {
+                self.w.resize(n * n, 0.0);
+            }
             self.qc.clear();
             self.qc.resize(n, 0.0);
             self.q1.clear();
@@ -742,28 +798,59 @@ impl Stepper {
             let poisson = self.settings.restitution == Restitution::Poisson;
             let mut poisson_impact = false;
             self.mu.clear();
-            for i in 0..nc {
-                let ai = self.active[i];
-                let cand = self.candidates[ai.cand];
-                self.mu.push(cand.mu);
-                for j in 0..nc {
-                    let aj = &self.active[j];
-                    for si in &ai.sides[..ai.nsides] {
-                        for sj in &aj.sides[..aj.nsides] {
-                            if si.body != sj.body {
-                                continue;
-                            }
-                            let nv = self.bodies[si.body].nv;
-                            for al in 0..dim {
-                                for be in 0..dim {
-                                    let s: f64 =
-                                        (0..nv).map(|a| si.g[a * 3 + al] * sj.b[a * 3 + be]).sum();
-                                    self.w[(i * dim + al) * n + j * dim + be] += s;
+            // W's blocks only where two contacts share a body: W_ij = sum over the shared
+            // bodies of G_i^T M^{-1} G_j, found from each body's list of contacts (O(sum of
+            // k_b^2), not O(nc^2)); stored dense for few contacts, block CSR for many
+            let sparse = nc >= SPARSE_FROM;
+            for list in &mut self.incidence {
+                list.clear();
+            }
+            for (i, a) in self.active.iter().enumerate() {
+                for (k, side) in a.sides[..a.nsides].iter().enumerate() {
+                    self.incidence[side.body].push((i, k));
+                }
+            }
+            self.coo_rows.clear();
+            self.coo_cols.clear();
+            self.coo_vals.clear();
+            for (body, list) in self.incidence.iter().enumerate() {
+                let nv = self.bodies[body].nv;
+                for &(i, ki) in list {
+                    let si = &self.active[i].sides[ki];
+                    for &(j, kj) in list {
+                        let sj = &self.active[j].sides[kj];
+                        for al in 0..dim {
+                            for be in 0..dim {
+                                let v: f64 =
+                                    (0..nv).map(|a| si.g[a * 3 + al] * sj.b[a * 3 + be]).sum();
+                                if sparse {
+                                    self.coo_rows.push(i * dim + al);
+                                    self.coo_cols.push(j * dim + be);
+                                    self.coo_vals.push(v);
+                                } else {
+                                    self.w[(i * dim + al) * n + j * dim + be] += v;
                                 }
                             }
                         }
                     }
                 }
+            }
+            let w_sparse = if sparse {
+                // every contact's diagonal block is present (a contact touches a body)
+                Some(BlockCsr::from_coo(
+                    dim,
+                    n,
+                    &self.coo_rows,
+                    &self.coo_cols,
+                    &self.coo_vals,
+                )?)
+            } else {
+                None
+            };
+            for i in 0..nc {
+                let ai = self.active[i];
+                let cand = self.candidates[ai.cand];
+                self.mu.push(cand.mu);
                 // q_c = G^T v_free (and q_1 = G^T v_k for Poisson's impact phase), then the
                 // normal's restitution or gap term
                 for si in &ai.sides[..ai.nsides] {
@@ -820,7 +907,7 @@ impl Stepper {
             // restitution impulse e P_comp), before the step's inelastic solve
             let mut p_impact = vec![];
             if poisson_impact {
-                let problem = ContactProblem::new(dim, &self.w, &self.q1, &self.mu)?;
+                let problem = step_problem(dim, &self.w, w_sparse.as_ref(), &self.q1, &self.mu)?;
                 let comp =
                     solve_step_problem(&self.settings, &problem, initial.clone(), &mut record)?;
                 p_impact = comp.impulse;
@@ -835,7 +922,7 @@ impl Stepper {
                     *q += d;
                 }
             }
-            let problem = ContactProblem::new(dim, &self.w, &self.qc, &self.mu)?;
+            let problem = step_problem(dim, &self.w, w_sparse.as_ref(), &self.qc, &self.mu)?;
             let mut sol = solve_step_problem(&self.settings, &problem, initial, &mut record)?;
             for (p, d) in sol.impulse.iter_mut().zip(&p_impact) {
                 *p += d;
@@ -1063,8 +1150,27 @@ impl Stepper {
         out.kinetic_energy.push(t);
         out.potential_energy.push(v);
         let (g, neg) = self.gap_summary();
+        self.geo_cache_step = Some(self.step_index);
         out.min_gap.push(g);
         out.negative_gaps.push(neg);
+    }
+}
+
+/// from this many active contacts on, a step's W is assembled in block CSR (its NSGS sweep then
+/// costs O(nnz) instead of O(nc^2)).
+const SPARSE_FROM: usize = 24;
+
+/// the step's contact problem over the dense or the block-sparse W.
+fn step_problem<'a>(
+    dim: usize,
+    dense: &'a [f64],
+    sparse: Option<&'a BlockCsr>,
+    q: &'a [f64],
+    mu: &'a [f64],
+) -> Result<ContactProblem<'a>> {
+    match sparse {
+        Some(w) => ContactProblem::with_block_sparse(w, q, mu),
+        None => ContactProblem::new(dim, dense, q, mu),
     }
 }
 

@@ -1,0 +1,295 @@
+"""Steps per second and the scenes' figures: coulomb's impulse stepper against MuJoCo.
+
+    python benches/peer_step.py [--quick]
+
+The same scenes, data and step size in both (see benches/mujoco_scenes.py for MuJoCo's side):
+a 1 kg box sent down a 20 deg ramp at 1 m/s (mu 0.4; gravity tilted, as in MuJoCo's model), a
+0.5 kg ball hitting the floor at 3 m/s (e 0.6 asked), a box resting on the floor, and piles of
+100 and 1000 spheres falling into a box (mu 0.5). MuJoCo runs through ``mujoco.rollout`` (its
+loop in C++), coulomb through ``Scene.simulate`` (its loop in Rust); each is the best of a
+few runs' wall time. Writes the table into BENCHMARKS.md between the step-peers markers.
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime
+import math
+import platform
+import re
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import coulomb
+import mujoco_scenes as mj
+from coulomb import Box, HalfSpace, RigidBody3D, Scene, Sphere
+
+ROOT = Path(__file__).resolve().parents[1]
+G0 = 9.81
+#: sphere pairs starting within this many grid spacings are contact candidates
+CUTOFF = 3.0
+
+
+def _best(build, t_end: float, h: float, solver: str, repeats: int = 3):
+    """Builds the scene (not timed, as MuJoCo's model compile is not) and times simulate."""
+    best = math.inf
+    out = None
+    for _ in range(repeats):
+        scene = build()
+        start = time.perf_counter()
+        out = scene.simulate(t_end, h, solver)
+        best = min(best, time.perf_counter() - start)
+    return out, best
+
+
+def _box_inertia(m: float, half: tuple[float, float, float]) -> tuple[float, float, float]:
+    a, b, c = (2 * x for x in half)
+    return (m * (b * b + c * c) / 12, m * (a * a + c * c) / 12, m * (a * a + b * b) / 12)
+
+
+def _floor() -> HalfSpace:
+    return HalfSpace((0.0, 0.0, 0.0), (0.0, 0.0, 1.0))
+
+
+def coulomb_ramp(h: float, solver: str, t_end: float = 10.0) -> dict:
+    th = math.radians(20.0)
+    half = (0.05, 0.05, 0.05)
+
+    def run():
+        scene = Scene(dim=3, gravity=(G0 * math.sin(th), 0.0, -G0 * math.cos(th)))
+        box = scene.add(
+            RigidBody3D(
+                mass=1.0,
+                inertia=_box_inertia(1.0, half),
+                position=(0.0, 0.0, 0.05),
+                velocity=(1.0, 0.0, 0.0),
+            )
+        )
+        scene.contact(scene.attach(box, Box(half)), scene.add(_floor()), mu=0.4)
+        return scene
+
+    tr, sec = _best(run, t_end, h, solver)
+    x = tr.q[:, 0]
+    i5 = int(np.searchsorted(tr.t, 5.0))
+    return {
+        "steps": len(tr.t) - 1,
+        "seconds": sec,
+        "figures": {
+            "distance at 3.011 s (m)": float(np.interp(3.011, tr.t, x)),
+            "creep 5 s..10 s (m)": float(x[-1] - x[i5]),
+        },
+    }
+
+
+def coulomb_impact(h: float, solver: str, t_end: float = 0.2) -> dict:
+    def run():
+        scene = Scene(dim=3, gravity=(0.0, 0.0, 0.0))
+        ball = scene.add(
+            RigidBody3D(
+                mass=0.5, inertia=(0.002,) * 3, position=(0.0, 0.0, 0.11), velocity=(0.0, 0.0, -3.0)
+            )
+        )
+        scene.contact(scene.attach(ball, Sphere(0.1)), scene.add(_floor()), e=0.6)
+        return scene
+
+    tr, sec = _best(run, t_end, h, solver)
+    return {
+        "steps": len(tr.t) - 1,
+        "seconds": sec,
+        "figures": {"rebound ratio (e asked 0.6)": float(tr.v[-1, 2] / 3.0)},
+    }
+
+
+def coulomb_resting_box(h: float, solver: str, t_end: float = 10.0) -> dict:
+    half = (0.1, 0.1, 0.05)
+
+    def run():
+        scene = Scene(dim=3, gravity=(0.0, 0.0, -G0))
+        box = scene.add(
+            RigidBody3D(mass=1.0, inertia=_box_inertia(1.0, half), position=(0.0, 0.0, 0.05))
+        )
+        scene.contact(scene.attach(box, Box(half)), scene.add(_floor()), mu=0.5)
+        return scene
+
+    tr, sec = _best(run, t_end, h, solver)
+    drift = float(np.max(np.abs(tr.q[:, :2] - tr.q[0, :2])))
+    return {
+        "steps": len(tr.t) - 1,
+        "seconds": sec,
+        "figures": {
+            "horizontal drift (m)": drift,
+            "penetration (m)": float(max(0.0, -np.min(tr.min_gap))),
+        },
+    }
+
+
+def coulomb_pile(count: int, h: float, solver: str, t_end: float = 1.0) -> dict:
+    radius = 0.05
+    side = math.ceil(count ** (1 / 3))
+    spacing = 2.2 * radius
+    half = side * spacing / 2 + radius
+
+    def run():
+        scene = Scene(dim=3, gravity=(0.0, 0.0, -G0))
+        walls = [scene.add(_floor())] + [
+            scene.add(HalfSpace(p, n))
+            for p, n in (
+                ((-half, 0.0, 0.0), (1.0, 0.0, 0.0)),
+                ((half, 0.0, 0.0), (-1.0, 0.0, 0.0)),
+                ((0.0, -half, 0.0), (0.0, 1.0, 0.0)),
+                ((0.0, half, 0.0), (0.0, -1.0, 0.0)),
+            )
+        ]
+        shapes = []
+        for k in range(count):
+            i, j, l = k % side, (k // side) % side, k // (side * side)
+            pos = (
+                -half + radius + spacing * (i + 0.5),
+                -half + radius + spacing * (j + 0.5),
+                radius + 0.01 + spacing * l,
+            )
+            inertia = 0.4 * 0.1 * radius * radius
+            body = scene.add(RigidBody3D(mass=0.1, inertia=(inertia,) * 3, position=pos))
+            shapes.append(scene.attach(body, Sphere(radius)))
+        for s in shapes:
+            for w in walls:
+                scene.contact(s, w, mu=0.5)
+        # candidate pairs: spheres whose centres start within CUTOFF spacings (coulomb has no
+        # broad phase yet); after the run the script checks that no other pair could have met
+        centers = np.array(list(_centers(count, side, spacing, half, radius)))
+        for a in range(count):
+            d = np.linalg.norm(centers[a + 1 :] - centers[a], axis=1)
+            for b in np.flatnonzero(d < CUTOFF * spacing) + a + 1:
+                scene.contact(shapes[a], shapes[int(b)], mu=0.5)
+        return scene
+
+    tr, sec = _best(run, t_end, h, solver, repeats=1)
+    pos = tr.q.reshape(len(tr.t), count, 7)[:, :, :3]
+    moved = float(np.max(np.linalg.norm(pos - pos[0], axis=2)))
+    # two spheres first CUTOFF spacings apart meet only if they move (CUTOFF s - 2 r) together
+    safe = 2 * moved < CUTOFF * spacing - 2 * radius
+    solved = int(np.sum(np.isin(tr.solver_status, ["solved", "no_contact"])))
+    return {
+        "steps": len(tr.t) - 1,
+        "seconds": sec,
+        "figures": {
+            "contacts per step (mean)": float(np.mean(tr.active)),
+            "steps solved": f"{solved}/{len(tr.t) - 1}",
+            "largest displacement (m)": moved,
+            "undeclared pairs could meet": "no" if safe else "YES (raise CUTOFF)",
+        },
+    }
+
+
+def _centers(count, side, spacing, half, radius):
+    for k in range(count):
+        i, j, l = k % side, (k // side) % side, k // (side * side)
+        yield (
+            -half + radius + spacing * (i + 0.5),
+            -half + radius + spacing * (j + 0.5),
+            radius + 0.01 + spacing * l,
+        )
+
+
+def _fmt_fig(figs: dict) -> str:
+    out = []
+    for k, v in figs.items():
+        out.append(f"{k}: {v:.4g}" if isinstance(v, float) else f"{k}: {v}")
+    return "; ".join(out)
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="skip the 1000-sphere pile")
+    ap.add_argument("--no-write", action="store_true", help="print only")
+    args = ap.parse_args()
+    h = 1e-3
+    rows = []
+
+    def add(scene: str, who: str, res: dict) -> None:
+        sps = res["steps"] / res["seconds"]
+        rows.append((scene, who, sps, res["seconds"], _fmt_fig(res["figures"])))
+        print(
+            f"{scene:24s} {who:18s} {sps:12.0f} steps/s  {_fmt_fig(res['figures'])}",
+            file=sys.stderr,
+        )
+
+    def add_peer(run: mj.PeerRun) -> None:
+        add(
+            run.scene,
+            "MuJoCo (defaults)",
+            {"steps": run.steps, "seconds": run.seconds, "figures": run.figures},
+        )
+
+    for solver in ("nsgs", "lemke"):
+        add("ramp", f"coulomb {solver}", coulomb_ramp(h, solver))
+    add_peer(mj.ramp(h))
+    for solver in ("nsgs", "lemke"):
+        add("floor impact", f"coulomb {solver}", coulomb_impact(h, solver))
+    add_peer(mj.floor_impact(h))
+    for solver in ("nsgs", "lemke"):
+        add("resting box", f"coulomb {solver}", coulomb_resting_box(h, solver))
+    add_peer(mj.resting_box(h))
+    counts = [100] if args.quick else [100, 1000]
+    for count in counts:
+        add(f"pile of {count} spheres", "coulomb nsgs", coulomb_pile(count, h, "nsgs"))
+        add_peer(mj.sphere_pile(count, h))
+
+    try:
+        rev = subprocess.run(
+            ["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, cwd=ROOT
+        ).stdout.strip()
+    except OSError:
+        rev = "unknown"
+    import mujoco
+
+    lines = [
+        "## The impulse stepper: coulomb vs MuJoCo",
+        "",
+        f"Generated by `benches/peer_step.py` on "
+        f"{datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC (revision {rev}; "
+        f"coulomb {coulomb.__version__}, MuJoCo {mujoco.__version__}, Python "
+        f"{platform.python_version()}, {platform.machine()}). Command: "
+        f"`python benches/peer_step.py`. h = 1 ms for every scene; best wall time of 3 runs "
+        f"(1 for the piles); MuJoCo's loop in C++ by `mujoco.rollout`, coulomb's in Rust by "
+        f"`Scene.simulate` (which also records every step's state, impulses and checks).",
+        "",
+        "| scene | solver | steps/s | wall time (s) | figures |",
+        "|---|---|---:|---:|---|",
+    ]
+    for scene, who, sps, sec, figs in rows:
+        lines.append(f"| {scene} | {who} | {sps:,.0f} | {sec:.3f} | {figs} |")
+    lines.append("")
+    lines.append(
+        "Exact answers: the ramp box stops at 1.505 m at t = 3.011 s and then does not move "
+        "(creep 0); the ball rebounds at e = 0.6 of its speed; the resting box neither drifts "
+        "nor sinks."
+    )
+    table = "\n".join(lines)
+    print(table)
+    if not args.no_write:
+        bench = ROOT / "BENCHMARKS.md"
+        text = bench.read_text()
+        block = f"<!-- step-peers:begin -->\n{table}\n<!-- step-peers:end -->"
+        if "<!-- step-peers:begin -->" in text:
+            text = re.sub(
+                r"<!-- step-peers:begin -->.*?<!-- step-peers:end -->",
+                lambda _: block,
+                text,
+                flags=re.S,
+            )
+        else:
+            text = text.rstrip() + "\n\n" + block + "\n"
+        bench.write_text(text)
+        print(f"wrote {bench}", file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
