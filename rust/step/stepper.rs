@@ -5,8 +5,10 @@
 
 use super::{det3, BodyKind, Drift, Pair, Restitution, Scene, StepSettings, StepSolver};
 use crate::contact::{
-    measure, solve_nsgs, solve_polyhedral, BlockCsr, ContactMeasures, ContactProblem,
-    ContactSolution, ContactStatus, NsgsSettings, PolyhedralSettings,
+    measure,
+    prox::{solve_prox, ProxSettings},
+    solve_nsgs, solve_polyhedral, BlockCsr, ContactMeasures, ContactProblem, ContactSolution,
+    ContactStatus, NsgsSettings, PolyhedralSettings,
 };
 use crate::error::Result;
 use crate::lcp::{solve_lemke, LcpRef, LemkeSettings};
@@ -1160,6 +1162,9 @@ impl Stepper {
 /// costs O(nnz) instead of O(nc^2)).
 const SPARSE_FROM: usize = 24;
 
+/// NSGS's fallback is the polyhedral Lemke up to this many contacts, the robust mode above.
+const LEMKE_FALLBACK_MAX: usize = 32;
+
 /// the step's contact problem over the dense or the block-sparse W.
 fn step_problem<'a>(
     dim: usize,
@@ -1213,10 +1218,22 @@ fn solve_step_problem(
                 } else {
                     // NSGS can stall on singular, strongly coupled W (e.g. a rod
                     // lying on two contacts with mu = 2): Lemke's pivoting on the
-                    // polyhedral cone (exact in 2D) decides; keep the better answer
-                    let mut lemke = PolyhedralSettings::for_dim(problem.dim);
-                    lemke.lemke.tol = s.tol.max(1e-9);
-                    let second = solve_polyhedral(problem, &lemke)?;
+                    // polyhedral cone (exact in 2D) decides for few contacts, the robust
+                    // mode (proximal Newton, sparse LU) for many, where the dense LCP of
+                    // nc (facets + 2) unknowns would cost more than the whole run; keep
+                    // the better answer
+                    let second = if problem.nc <= LEMKE_FALLBACK_MAX {
+                        let mut lemke = PolyhedralSettings::for_dim(problem.dim);
+                        lemke.lemke.tol = s.tol.max(1e-9);
+                        solve_polyhedral(problem, &lemke)?
+                    } else {
+                        let prox = ProxSettings {
+                            tol: s.tol.max(1e-9),
+                            initial: Some(first.impulse.clone()),
+                            ..ProxSettings::default()
+                        };
+                        solve_prox(problem, &prox)?
+                    };
                     if second.measures.error < first.measures.error {
                         record.fallback = true;
                         ContactSolution {
