@@ -537,3 +537,72 @@ fn a_large_sparse_pile_is_solved() {
     );
     assert!(s.measures.min_normal_impulse >= 0.0);
 }
+
+// --- anisotropic friction ------------------------------------------------------------------
+
+#[test]
+fn anisotropic_seed_step_slides_with_the_coefficient_of_its_axis() {
+    // the seed's step (m = 2, v_n = -3, slip 1) along each tangent in turn, with 0.2 along the
+    // slip and 0.5 across it: P_n = 6, P_t = -0.2 * 6 = -1.2 along the slip, u_t = 0.4
+    let w = identity_over(2.0, 3);
+    for axis in [1, 2] {
+        let mut q = [-3.0, 0.0, 0.0];
+        q[axis] = 1.0;
+        let pairs = if axis == 1 { [0.2, 0.5] } else { [0.5, 0.2] };
+        let p = ContactProblem::new(3, &w, &q, &[0.5])
+            .and_then(|p| p.with_anisotropic_friction(&pairs))
+            .unwrap();
+        let s = solve_nsgs(&p, &NsgsSettings::default()).unwrap();
+        assert!(s.success(), "{}", s.message);
+        let mut expect = [6.0, 0.0, 0.0];
+        expect[axis] = -1.2;
+        for (got, want) in s.impulse.iter().zip(expect) {
+            assert!((got - want).abs() < 1e-12, "{:?}", s.impulse);
+        }
+        assert!((s.velocity[axis] - 0.4).abs() < 1e-12);
+        assert!(s.measures.error < 1e-14);
+    }
+}
+
+#[test]
+fn anisotropic_pile_sparse_equals_dense_and_dissipates_maximally() {
+    let p = pile::pile(40, 0.4, 9);
+    let sparse = BlockCsr::from_coo(3, p.n, &p.rows, &p.cols, &p.vals).unwrap();
+    let dense = sparse.to_dense();
+    let mut rng = SplitMix64::new(2);
+    let pairs: Vec<f64> = (0..80).map(|_| rng.range(0.05, 0.8)).collect();
+    let mu: Vec<f64> = pairs.chunks(2).map(|c| c[0].max(c[1])).collect();
+    let s = NsgsSettings {
+        tol: 1e-10,
+        max_iter: 20_000,
+        ..Default::default()
+    };
+    let a = ContactProblem::new(3, &dense, &p.q, &mu)
+        .and_then(|pr| pr.with_anisotropic_friction(&pairs))
+        .unwrap();
+    let b = ContactProblem::with_block_sparse(&sparse, &p.q, &mu)
+        .and_then(|pr| pr.with_anisotropic_friction(&pairs))
+        .unwrap();
+    let sa = solve_nsgs(&a, &s).unwrap();
+    assert!(sa.success(), "{}", sa.message);
+    assert_same(&sa, &solve_nsgs(&b, &s).unwrap());
+    let big = sa.impulse.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let mut sliding = 0;
+    for i in 0..40 {
+        let (m1, m2) = (pairs[2 * i], pairs[2 * i + 1]);
+        let r = &sa.impulse[3 * i..3 * i + 3];
+        let u = &sa.velocity[3 * i..3 * i + 3];
+        assert!((r[1] / m1).hypot(r[2] / m2) <= r[0] * (1.0 + 1e-9) + 1e-12);
+        let phi = (m1 * u[1]).hypot(m2 * u[2]);
+        if phi > 1e-6 && r[0] > 1e-6 {
+            // maximal dissipation over the ellipse: r_t = -r_n (mu_1^2 u_1, mu_2^2 u_2) / phi
+            sliding += 1;
+            let e = [-r[0] * m1 * m1 * u[1] / phi, -r[0] * m2 * m2 * u[2] / phi];
+            assert!(
+                (r[1] - e[0]).abs() <= 1e-6 * big && (r[2] - e[1]).abs() <= 1e-6 * big,
+                "contact {i}: {r:?} vs {e:?}"
+            );
+        }
+    }
+    assert!(sliding >= 3, "only {sliding} sliding contacts");
+}

@@ -299,3 +299,57 @@ fn random_positive_definite_problems_are_all_solved() {
         }
     }
 }
+
+// --- anisotropic friction: directions scaled onto the ellipse -------------------------------
+
+#[test]
+fn anisotropic_polygon_is_inscribed_in_the_ellipse_and_converges() {
+    let w = identity_over(2.0, 3);
+    let pairs = [0.2, 0.5];
+    // sliding along a principal axis: a vertex of every polygon, so exact
+    for (q, expect) in [
+        ([-3.0, 1.0, 0.0], [6.0, -1.2, 0.0]),
+        ([-3.0, 0.0, 2.0], [6.0, 0.0, -3.0]),
+    ] {
+        let p = ContactProblem::new(3, &w, &q, &[0.5])
+            .and_then(|p| p.with_anisotropic_friction(&pairs))
+            .unwrap();
+        let (s, lcp, _) = solve_polyhedral_lcp(&p, &settings(8)).unwrap();
+        assert!(s.success(), "{}", s.message);
+        assert_eq!(lcp.direction_scale(0), [0.4, 1.0]);
+        assert!(close(&s.impulse, &expect, 1e-10), "{:?}", s.impulse);
+        assert!(s.measures.error < 1e-12);
+    }
+    // oblique slip: the polygon answer approaches the exact ellipse answer (NSGS) as the
+    // facets grow, and every polygon answer lies inside the ellipse
+    let q = [-3.0, 1.0, 1.0];
+    let p = ContactProblem::new(3, &w, &q, &[0.5])
+        .and_then(|p| p.with_anisotropic_friction(&pairs))
+        .unwrap();
+    let exact = solve_nsgs(
+        &p,
+        &NsgsSettings {
+            tol: 1e-14,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    assert!(exact.success());
+    let dist = |r: &[f64]| {
+        (0..3)
+            .map(|k| (r[k] - exact.impulse[k]).powi(2))
+            .sum::<f64>()
+            .sqrt()
+    };
+    let mut errs = Vec::new();
+    for s in [4, 8, 16, 32, 64, 128] {
+        let sol = solve_polyhedral(&p, &settings(s)).unwrap();
+        assert!(sol.success(), "{}", sol.message);
+        let r = &sol.impulse;
+        assert!((r[1] / 0.2).hypot(r[2] / 0.5) <= r[0] * (1.0 + 1e-12));
+        errs.push(dist(r));
+    }
+    println!("anisotropic polygon vs ellipse, s = 4 .. 128: {errs:?}");
+    assert!(errs[5] < 0.05 * errs[0], "{errs:?}");
+    assert!(errs[5] < 1e-2, "{errs:?}");
+}

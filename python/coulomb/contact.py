@@ -40,7 +40,8 @@ Methods:
     in ``message``); ``iterations`` counts Lemke's pivots and ``max_iter`` (if given) limits
     them. The measures below are still taken against the exact disk, so in 3D ``error``
     reflects the facet approximation (it shrinks as ``facets`` grows, not monotonically: a
-    sliding contact's impulse snaps to a facet).
+    sliding contact's impulse snaps to a facet). With anisotropic friction the directions are
+    scaled along the tangents so that the polygon is inscribed in the ellipse.
 ``"prox"`` (the robust mode)
     A proximal-point semismooth Newton method on the natural map (Rust ``contact::prox``):
     each iteration is one Newton step on the proximal subproblem ``W + eta I`` centred at the
@@ -178,8 +179,8 @@ def solve(
         array, its length fixes nc; when a scalar, ``nc = len(q) // dim``. In 3D an (nc, 2)
         array gives anisotropic friction: per contact the pair ``(mu_1, mu_2)`` along the two
         tangents, the friction set being the ellipse
-        ``(P_t1 / mu_1)^2 + (P_t2 / mu_2)^2 <= P_n^2`` (``"nsgs"`` only; ``"lemke"`` refuses
-        pairs with ``mu_1 != mu_2`` with InvalidParameterError).
+        ``(P_t1 / mu_1)^2 + (P_t2 / mu_2)^2 <= P_n^2`` (for ``"lemke"`` the polygon's
+        directions are scaled onto the ellipse: ``(mu_1 cos a_k, mu_2 sin a_k) / max(mu_1, mu_2)``).
     dim : {2, 3}
         Components per contact.
     method : {"nsgs", "lemke", "prox"}

@@ -578,6 +578,63 @@ mod tests {
     }
 
     #[test]
+    fn anisotropic_friction_is_checked_and_measured() {
+        let w = [0.5, 0.0, 0.0, 0.0, 0.5, 0.0, 0.0, 0.0, 0.5];
+        let q = [-3.0, 1.0, 0.0];
+        let p = ContactProblem::new(3, &w, &q, &[0.5]).unwrap();
+        assert!(p.with_anisotropic_friction(&[0.2, 0.5]).is_ok());
+        assert!(p.is_isotropic());
+        let bad = |pairs: &'static [f64]| p.with_anisotropic_friction(pairs);
+        assert!(matches!(bad(&[0.2]), Err(CoulombError::Shape(_))));
+        assert!(matches!(
+            bad(&[0.2, f64::NAN]),
+            Err(CoulombError::NonFinite(_))
+        ));
+        assert!(matches!(
+            bad(&[-0.2, 0.5]),
+            Err(CoulombError::InvalidParameter(_))
+        ));
+        // mu must be max(mu_1, mu_2)
+        assert!(matches!(
+            bad(&[0.2, 0.4]),
+            Err(CoulombError::InvalidParameter(_))
+        ));
+        let p2 = ContactProblem::new(2, &[0.5, 0.0, 0.0, 0.5], &[-3.0, 1.0], &[0.5]).unwrap();
+        assert!(matches!(
+            p2.with_anisotropic_friction(&[0.2, 0.5]),
+            Err(CoulombError::InvalidParameter(_))
+        ));
+        let a = p.with_anisotropic_friction(&[0.2, 0.5]).unwrap();
+        assert!(!a.is_isotropic() && a.anisotropy(0) == Some([0.2, 0.5]));
+        // sliding along t1 with mu_1 = 0.2: the seed's answer, zero error
+        let (u, m) = measure(&a, &[6.0, -1.2, 0.0]).unwrap();
+        assert!((u[1] - 0.4).abs() < 1e-15);
+        assert!(m.error < 1e-15 && m.cone_violation == 0.0, "{m:?}");
+        // the isotropic answer with mu = 0.5 is wrong for the ellipse
+        let (_, m) = measure(&a, &[6.0, -2.0, 0.0]).unwrap();
+        assert!(m.error > 0.05 && m.cone_violation > 0.5, "{m:?}");
+        // an equal pair gives exactly the isotropic residual
+        let mut rng = crate::testing::SplitMix64::new(1);
+        for _ in 0..200 {
+            let r = [rng.normal(), rng.normal(), rng.normal()];
+            let u = [rng.normal(), rng.normal(), rng.normal()];
+            let mu = rng.range(0.0, 2.0);
+            let (d2, viol) = anisotropic_residual([mu, mu], &r, &u);
+            let mut v = [
+                r[0] - u[0] - mu * u[1].hypot(u[2]),
+                r[1] - u[1],
+                r[2] - u[2],
+            ];
+            project_cone(&mut v, mu);
+            let e2: f64 = (0..3).map(|k| (r[k] - v[k]).powi(2)).sum();
+            assert!((d2 - e2).abs() <= 1e-14 * (1.0 + e2), "{d2} vs {e2}");
+            // (violations are clipped at 0 when aggregated)
+            let iso = (r[1].hypot(r[2]) - mu * r[0]).max(0.0);
+            assert!((viol.max(0.0) - iso).abs() <= 1e-14 * (1.0 + iso));
+        }
+    }
+
+    #[test]
     fn measures_of_the_seed_answer_and_of_zero() {
         let w = [0.5, 0.0, 0.0, 0.5];
         let q = [-3.0, 1.0];

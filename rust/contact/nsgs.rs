@@ -1,4 +1,4 @@
-//! Nonsmooth Gauss-Seidel (NSGS) with the exact friction disk.
+//! Nonsmooth Gauss-Seidel (NSGS) with the exact friction disk (or ellipse).
 //!
 //! Sweep after sweep, contact i = 1..nc in order, with the other contacts' impulses frozen:
 //!
@@ -29,9 +29,19 @@
 //!   exact for anisotropic T in the tangential plane at the price of a 2x2 eigendecomposition
 //!   done once per contact.
 //!
+//! - anisotropic friction (3D, the ellipse `(r_t1 / mu_1)^2 + (r_t2 / mu_2)^2 <= r_n^2`): the
+//!   same descent, the tangential update being the exact minimiser over the ellipse. With
+//!   `r_t = E s`, `E = diag(mu_1, mu_2)`, the ellipse is the disk `||s|| <= r_n` and the
+//!   problem is the trust-region problem `min 1/2 s^T (E T E) s + (E g) . s` over that disk,
+//!   solved as above in the eigenbasis of `E T E` (precomputed). When `T = t I` this minimiser
+//!   is the ellipse projection of `-g / t` ([`super::projection::project_ellipse`]); a test pins
+//!   that.
+//!
 //! Frictionless contacts (mu = 0) carry no tangential impulse. The error (see
 //! [`super::ContactMeasures`]) is computed after every sweep from the original W and q, into
-//! buffers allocated once, so a sweep allocates nothing.
+//! buffers allocated once. `b_i` is read from the stored blocks of W's block row i
+//! ([`ContactProblem::block_row_mul_offdiag`]), so with block-sparse W a sweep costs
+//! O(nnz(W)); a sweep allocates nothing (tests/nsgs_alloc.rs counts the allocations).
 
 use super::projection::{secular, solve_secular};
 use super::{measure_into, ContactProblem, ContactSolution, ContactStatus};
@@ -443,6 +453,35 @@ mod tests {
                 "{t:?}: {r00} {r01} {r11}"
             );
             assert!((r11 - t[2]).abs() < 1e-14 && e.small <= e.large);
+        }
+    }
+
+    #[test]
+    fn anisotropic_tangential_update_is_the_ellipse_projection_for_isotropic_t() {
+        use crate::contact::projection::project_ellipse;
+        let mut rng = SplitMix64::new(23);
+        for _ in 0..300 {
+            let t = rng.range(0.1, 3.0);
+            let e = [rng.range(0.0, 1.5), rng.range(0.01, 1.5)];
+            let blk = LocalBlock {
+                a: 1.0,
+                c: [0.0, 0.0],
+                t: [t, 0.0, t],
+                eig: Eig2::of([e[0] * e[0] * t, 0.0, e[1] * e[1] * t]),
+                scale: Some(e),
+            };
+            // b_n = -rn fixes r_n = rn (a = 1, no coupling)
+            let rn = rng.range(0.1, 4.0);
+            let b = [-rn, 3.0 * rng.normal(), 3.0 * rng.normal()];
+            let mut r = [0.0; 3];
+            local_descent(&blk, 0.0, &b, 3, &mut r);
+            assert_eq!(r[0], rn);
+            let p = project_ellipse([-b[1] / t, -b[2] / t], e[0], e[1], rn);
+            let scale = 1.0 + (b[1].abs() + b[2].abs()) / t;
+            assert!(
+                (r[1] - p[0]).abs() <= 1e-12 * scale && (r[2] - p[1]).abs() <= 1e-12 * scale,
+                "{r:?} vs {p:?} (t {t}, e {e:?})"
+            );
         }
     }
 

@@ -21,7 +21,17 @@
 //!         [ mu        -E^T        0 ]            [ 0       ]
 //! ```
 //!
-//! (E: each contact's β block to its λ). A is copositive but not positive semidefinite, so
+//! (E: each contact's β block to its λ).
+//!
+//! Anisotropic friction (3D, the ellipse `(r_t1 / mu_1)^2 + (r_t2 / mu_2)^2 <= r_n^2`): the
+//! directions of contact i are scaled along the tangents,
+//! `d_k = (mu_1 cos θ_k, mu_2 sin θ_k) / m` with `m = max(mu_1, mu_2) = mu_i` in the row
+//! `m r_n - 1^T β`, so the polygon's vertices `m r_n d_k = r_n (mu_1 cos θ_k, mu_2 sin θ_k)` lie
+//! on the ellipse: the polygon is inscribed in it, as the isotropic one is in the disk, and
+//! the rest of the LCP is unchanged. The reported measures are then taken against the exact
+//! ellipse.
+//!
+//! A is copositive but not positive semidefinite, so
 //! the LCP is solved by [`crate::lcp::solve_lemke`], not by PGS. Frictionless contacts carry
 //! only their normal unknown. The impulses are mapped back (`r_i = (r_n, D_i β_i)`) and the
 //! velocity `u = W r + q` is recomputed from the original W and q.
@@ -70,6 +80,9 @@ pub struct PolyhedralLcp {
     dim: usize,
     /// the tangent directions, `facets` pairs `(d_x, d_y)` (`d_y = 0` in 2D).
     directions: Vec<[f64; 2]>,
+    /// per contact, the scale of the directions along each tangent: `(1, 1)`, or
+    /// `(mu_1 / m, mu_2 / m)` for anisotropic friction.
+    scale: Vec<[f64; 2]>,
     /// per contact, the index of its first β in z (`None` when frictionless).
     beta: Vec<Option<usize>>,
     /// per contact, the index of its λ in z (`None` when frictionless).
@@ -81,13 +94,6 @@ impl PolyhedralLcp {
     pub fn new(problem: &ContactProblem<'_>, facets: usize) -> Result<Self> {
         let dim = problem.dim;
         check_facets(dim, facets)?;
-        if !problem.is_isotropic() {
-            return Err(CoulombError::InvalidParameter(
-                "the polyhedral (Stewart-Trinkle) method approximates the isotropic friction \
-                 disk only; use method 'nsgs' for anisotropic friction"
-                    .into(),
-            ));
-        }
         let directions: Vec<[f64; 2]> = if dim == 2 {
             vec![[1.0, 0.0], [-1.0, 0.0]]
         } else {
@@ -117,8 +123,9 @@ impl PolyhedralLcp {
         for (i, b) in beta.iter_mut().enumerate() {
             if problem.mu[i] > 0.0 {
                 *b = Some(p);
+                let e = axis_scale(problem, i);
                 for d in &directions {
-                    local[i].push((p, [0.0, d[0], d[1]]));
+                    local[i].push((p, [0.0, e[0] * d[0], e[1] * d[1]]));
                     p += 1;
                 }
             }
@@ -173,6 +180,7 @@ impl PolyhedralLcp {
             q,
             dim,
             directions,
+            scale: (0..nc).map(|i| axis_scale(problem, i)).collect(),
             beta,
             lambda,
         })
@@ -196,9 +204,16 @@ impl PolyhedralLcp {
         self.lambda[i]
     }
 
-    /// the tangent directions `d_k` (`(±1, 0)` in 2D).
+    /// the unit tangent directions `d_k` (`(±1, 0)` in 2D), before the per-contact scale of
+    /// [`Self::direction_scale`].
     pub fn directions(&self) -> &[[f64; 2]] {
         &self.directions
+    }
+
+    /// contact i's scale of the directions along its two tangents: `(1, 1)`, or
+    /// `(mu_1 / m, mu_2 / m)` with anisotropic friction.
+    pub fn direction_scale(&self, i: usize) -> [f64; 2] {
+        self.scale[i]
     }
 
     /// the contact impulses `r_i = (r_n, D_i β_i)` (`dim nc` entries) of an LCP answer z.
@@ -210,12 +225,25 @@ impl PolyhedralLcp {
             r[i * dim] = z[i];
             for (k, zk) in self.beta_range(i).enumerate() {
                 let d = self.directions[k];
+                let e = self.scale[i];
                 for t in 0..dim - 1 {
-                    r[i * dim + 1 + t] += d[t] * z[zk];
+                    r[i * dim + 1 + t] += e[t] * d[t] * z[zk];
                 }
             }
         }
         r
+    }
+}
+
+/// the scale of contact i's tangent directions: `(1, 1)` for the disk, `(mu_1 / m, mu_2 / m)`
+/// with `m = max(mu_1, mu_2) = mu_i` for the ellipse.
+fn axis_scale(problem: &ContactProblem<'_>, i: usize) -> [f64; 2] {
+    match problem.anisotropy(i) {
+        Some(p) => {
+            let m = p[0].max(p[1]);
+            [p[0] / m, p[1] / m]
+        }
+        None => [1.0, 1.0],
     }
 }
 

@@ -146,7 +146,8 @@ pub(crate) fn secular(d: [f64; 2], g: [f64; 2], lambda: f64) -> f64 {
 pub(crate) fn solve_secular(d: [f64; 2], g: [f64; 2], target: f64, lo: f64) -> f64 {
     let gnorm = g[0].hypot(g[1]);
     let dmin = d[0].min(d[1]);
-    let mut lo = lo;
+    // S(λ) >= ||g||^2 / (max d + λ)^2: the root is at least ||g|| / target - max d
+    let mut lo = lo.max(gnorm / target - d[0].max(d[1]));
     let mut hi = (gnorm / target - dmin).max(lo);
     let mut lambda = hi;
     for _ in 0..200 {
@@ -164,6 +165,10 @@ pub(crate) fn solve_secular(d: [f64; 2], g: [f64; 2], target: f64, lo: f64) -> f
             break;
         }
         let psi = 1.0 / s.sqrt() - 1.0 / target;
+        if psi.abs() <= f64::EPSILON / target {
+            // S(λ) = target^2 to rounding
+            break;
+        }
         if psi < 0.0 {
             lo = lambda;
         } else {

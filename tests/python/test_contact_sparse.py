@@ -336,11 +336,30 @@ def test_anisotropic_equals_isotropic_when_the_pair_is_equal():
     a = contact.solve(W, q, mu)
     b = contact.solve(W, q, np.stack([mu, mu], axis=1))
     same(a, b)
-    # the polyhedral method accepts equal pairs (it is the disk) and refuses an ellipse
     c = contact.solve(W, q, np.stack([mu, mu], axis=1), method="lemke")
     same(c, contact.solve(W, q, mu, method="lemke"))
-    with pytest.raises(errors.InvalidParameterError, match="anisotropic"):
-        contact.solve(W, q, np.stack([mu, 0.5 * mu], axis=1), method="lemke")
+
+
+def test_anisotropic_polyhedral_lemke():
+    # the polygon is inscribed in the ellipse: exact when sliding along a principal axis
+    W = np.eye(3) / 2
+    for q, expect in (([-3.0, 1.0, 0.0], [6.0, -1.2, 0.0]), ([-3.0, 0.0, 2.0], [6.0, 0.0, -3.0])):
+        r = contact.solve(W, q, [[0.2, 0.5]], method="lemke")
+        assert r.success, r.message
+        np.testing.assert_allclose(r.impulse[0], expect, atol=1e-10)
+        assert r.error < 1e-12
+    # oblique: inside the ellipse, close to the exact answer with many facets
+    q = np.array([-3.0, 1.0, 1.0])
+    exact = contact.solve(W, q, [[0.2, 0.5]], tol=1e-14).impulse[0]
+    r = contact.solve(W, q, [[0.2, 0.5]], method="lemke", facets=128).impulse[0]
+    assert np.hypot(r[1] / 0.2, r[2] / 0.5) <= r[0] * (1 + 1e-12)
+    assert np.abs(r - exact).max() < 5e-3
+    # a random problem: sparse and dense agree
+    W, q, _ = random_problem(6, nc=6, density=0.6)
+    pairs = np.random.default_rng(6).uniform(0.05, 0.8, (6, 2))
+    a = contact.solve(W, q, pairs, method="lemke")
+    assert a.success, a.message
+    same(a, contact.solve(sp.csr_array(W), q, pairs, method="lemke"))
 
 
 def test_a_zero_coefficient_forbids_friction_along_its_tangent():
