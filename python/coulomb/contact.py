@@ -274,18 +274,6 @@ def solve(
         raise InvalidParameterError(f"max_iter must be at least 1, got {max_iter}")
     if not 0 < relaxation < 2:
         raise InvalidParameterError(f"relaxation must lie in (0, 2), got {relaxation}")
-    if method == "prox":
-        out = _core.contact_solve_prox(
-            Wa,
-            qa,
-            mua,
-            dim,
-            float(tol),
-            None if max_iter is None else int(max_iter),
-            1.0 if eta is None else float(eta),
-            init,
-        )
-        return ContactResult(out)
     out = _core.contact_solve(
         Wa,
         qa,
@@ -299,6 +287,7 @@ def solve(
         facets,
         w_csr=csr,
         mu_pair=pairs,
+        eta=None if eta is None else float(eta),
     )
     return ContactResult(out)
 

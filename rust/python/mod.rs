@@ -18,6 +18,7 @@ use pyo3::types::{PyDict, PyType};
 
 mod step;
 
+use crate::contact::prox::{solve_prox, ProxSettings};
 use crate::contact::{
     self, BlockCsr, ContactProblem, ContactSolution, NsgsSettings, PolyhedralSettings,
 };
@@ -315,6 +316,7 @@ fn contact_dict<'py>(
 enum ContactSettings {
     Nsgs(NsgsSettings),
     Lemke(PolyhedralSettings),
+    Prox(ProxSettings),
 }
 
 /// Scalar CSR index arrays as scipy stores them (int32 or int64), borrowed without a copy.
@@ -375,7 +377,7 @@ fn block_csr(
 /// (then `mu` holds `max(mu_1, mu_2)`).
 #[pyfunction]
 #[pyo3(signature = (w, q, mu, dim, method, tol, max_iter=None, relaxation=1.0, initial=None,
-                    facets=None, w_csr=None, mu_pair=None))]
+                    facets=None, w_csr=None, mu_pair=None, eta=None))]
 #[allow(clippy::too_many_arguments)]
 fn contact_solve<'py>(
     py: Python<'py>,
@@ -396,6 +398,7 @@ fn contact_solve<'py>(
         PyReadonlyArray1<'py, f64>,
     )>,
     mu_pair: Option<PyReadonlyArray1<'py, f64>>,
+    eta: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let qs = slice1(py, "q", &q)?;
     let mus = slice1(py, "mu", &mu)?;
@@ -423,12 +426,21 @@ fn contact_solve<'py>(
             s.lemke.max_pivots = max_iter;
             ContactSettings::Lemke(s)
         }
+        "prox" => {
+            let d = ProxSettings::default();
+            ContactSettings::Prox(ProxSettings {
+                tol,
+                max_iter: max_iter.unwrap_or(d.max_iter),
+                eta: eta.unwrap_or(d.eta),
+                initial: init,
+            })
+        }
         other => {
             return Err(to_py(
                 py,
                 CoulombError::InvalidParameter(format!(
-                    "unknown method {other:?}: expected 'nsgs' (exact friction disk) or 'lemke' \
-                     (polyhedral cone)"
+                    "unknown method {other:?}: expected 'nsgs' (exact friction disk), 'lemke' \
+                     (polyhedral cone) or 'prox' (robust mode)"
                 )),
             ))
         }
@@ -478,6 +490,16 @@ fn contact_solve<'py>(
         let s = match &settings {
             ContactSettings::Nsgs(s) => contact::solve_nsgs(&problem, s)?,
             ContactSettings::Lemke(s) => contact::solve_polyhedral(&problem, s)?,
+            ContactSettings::Prox(s) => {
+                if !problem.is_isotropic() {
+                    return Err(CoulombError::InvalidParameter(
+                        "the robust mode (prox) takes isotropic friction; solve anisotropic \
+                         (mu_1, mu_2) pairs with 'nsgs' or 'lemke'"
+                            .into(),
+                    ));
+                }
+                solve_prox(&problem, s)?
+            }
         };
         Ok((s, problem.nc, start.elapsed().as_secs_f64()))
     })?;

@@ -235,7 +235,9 @@ def ellipse_brute(x, a: float, b: float) -> np.ndarray:
 
     grid = np.linspace(0.0, 2 * np.pi, 20001)
     k = int(np.argmin(f(grid)))
-    lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
+    # the angle is periodic: bracket across 0 = 2 pi instead of clamping at the grid's ends
+    step = grid[1] - grid[0]
+    lo, hi = grid[k] - step, grid[k] + step
     g = (np.sqrt(5.0) - 1) / 2
     for _ in range(100):
         c, d = hi - g * (hi - lo), lo + g * (hi - lo)
