@@ -51,7 +51,8 @@ pub fn project_cone(r: &mut [f64], mu: f64) {
     let n = r[0];
     let s = tangent_norm(&r[1..]);
     let (n_new, t_norm_new) = if mu <= 1.0 {
-        if s <= mu * n {
+        // inside K (n >= 0 matters for mu = 0, where s <= mu n holds for any n when s = 0)
+        if s <= mu * n && n >= 0.0 {
             return;
         }
         if mu * s <= -n {
@@ -198,6 +199,20 @@ pub(crate) fn solve_secular(d: [f64; 2], g: [f64; 2], target: f64, lo: f64) -> f
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn frictionless_cone_is_the_nonnegative_normal_half_line() {
+        // mu = 0: K = { r_t = 0, r_n >= 0 }; a point below it projects to the apex
+        let mut r = [-2.0, 0.0, 0.0];
+        project_cone(&mut r, 0.0);
+        assert_eq!(r, [0.0, 0.0, 0.0]);
+        let mut r = [3.0, 0.5, -1.0];
+        project_cone(&mut r, 0.0);
+        assert_eq!(r, [3.0, 0.0, 0.0]);
+        let mut r = [-1.0, 0.0];
+        project_cone(&mut r, 0.0);
+        assert_eq!(r, [0.0, 0.0]);
+    }
     use crate::testing::SplitMix64;
 
     fn in_cone(r: &[f64], mu: f64, tol: f64) -> bool {
