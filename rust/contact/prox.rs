@@ -470,6 +470,20 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
         }
     }
 
+    // Newton iterates may leave the cones by about the tolerance: keep the projection on the
+    // cones when it still passes the test (then r is feasible exactly)
+    if measures.error_q <= s.tol && iterations > 0 {
+        r_try.copy_from_slice(&r);
+        for (ri, &mu) in r_try.chunks_exact_mut(dim).zip(problem.mu) {
+            project_cone(ri, mu);
+        }
+        let projected = measure_into(problem, &r_try, &mut u_try);
+        if projected.error_q <= s.tol {
+            std::mem::swap(&mut r, &mut r_try);
+            std::mem::swap(&mut u, &mut u_try);
+            measures = projected;
+        }
+    }
     let (status, message) = if measures.error_q <= s.tol {
         (
             ContactStatus::Solved,
