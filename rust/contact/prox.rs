@@ -108,6 +108,9 @@ const STALL_WINDOW: usize = 25;
 const RESTART_SWEEPS: usize = 100;
 /// restarts at most.
 const MAX_RESTARTS: usize = 10;
+/// Newton steps taken after the test passes, for an answer whose projection on the cones
+/// passes too.
+const FEASIBILITY_STEPS: usize = 3;
 /// step halvings in the line search.
 const MAX_HALVINGS: usize = 30;
 
@@ -363,7 +366,28 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
     let mut restarts = 0usize;
     // progress mark: the last time ||F|| fell below a tenth of its value at the previous mark
     let (mut phi_mark, mut iter_mark) = (phi, 0usize);
-    while measures.error_q > s.tol && iterations < s.max_iter {
+    // Newton iterates may leave the cones by about the tolerance: once the test passes, the
+    // answer is the projection of r on the cones if that passes too (r then exactly feasible);
+    // otherwise up to FEASIBILITY_STEPS more Newton steps are taken before r is returned as is
+    let mut extra = 0usize;
+    while iterations < s.max_iter {
+        if measures.error_q <= s.tol {
+            r_try.copy_from_slice(&r);
+            for (ri, &mu) in r_try.chunks_exact_mut(dim).zip(problem.mu) {
+                project_cone(ri, mu);
+            }
+            let projected = measure_into(problem, &r_try, &mut u_try);
+            if projected.error_q <= s.tol {
+                std::mem::swap(&mut r, &mut r_try);
+                std::mem::swap(&mut u, &mut u_try);
+                measures = projected;
+                break;
+            }
+            if extra == FEASIBILITY_STEPS {
+                break;
+            }
+            extra += 1;
+        }
         if stalled || iterations - iter_mark >= STALL_WINDOW {
             // restart from NSGS sweeps (see the module notes)
             if restarts >= MAX_RESTARTS {
@@ -470,20 +494,6 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
         }
     }
 
-    // Newton iterates may leave the cones by about the tolerance: keep the projection on the
-    // cones when it still passes the test (then r is feasible exactly)
-    if measures.error_q <= s.tol && iterations > 0 {
-        r_try.copy_from_slice(&r);
-        for (ri, &mu) in r_try.chunks_exact_mut(dim).zip(problem.mu) {
-            project_cone(ri, mu);
-        }
-        let projected = measure_into(problem, &r_try, &mut u_try);
-        if projected.error_q <= s.tol {
-            std::mem::swap(&mut r, &mut r_try);
-            std::mem::swap(&mut u, &mut u_try);
-            measures = projected;
-        }
-    }
     let (status, message) = if measures.error_q <= s.tol {
         (
             ContactStatus::Solved,
