@@ -334,7 +334,8 @@ def profile(runs: list[Run], solvers: list[str], tols: list[float], path: Path) 
         ax.legend(loc="lower right", fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
-    return f"performance profile: `{path.relative_to(REPO_ROOT)}`"
+    shown = path.relative_to(REPO_ROOT) if path.is_relative_to(REPO_ROOT) else path
+    return f"Dolan-More performance profile: `{shown}`"
 
 
 def write_markers(target: Path, body: str) -> None:
