@@ -386,7 +386,13 @@ def main() -> None:
         f"{args.nsgs_max_iter} sweeps (coulomb and Siconos), coulomb prox at most "
         f"{args.prox_max_iter} Newton steps, Siconos PROX its default inner solver and 1000 "
         "outer iterations. Zero initial impulses. Siconos: "
-        + ("`python3-siconos` from the system Python, dense W." if with_siconos else "not run.")
+        + (
+            "`python3-siconos` from the system Python, given a dense W (no scipy there): its "
+            "NSGS is slower on the larger problems than with its sparse-block storage "
+            "(../shared/data/fclib/SOURCE.md), so the ratios below flatter coulomb there."
+            if with_siconos
+            else "not run."
+        )
         + " Global FCLib problems are reduced with `coulomb.contact.assemble`.",
         "",
     ]
