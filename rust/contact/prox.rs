@@ -42,8 +42,9 @@
 //! numbers of `benches/peer_contact.py`):
 //!
 //! - this method with the default eta = 0.1 solves every 3D problem of the FCLib subset except
-//!   RockPile (BoxesStack1 47 Newton steps, local_problem_test 31, OneObject-i100000-499 8,
-//!   Capsules-i122-1617 26, KaplasTower 11, Spheres (reduced) 20, PerioBox 23), and 42 of the 44
+//!   RockPile (BoxesStack1 49 Newton steps / 21 ms, local_problem_test 31 / 25 ms,
+//!   OneObject-i100000-499 8 / 1 ms, Capsules-i122-1617 26 / 0.30 s, KaplasTower 14 / 0.33 s,
+//!   Spheres (reduced) 20 / 0.14 s, PerioBox 23 / 45 ms), and 42 of the 44
 //!   local siconos-fc problems: all but RockPile_tob1 and the 2D
 //!   fc2d_granularflowonwall_02020_00213 (nc 2020: error_q 3.5e-7 after 200 steps, slow on a
 //!   dense W). RockPile ends at error_q 8e-5 after 200 steps (Siconos NSGS: 3.5e-4).
