@@ -14,7 +14,7 @@ are found from the sparsity pattern), otherwise by faer's sparse Cholesky.
 >>> import numpy as np, coulomb
 >>> # the seed's inelastic step: a particle of mass 2, free velocity (-3, 1) in the contact frame
 >>> W, q = coulomb.contact.assemble(2 * np.eye(2), np.eye(2), [-3.0, 1.0])
->>> W.tolist(), q.tolist()
+>>> W.round(12).tolist(), q.tolist()
 ([[0.5, 0.0], [0.0, 0.5]], [-3.0, 1.0])
 >>> r = coulomb.contact.solve(W, q, 0.2, dim=2)
 >>> coulomb.contact.post_velocity(2 * np.eye(2), np.eye(2), [-3.0, 1.0], r.impulse).round(12)

@@ -51,7 +51,7 @@ def contact_solve_prox(
     dim: int,
     tol: float,
     max_iter: int | None = None,
-    eta: float = 1.0,
+    eta: float = 0.1,
     initial: NDArray[np.float64] | None = None,
 ) -> dict[str, Any]: ...
 

@@ -46,7 +46,7 @@ Methods:
     A proximal-point semismooth Newton method on the natural map (Rust ``contact::prox``):
     each iteration is one Newton step on the proximal subproblem ``W + eta I`` centred at the
     current impulses, with a line search and ``eta`` adapted (``eta`` is relative to W's mean
-    diagonal; default 1), restarted from NSGS sweeps when it makes no progress. For the
+    diagonal; default 0.1), restarted from NSGS sweeps when it makes no progress. For the
     problems where NSGS stalls at tight tolerances (redundant contacts, FCLib BoxesStack and
     OneObject). ``success`` means ``error_q <= tol`` (which implies ``error <= tol``);
     ``iterations`` counts Newton steps (each one sparse LU factorization); ``max_iter`` defaults
@@ -201,7 +201,7 @@ def solve(
         least 4 in 3D (default 8); exactly 2 in 2D (the default, and exact).
     eta : float, optional
         ``"prox"`` only: the initial proximal parameter relative to W's mean diagonal (> 0,
-        default 1).
+        default 0.1).
 
     Returns
     -------

@@ -19,7 +19,7 @@ use crate::error::CoulombError;
 /// `crate::contact::prox`). The Python wrapper `coulomb.contact.solve(method="prox")` documents
 /// the arguments.
 #[pyfunction]
-#[pyo3(signature = (w, q, mu, dim, tol, max_iter=None, eta=1.0, initial=None))]
+#[pyo3(signature = (w, q, mu, dim, tol, max_iter=None, eta=0.1, initial=None))]
 #[allow(clippy::too_many_arguments)]
 fn contact_solve_prox<'py>(
     py: Python<'py>,

@@ -152,8 +152,11 @@ def test_robust_mode_solves_the_fclib_subset_at_1e_8(problems, name):
     assert r.success and r.status == "solved", r.message
     err, err_q = contact_error(W, p.q, p.mu, p.dim, r.impulse)
     assert err_q <= TOL and err <= TOL, (name, err_q)
-    assert abs(err_q - r.error_q) <= 1e-6 * TOL + 1e-3 * err_q
-    assert r.min_normal_impulse >= -1e-9 * np.abs(r.impulse).max()
+    # the same residual, up to rounding in u = W r + q (||r|| is 5e5 times ||q|| on PerioBox)
+    assert abs(err_q - r.error_q) <= 1e-3 * TOL + 1e-3 * err_q
+    # r lies within ||F|| <= tol ||q|| of the cones (F = r - P_K(...)): bounded infeasibility
+    assert r.min_normal_impulse >= -TOL * np.linalg.norm(p.q) * (1 + p.mu.max())
+    assert r.cone_violation <= TOL * np.linalg.norm(p.q) * (1 + p.mu.max())
 
 
 def test_rockpile_is_reported_honestly(problems):
