@@ -8,14 +8,16 @@ Submodules
 lcp
     Linear complementarity problems (Lemke, projected Gauss-Seidel, enumeration).
 contact
-    Frictional contact over a frozen Delassus matrix (nonsmooth Gauss-Seidel, exact cone).
+    Frictional contact over a frozen Delassus matrix: nonsmooth Gauss-Seidel on the exact cone,
+    the polyhedral-cone LCP by Lemke, the robust mode (``method="prox"``), and the assembly of
+    W = G^T M^-1 G.
 model
     Scenes (bodies, contact shapes, half-spaces, pairs) and ``Scene.simulate``: the seed's
     impulse time stepper, run in Rust.
 trajectory
     The simulation result with the seed's per-step checks (``Trajectory.check``) and plots.
 io
-    Readers for benchmark problem files (Siconos).
+    Readers for benchmark problem files (Siconos LCP and friction contact, FCLib HDF5).
 painleve
     Painleve's sliding rod: the seed's A(theta), b and which smooth contact modes exist.
 regularized
