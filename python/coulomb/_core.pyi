@@ -42,6 +42,8 @@ def contact_solve(
     | None = None,
     mu_pair: NDArray[np.float64] | None = None,
     eta: float | None = None,
+    order: str = "forward",
+    permutation: list[int] | None = None,
 ) -> dict[str, Any]: ...
 def read_siconos_fc(path: str) -> dict[str, Any]: ...
 def contact_solve_prox(

@@ -161,6 +161,7 @@ def solve(
     initial: ArrayLike | None = None,
     facets: int | None = None,
     eta: float | None = None,
+    order: str | ArrayLike = "forward",
 ) -> ContactResult:
     """Solve the friction-contact problem ``u = W r + q`` with Coulomb's law at every contact.
 
@@ -202,6 +203,10 @@ def solve(
     eta : float, optional
         ``"prox"`` only: the initial proximal parameter relative to W's mean diagonal (> 0,
         default 0.1).
+    order : {"forward", "backward", "symmetric"} or (nc,) array of int
+        ``"nsgs"`` only: the order in which a sweep visits the contacts; ``"symmetric"`` is a
+        forward then a backward pass (no directional bias in stacks and chains, twice the cost
+        per sweep); an array is a permutation of the contacts.
 
     Returns
     -------
@@ -274,6 +279,7 @@ def solve(
         raise InvalidParameterError(f"max_iter must be at least 1, got {max_iter}")
     if not 0 < relaxation < 2:
         raise InvalidParameterError(f"relaxation must lie in (0, 2), got {relaxation}")
+    order_name, permutation = _order(order, nc, method)
     out = _core.contact_solve(
         Wa,
         qa,
@@ -288,8 +294,31 @@ def solve(
         w_csr=csr,
         mu_pair=pairs,
         eta=None if eta is None else float(eta),
+        order=order_name,
+        permutation=permutation,
     )
     return ContactResult(out)
+
+
+def _order(order: object, nc: int, method: str) -> tuple[str, list[int] | None]:
+    """The NSGS sweep order as the core takes it: a name, or "custom" and a permutation."""
+    if isinstance(order, str):
+        if order not in ("forward", "backward", "symmetric"):
+            raise InvalidParameterError(
+                f"order must be 'forward', 'backward', 'symmetric' or a permutation of the "
+                f"{nc} contacts, got {order!r}"
+            )
+        if order != "forward" and method != "nsgs":
+            raise InvalidParameterError("order applies to method='nsgs' only")
+        return order, None
+    if method != "nsgs":
+        raise InvalidParameterError("order applies to method='nsgs' only")
+    perm = np.asarray(order)
+    if perm.ndim != 1 or not np.issubdtype(perm.dtype, np.integer):
+        raise InvalidParameterError("a custom order must be a 1-D array of contact indices")
+    if perm.shape[0] != nc or sorted(perm.tolist()) != list(range(nc)):
+        raise InvalidParameterError(f"a custom order must be a permutation of 0..{nc - 1}")
+    return "custom", [int(i) for i in perm]
 
 
 def _is_scipy_sparse(W: object) -> bool:

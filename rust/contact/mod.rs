@@ -26,7 +26,7 @@ pub mod sparse;
 use crate::error::{check_finite, CoulombError, Result};
 use projection::{project_cone, tangent_norm};
 
-pub use nsgs::{solve_nsgs, NsgsSettings};
+pub use nsgs::{solve_nsgs, ContactOrder, NsgsSettings};
 pub use polyhedral::{solve_polyhedral, PolyhedralSettings};
 pub use sparse::BlockCsr;
 

@@ -401,6 +401,7 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
                 max_iter: RESTART_SWEEPS,
                 relaxation: 1.0,
                 initial: Some(r.clone()),
+                order: crate::contact::ContactOrder::Forward,
             };
             let out = solve_nsgs(problem, &sweep)?;
             if out.impulse.iter().all(|v| v.is_finite()) {

@@ -377,7 +377,8 @@ fn block_csr(
 /// (then `mu` holds `max(mu_1, mu_2)`).
 #[pyfunction]
 #[pyo3(signature = (w, q, mu, dim, method, tol, max_iter=None, relaxation=1.0, initial=None,
-                    facets=None, w_csr=None, mu_pair=None, eta=None))]
+                    facets=None, w_csr=None, mu_pair=None, eta=None,
+                    order="forward", permutation=None))]
 #[allow(clippy::too_many_arguments)]
 fn contact_solve<'py>(
     py: Python<'py>,
@@ -399,8 +400,25 @@ fn contact_solve<'py>(
     )>,
     mu_pair: Option<PyReadonlyArray1<'py, f64>>,
     eta: Option<f64>,
+    order: &str,
+    permutation: Option<Vec<usize>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let qs = slice1(py, "q", &q)?;
+    let order = match (order, permutation) {
+        ("forward", None) => contact::ContactOrder::Forward,
+        ("backward", None) => contact::ContactOrder::Backward,
+        ("symmetric", None) => contact::ContactOrder::Symmetric,
+        ("custom", Some(p)) => contact::ContactOrder::Custom(p),
+        (other, _) => {
+            return Err(to_py(
+                py,
+                CoulombError::InvalidParameter(format!(
+                    "order must be 'forward', 'backward', 'symmetric' or a permutation of the \
+                     contacts, got {other:?}"
+                )),
+            ))
+        }
+    };
     let mus = slice1(py, "mu", &mu)?;
     let pairs = match &mu_pair {
         Some(p) => Some(slice1(py, "mu_pair", p)?),
@@ -416,6 +434,7 @@ fn contact_solve<'py>(
             max_iter: max_iter.unwrap_or(1000),
             relaxation,
             initial: init,
+            order,
         }),
         "lemke" => {
             let mut s = PolyhedralSettings::for_dim(dim);

@@ -164,6 +164,7 @@ pub(super) fn step_simulate<'py>(
             max_iter: max_iter.unwrap_or(1000),
             relaxation,
             initial: None,
+            order: crate::contact::ContactOrder::Forward,
         }),
         "lemke" => {
             let mut s = PolyhedralSettings::for_dim(scene.dim);

@@ -408,3 +408,25 @@ def test_one_contact_answer_is_the_ellipse_projection(qt, m1, m2, qn, mass):
     expect = ellipse_brute(-mass * q[1:], m1 * pn, m2 * pn)
     scale = 1.0 + mass * np.abs(q).max()
     np.testing.assert_allclose(r.impulse[0, 1:], expect, rtol=0, atol=1e-7 * scale)
+
+
+@pytest.mark.parametrize("order", ["forward", "backward", "symmetric", "custom"])
+def test_sweep_orders_reach_the_same_answer(order):
+    from coulomb.study import _stack_problem
+
+    W, q = _stack_problem(10, 3)
+    ref = contact.solve(W, q, 0.5, tol=1e-13, max_iter=100_000)
+    arg = np.random.default_rng(0).permutation(10) if order == "custom" else order
+    r = contact.solve(W, q, 0.5, tol=1e-11, max_iter=100_000, order=arg)
+    assert r.success and ref.success
+    np.testing.assert_allclose(r.impulse, ref.impulse, atol=1e-8 * np.abs(ref.impulse).max())
+
+
+def test_bad_sweep_orders_are_refused():
+    W, q = np.eye(6), np.array([-1.0, 0.1, 0.0, -1.0, 0.0, 0.2])
+    with pytest.raises(errors.InvalidParameterError):
+        contact.solve(W, q, 0.5, order="sideways")
+    with pytest.raises(errors.InvalidParameterError):
+        contact.solve(W, q, 0.5, order=[0, 0])
+    with pytest.raises(errors.InvalidParameterError):
+        contact.solve(W, q, 0.5, method="lemke", order="backward")
