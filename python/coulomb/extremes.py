@@ -1,6 +1,7 @@
 """Numerical stability at the extremes: scenes pushed to the ends of their parameters.
 
-Each case runs a scene of :mod:`coulomb.model` at an extreme setting (mass ratios up to 1e6,
+Each case runs a scene of :mod:`coulomb.model` at an extreme setting (mass ratios up to 1e6:
+stacked disks, and a box on a box in generalized coordinates,
 friction from 0 to 100, e = 0 and 1, steps from 1e-6 to 1e-1 s, grazing impacts, many
 redundant contacts, the same scene in other units, Painleve's rod across theta and mu) and
 compares one figure with its bound. A case *passes* when the figure is finite and within its
@@ -23,7 +24,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .model import HalfSpace, Particle, Point, Polygon, RigidBody2D, Scene, Segment, Sphere
+from .model import (
+    GapContact,
+    HalfSpace,
+    Model,
+    Particle,
+    Point,
+    Polygon,
+    RigidBody2D,
+    Scene,
+    Segment,
+    Sphere,
+)
 from .regularized import coulomb_ramp
 
 __all__ = ["ExtremeCase", "ExtremeWarning", "format_report", "run"]
@@ -83,6 +95,13 @@ def _floor(dim: int = 2) -> HalfSpace:
 # ---- families ------------------------------------------------------------------------------
 
 
+def _stillness_bound(ratio: float, h: float, t_end: float, tol: float = 1e-12) -> float:
+    """How still a resting stack can stay: the contact solve is exact to ``tol`` relative to the
+    largest impulse (the heavy body's ``m g h``), and that much impulse moves the light body by
+    ``tol ratio g h`` per second. Floor: 1e-9 m."""
+    return max(1e-9, tol * ratio * G0 * h * t_end)
+
+
 def _mass_ratio(ratios: list[float]) -> Iterator[ExtremeCase]:
     """Two disks stacked on the floor, one `ratio` times heavier than the other, resting 1 s."""
     for ratio in ratios:
@@ -100,7 +119,88 @@ def _mass_ratio(ratios: list[float]) -> Iterator[ExtremeCase]:
             tr = scene.simulate(1.0, 1e-3)
             drift = float(np.max(np.abs(tr.q - tr.q[0])))
             order = "heavy on light" if heavy_on_top else "light on heavy"
-            yield _case("mass ratio", f"{ratio:g}, {order}", "drift (m)", drift, 1e-9, tr, t0)
+            yield _case(
+                "mass ratio",
+                f"{ratio:g}, {order}",
+                "drift (m)",
+                drift,
+                _stillness_bound(ratio, 1e-3, 1.0),
+                tr,
+                t0,
+            )
+
+
+def _box_corner_gaps(a_bottom: float, a_top: float, b: float):
+    """Gap contacts of a planar box (q[3:6]) resting on another (q[0:3]) resting on the floor,
+    written in generalized coordinates: each bottom corner of the lower box against the floor,
+    each bottom corner of the upper box against the lower box's top face (gap and tangential
+    position measured in the lower box's frame, so their rates are the relative velocities)."""
+
+    def corner(q: np.ndarray, k: int, sx: float, half: float) -> np.ndarray:
+        x, y, th = q[3 * k : 3 * k + 3]
+        c, s = math.cos(th), math.sin(th)
+        return np.array([x + c * sx * half - s * (-b), y + s * sx * half + c * (-b)])
+
+    contacts = []
+    for sx in (-1.0, 1.0):
+        contacts.append(
+            GapContact(
+                gap=lambda q, sx=sx: float(corner(q, 0, sx, a_bottom)[1]),
+                tangent_position=lambda q, sx=sx: [float(corner(q, 0, sx, a_bottom)[0])],
+                mu=0.5,
+            )
+        )
+
+        def local(q: np.ndarray, sx: float = sx) -> np.ndarray:
+            p = corner(q, 1, sx, a_top)
+            x, y, th = q[0:3]
+            c, s = math.cos(th), math.sin(th)
+            d = p - np.array([x, y])
+            return np.array([c * d[0] + s * d[1], -s * d[0] + c * d[1]])
+
+        contacts.append(
+            GapContact(
+                gap=lambda q, local=local: float(local(q)[1] - b),
+                tangent_position=lambda q, local=local: [float(local(q)[0])],
+                mu=0.5,
+            )
+        )
+    return contacts
+
+
+def _mass_ratio_boxes(ratios: list[float]) -> Iterator[ExtremeCase]:
+    """A box resting on another box on the floor, one `ratio` times heavier than the other
+    (generalized coordinates, both boxes planar rigid bodies), 0.5 s: no drift."""
+    b = 0.05
+    for ratio in ratios:
+        for heavy_on_top in (True, False):
+            t0 = time.perf_counter()
+            m_top, m_bottom = (ratio, 1.0) if heavy_on_top else (1.0, ratio)
+            a_bottom, a_top = 0.2, 0.1
+            j_bottom = m_bottom * (4 * a_bottom**2 + 4 * b * b) / 12
+            j_top = m_top * (4 * a_top**2 + 4 * b * b) / 12
+            mass = np.diag([m_bottom, m_bottom, j_bottom, m_top, m_top, j_top])
+            gravity = np.array([0.0, -G0 * m_bottom, 0.0, 0.0, -G0 * m_top, 0.0])
+            model = Model(
+                2,
+                mass,
+                q0=[0.0, b, 0.0, 0.03, 3 * b, 0.0],
+                force=lambda q, v, t, g=gravity: g,
+                contacts=_box_corner_gaps(a_bottom, a_top, b),
+                potential=lambda q, g=gravity: float(-(g @ q)),
+            )
+            tr = model.simulate(0.5, 1e-3)
+            drift = float(np.max(np.abs(tr.q - tr.q[0])))
+            order = "heavy on light" if heavy_on_top else "light on heavy"
+            yield _case(
+                "mass ratio",
+                f"boxes {ratio:g}, {order}",
+                "drift (m)",
+                drift,
+                _stillness_bound(ratio, 1e-3, 0.5),
+                tr,
+                t0,
+            )
 
 
 def _friction(mus: list[float]) -> Iterator[ExtremeCase]:
@@ -275,6 +375,7 @@ def run(
     if full:
         families = [
             _mass_ratio([1.0, 1e2, 1e4, 1e6]),
+            _mass_ratio_boxes([1.0, 1e3, 1e6]),
             _friction([0.0, 1e-6, 0.1, 0.3, 0.4, 1.0, 10.0, 100.0]),
             _restitution(1000),
             _step_size([1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 1e-1]),
@@ -288,6 +389,7 @@ def run(
     else:
         families = [
             _mass_ratio([1e6]),
+            _mass_ratio_boxes([1e6]),
             _friction([0.0, 1e-6, 100.0]),
             _restitution(100),
             _step_size([1e-6, 1e-1]),

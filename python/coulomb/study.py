@@ -438,11 +438,14 @@ def ramp(
     tol: float | None = None,
     facets: int | None = None,
     warm_start: bool = True,
+    max_iter: int | None = None,
+    drift: str = "none",
     t_end: float = 4.0,
 ) -> dict[str, Any]:
     """The seed's ramp (20 deg, mu = 0.4, v0 = 1 m/s down the slope) stepped at ``h``:
     ``stop_distance`` (exact 1.5053 m), ``stop_time`` (exact 3.0112 s), ``creep`` (motion after
-    the stop; exact 0) and the stepper's work."""
+    the stop; exact 0) and the stepper's work. Every setting a user trades is an argument:
+    step, solver, tolerance, facets, warm start, iteration limit, drift correction."""
     from .model import HalfSpace, Particle, Point, Scene
 
     th = math.radians(20.0)
@@ -457,7 +460,9 @@ def ramp(
         solver,
         tol=tol,
         facets=facets,
-        warm_start=warm_start,  # type: ignore[arg-type]
+        warm_start=warm_start,
+        max_iter=max_iter,
+        drift=drift,  # type: ignore[arg-type]
     )
     still = np.flatnonzero(np.all(np.abs(tr.v) < 1e-12, axis=1))
     k = int(still[0]) if len(still) else len(tr.t) - 1

@@ -206,3 +206,15 @@ def test_impact_is_exact_at_every_step_size_and_phase() -> None:
     assert len(s) == 15
     assert max(r["error"] for r in s.records) < 1e-12
     assert all(r["success"] for r in s.records)
+
+
+def test_ramp_sweeps_iteration_limit_and_drift_correction() -> None:
+    s = study.sweep(
+        study.ramp,
+        {"h": [1e-2], "max_iter": [1, 1000], "drift": ["none", "bias", "projection"]},
+        reference={"stop_distance": 1.5053},
+    )
+    assert len(s) == 6
+    # one contact: NSGS is exact in one sweep, so neither setting moves the stop distance
+    errors = {round(r["error"], 12) for r in s.records}
+    assert len(errors) == 1 and all(r["success"] for r in s.records)
