@@ -56,7 +56,8 @@ missed while every step claims success) fails the suite.
 
 Bounds: drift 1e-9 m, except that a resting stack of bodies whose masses differ by a ratio
 R cannot be stiller than the contact solver's tolerance allows: 1e-12 relative to the heavy
-body's impulse moves the light one by `1e-12 R g h` per second (so `max(1e-9, 1e-12 R g h t)`); ramp distances against the exact Coulomb answer within
+body's impulse moves the light one by `1e-12 R g h` per second (so `max(1e-9, 1e-12 R g h t)`);
+ramp distances against the exact Coulomb answer within
 `2 h (1 + g t)` (first order in h); rebound speeds to 1e-9 m/s (the impact law is exact
 wherever in the step the impact falls); energy at the apexes of 1000 elastic bounces never above
 the first; a scene in other units scales exactly (1e-9 relative).

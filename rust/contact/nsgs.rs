@@ -271,6 +271,30 @@ fn local_descent(blk: &LocalBlock, mu: f64, b: &[f64; 3], dim: usize, r: &mut [f
 /// anisotropic friction the elliptic cone through the change of variables of
 /// [`super::anisotropic_residual`] (`r^ = B^+ r` projected on `K_m`, mapped back by B: a point of
 /// the elliptic cone, the nearest one in the B-weighted norm). Used for warm starts.
+/// The starting impulses of an iterative solver: zeros, or the caller's warm start (`dim nc`
+/// finite entries), each contact's projected on its friction cone.
+pub(crate) fn initial_impulses(
+    problem: &ContactProblem<'_>,
+    initial: Option<&[f64]>,
+) -> Result<Vec<f64>> {
+    let n = problem.size();
+    let Some(r0) = initial else {
+        return Ok(vec![0.0; n]);
+    };
+    if r0.len() != n {
+        return Err(CoulombError::Shape(format!(
+            "initial impulses have length {}, expected {n}",
+            r0.len()
+        )));
+    }
+    check_finite("initial impulses", r0)?;
+    let mut r = r0.to_vec();
+    for (i, ri) in r.chunks_exact_mut(problem.dim).enumerate() {
+        project_friction_cone(problem, i, ri);
+    }
+    Ok(r)
+}
+
 pub(crate) fn project_friction_cone(problem: &ContactProblem<'_>, i: usize, ri: &mut [f64]) {
     match problem.anisotropy(i) {
         None => super::projection::project_cone(ri, problem.mu[i]),
@@ -309,23 +333,7 @@ pub fn solve_nsgs(problem: &ContactProblem<'_>, s: &NsgsSettings) -> Result<Cont
     let dim = problem.dim;
     let nc = problem.nc;
     let n = problem.size();
-    let mut r = match &s.initial {
-        Some(r0) => {
-            if r0.len() != n {
-                return Err(CoulombError::Shape(format!(
-                    "initial impulses have length {}, expected {n}",
-                    r0.len()
-                )));
-            }
-            check_finite("initial impulses", r0)?;
-            let mut r = r0.clone();
-            for (i, ri) in r.chunks_exact_mut(dim).enumerate() {
-                project_friction_cone(problem, i, ri);
-            }
-            r
-        }
-        None => vec![0.0; n],
-    };
+    let mut r = initial_impulses(problem, s.initial.as_deref())?;
 
     // the diagonal blocks, once
     let blocks: Vec<LocalBlock> = (0..nc)

@@ -71,7 +71,7 @@ use faer::sparse::{SparseColMat, Triplet};
 use super::nsgs::{solve_nsgs, NsgsSettings};
 use super::projection::{project_cone, tangent_norm};
 use super::{measure_into, ContactMeasures, ContactProblem, ContactSolution, ContactStatus};
-use crate::error::{check_finite, CoulombError, Result};
+use crate::error::{CoulombError, Result};
 
 /// Settings of [`solve_prox`].
 #[derive(Clone, Debug)]
@@ -310,23 +310,7 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
     let dim = problem.dim;
     let nc = problem.nc;
     let n = problem.size();
-    let mut r = match &s.initial {
-        Some(r0) => {
-            if r0.len() != n {
-                return Err(CoulombError::Shape(format!(
-                    "initial impulses have length {}, expected {n}",
-                    r0.len()
-                )));
-            }
-            check_finite("initial impulses", r0)?;
-            let mut r = r0.clone();
-            for (ri, &mu) in r.chunks_exact_mut(dim).zip(problem.mu) {
-                project_cone(ri, mu);
-            }
-            r
-        }
-        None => vec![0.0; n],
-    };
+    let mut r = super::nsgs::initial_impulses(problem, s.initial.as_deref())?;
 
     // scales: rho_i = 1 / (W_ii)_nn (the mean normal diagonal where that is not positive)
     let diag: Vec<f64> = (0..nc).map(|i| problem.w_block(i, i)[0][0]).collect();

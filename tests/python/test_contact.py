@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 from coulomb import contact, errors
-from helpers import contact_error
+from helpers import contact_error, count_during
 
 
 def seed_problem(dim: int, mu: float):
@@ -193,30 +193,9 @@ def test_no_contacts():
 
 
 def test_large_solve_releases_the_gil():
-    import sys
-    import threading
-
     W, q, mu = random_problem(4, nc=200)
-    counter = [0]
-    seen = {}
-
-    def run():
-        seen["before"] = counter[0]
-        # a tolerance no iterate reaches: the sweeps run to max_iter
-        seen["result"] = contact.solve(W, q, mu, tol=1e-300, max_iter=300)
-        seen["after"] = counter[0]
-
-    old = sys.getswitchinterval()
-    sys.setswitchinterval(1e-4)
-    try:
-        t = threading.Thread(target=run)
-        t.start()
-        while t.is_alive():
-            counter[0] += 1
-        t.join()
-    finally:
-        sys.setswitchinterval(old)
-    r = seen["result"]
+    # a tolerance no iterate reaches: the sweeps run to max_iter
+    r, count = count_during(lambda: contact.solve(W, q, mu, tol=1e-300, max_iter=300))
     assert r.error <= 1e-10  # converged long before the 300 sweeps end
-    # see test_gil.py: a GIL-holding call lets the main thread count to at most ~600
-    assert seen["after"] - seen["before"] > 20_000, (seen["after"] - seen["before"], r.solve_time)
+    # see helpers.count_during: a GIL-holding call lets the main thread count to at most ~600
+    assert count > 20_000, (count, r.solve_time)

@@ -10,7 +10,7 @@ import pytest
 import scipy.sparse as sp
 from coulomb import _core, contact, errors
 from coulomb.io import FrictionContactProblem, read_siconos_fc
-from helpers import contact_error, project_coulomb_cone
+from helpers import contact_error, count_during, project_coulomb_cone
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -193,31 +193,11 @@ def test_sparse_input_errors():
 
 
 def test_large_sparse_solve_releases_the_gil():
-    import sys
-    import threading
-
     W, q, mu = pile(1, nc=3000)
-    counter = [0]
-    seen = {}
-
-    def run():
-        seen["before"] = counter[0]
-        seen["result"] = contact.solve(W, q, mu, tol=1e-300, max_iter=200)
-        seen["after"] = counter[0]
-
-    old = sys.getswitchinterval()
-    sys.setswitchinterval(1e-4)
-    try:
-        t = threading.Thread(target=run)
-        t.start()
-        while t.is_alive():
-            counter[0] += 1
-        t.join()
-    finally:
-        sys.setswitchinterval(old)
-    assert seen["result"].iterations == 200
-    # see test_gil.py: a GIL-holding call lets the main thread count to at most ~600
-    assert seen["after"] - seen["before"] > 20_000
+    r, count = count_during(lambda: contact.solve(W, q, mu, tol=1e-300, max_iter=200))
+    assert r.iterations == 200
+    # see helpers.count_during: a GIL-holding call lets the main thread count to at most ~600
+    assert count > 20_000
 
 
 # --- anisotropic friction ------------------------------------------------------------------

@@ -20,6 +20,7 @@ from coulomb import (
 )
 from coulomb.errors import InvalidParameterError, NonFiniteError, ShapeError
 from coulomb.trajectory import TrajectoryCheckError
+from helpers import count_during
 
 
 def ball_scene(**kw) -> Scene:
@@ -179,9 +180,6 @@ def test_exported_names():
 
 
 def test_simulate_releases_the_gil():
-    import sys
-    import threading
-
     from coulomb import _core
 
     scene = Scene(dim=3)
@@ -190,27 +188,10 @@ def test_simulate_releases_the_gil():
     floor = scene.add(HalfSpace((0, 0, 0), (0, 0, 1)))
     scene.contact(scene.attach(cube, Box((0.5, 0.5, 0.5))), floor, mu=0.5)
     spec = scene._spec()
-    counter = [0]
-    seen = {}
-
-    def run():
-        seen["before"] = counter[0]
-        seen["result"] = _core.step_simulate(spec, 1e-3, 40_000)
-        seen["after"] = counter[0]
-
-    # see test_gil.py: a GIL-holding call of this length lets the main thread count to ~600
-    old = sys.getswitchinterval()
-    sys.setswitchinterval(1e-4)
-    try:
-        t = threading.Thread(target=run)
-        t.start()
-        while t.is_alive():
-            counter[0] += 1
-        t.join()
-    finally:
-        sys.setswitchinterval(old)
-    assert seen["result"]["stopped"] is None
-    assert seen["after"] - seen["before"] > 20_000
+    result, count = count_during(lambda: _core.step_simulate(spec, 1e-3, 40_000))
+    assert result["stopped"] is None
+    # see helpers.count_during: a GIL-holding call lets the main thread count to at most ~600
+    assert count > 20_000
 
 
 def test_disk_and_sphere_roll_down_a_ramp_without_slipping():
