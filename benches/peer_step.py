@@ -147,22 +147,16 @@ def coulomb_pile(count: int, h: float, solver: str, t_end: float = 1.0) -> dict:
             )
         ]
         shapes = []
-        for k in range(count):
-            i, j, l = k % side, (k // side) % side, k // (side * side)
-            pos = (
-                -half + radius + spacing * (i + 0.5),
-                -half + radius + spacing * (j + 0.5),
-                radius + 0.01 + spacing * l,
-            )
+        centers = np.array(list(_centers(count, side, spacing, half, radius)))
+        for pos in centers:
             inertia = 0.4 * 0.1 * radius * radius
-            body = scene.add(RigidBody3D(mass=0.1, inertia=(inertia,) * 3, position=pos))
+            body = scene.add(RigidBody3D(mass=0.1, inertia=(inertia,) * 3, position=tuple(pos)))
             shapes.append(scene.attach(body, Sphere(radius)))
         for s in shapes:
             for w in walls:
                 scene.contact(s, w, mu=0.5)
         # candidate pairs: spheres whose centres start within CUTOFF spacings (coulomb has no
         # broad phase yet); after the run the script checks that no other pair could have met
-        centers = np.array(list(_centers(count, side, spacing, half, radius)))
         for a in range(count):
             d = np.linalg.norm(centers[a + 1 :] - centers[a], axis=1)
             for b in np.flatnonzero(d < CUTOFF * spacing) + a + 1:

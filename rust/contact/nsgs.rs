@@ -313,12 +313,7 @@ pub(crate) fn project_friction_cone(problem: &ContactProblem<'_>, i: usize, ri: 
 
 /// Solves the friction-contact problem by nonsmooth Gauss-Seidel (see the module notes).
 pub fn solve_nsgs(problem: &ContactProblem<'_>, s: &NsgsSettings) -> Result<ContactSolution> {
-    if !(s.tol.is_finite() && s.tol > 0.0) {
-        return Err(CoulombError::InvalidParameter(format!(
-            "tol must be a positive finite number, got {}",
-            s.tol
-        )));
-    }
+    crate::lcp::check_tol(s.tol)?;
     if !(s.relaxation > 0.0 && s.relaxation < 2.0) {
         return Err(CoulombError::InvalidParameter(format!(
             "relaxation must lie in (0, 2), got {}",

@@ -290,12 +290,7 @@ impl Jacobian {
 /// Solves the friction-contact problem by the proximal-point semismooth Newton method (see the
 /// module notes).
 pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<ContactSolution> {
-    if !(s.tol.is_finite() && s.tol > 0.0) {
-        return Err(CoulombError::InvalidParameter(format!(
-            "tol must be a positive finite number, got {}",
-            s.tol
-        )));
-    }
+    crate::lcp::check_tol(s.tol)?;
     if !(s.eta.is_finite() && s.eta > 0.0) {
         return Err(CoulombError::InvalidParameter(format!(
             "eta (the initial proximal parameter) must be a positive finite number, got {}",

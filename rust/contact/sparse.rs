@@ -110,28 +110,7 @@ impl BlockCsr {
     where
         I: Copy + TryInto<usize> + std::fmt::Debug,
     {
-        let nc = check_dims(dim, n)?;
-        if indices.len() != data.len() {
-            return Err(CoulombError::Shape(format!(
-                "W's indices ({}) and data ({}) differ in length",
-                indices.len(),
-                data.len()
-            )));
-        }
-        let ptr = check_ptr("indptr", indptr, n, data.len())?;
-        let mut cols = Vec::with_capacity(indices.len());
-        for (k, &c) in indices.iter().enumerate() {
-            cols.push(index_of("indices", k, c, n)?);
-        }
-        check_data(data)?;
-        let entries = |f: &mut dyn FnMut(usize, usize, f64)| {
-            for r in 0..n {
-                for k in ptr[r]..ptr[r + 1] {
-                    f(r, cols[k], data[k]);
-                }
-            }
-        };
-        Self::from_entries(dim, nc, data.len(), &entries)
+        Self::from_compressed(dim, n, indptr, indices, data, false)
     }
 
     /// From scalar CSC arrays of an `n x n` W (`indptr` over columns, `indices` the rows).
@@ -145,6 +124,22 @@ impl BlockCsr {
     where
         I: Copy + TryInto<usize> + std::fmt::Debug,
     {
+        Self::from_compressed(dim, n, indptr, indices, data, true)
+    }
+
+    /// CSR (`by_columns` false: `indptr` over rows, `indices` the columns) or CSC (the
+    /// transposed reading), checked, then tiled.
+    fn from_compressed<I>(
+        dim: usize,
+        n: usize,
+        indptr: &[I],
+        indices: &[I],
+        data: &[f64],
+        by_columns: bool,
+    ) -> Result<Self>
+    where
+        I: Copy + TryInto<usize> + std::fmt::Debug,
+    {
         let nc = check_dims(dim, n)?;
         if indices.len() != data.len() {
             return Err(CoulombError::Shape(format!(
@@ -154,15 +149,19 @@ impl BlockCsr {
             )));
         }
         let ptr = check_ptr("indptr", indptr, n, data.len())?;
-        let mut rows = Vec::with_capacity(indices.len());
-        for (k, &r) in indices.iter().enumerate() {
-            rows.push(index_of("indices", k, r, n)?);
+        let mut inner = Vec::with_capacity(indices.len());
+        for (k, &c) in indices.iter().enumerate() {
+            inner.push(index_of("indices", k, c, n)?);
         }
         check_data(data)?;
         let entries = |f: &mut dyn FnMut(usize, usize, f64)| {
-            for c in 0..n {
-                for k in ptr[c]..ptr[c + 1] {
-                    f(rows[k], c, data[k]);
+            for outer in 0..n {
+                for k in ptr[outer]..ptr[outer + 1] {
+                    if by_columns {
+                        f(inner[k], outer, data[k]);
+                    } else {
+                        f(outer, inner[k], data[k]);
+                    }
                 }
             }
         };

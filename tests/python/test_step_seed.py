@@ -8,18 +8,14 @@ import math
 import coulomb
 import numpy as np
 import pytest
-from coulomb import HalfSpace, Particle, Point, RigidBody2D, RigidBody3D, Scene, Segment
+from coulomb import HalfSpace, RigidBody2D, RigidBody3D, Scene, Segment
+
+# the scene of one point body against a half-space, shared with the validate rows
+from coulomb._step_figures import _point as point_scene
 
 G = 9.81
 
 
-def point_scene(position, velocity, mu=0.0, e=0.0, mass=1.0, gravity=(0.0, -G),
-                floor: HalfSpace | None = None) -> Scene:
-    scene = Scene(dim=2, gravity=gravity)
-    body = scene.add(Particle(mass=mass, position=position, velocity=velocity))
-    floor = scene.add(floor or HalfSpace((0.0, 0.0), (0.0, 1.0)))
-    scene.contact(scene.attach(body, Point()), floor, mu=mu, e=e)
-    return scene
 
 
 def test_free_flight_is_the_exact_discrete_parabola():
