@@ -42,6 +42,7 @@ __all__ = ["LcpResult", "check", "solve"]
 
 Method = Literal["lemke", "pgs", "enumerate"]
 _METHODS = ("lemke", "pgs", "enumerate")
+_F64 = np.dtype(np.float64)
 
 
 class LcpResult(Result):
@@ -204,8 +205,22 @@ def solve(
     ShapeError, NonFiniteError, InvalidParameterError, ProblemTooLargeError
         Before any work, for bad input.
     """
-    Ma = _as_array(M, "M", 2)
-    qa = _as_array(q, "q", 1)
+    # The common call (float64 C-contiguous arrays, default options) skips the generic
+    # conversions: for small n the Python layer would otherwise cost more than the solve.
+    if (
+        type(M) is np.ndarray
+        and type(q) is np.ndarray
+        and M.dtype == _F64
+        and q.dtype == _F64
+        and M.flags.c_contiguous
+        and q.flags.c_contiguous
+        and M.ndim == 2
+        and q.ndim == 1
+    ):
+        Ma, qa = M, q
+    else:
+        Ma = _as_array(M, "M", 2)
+        qa = _as_array(q, "q", 1)
     n = qa.shape[0]
     if Ma.shape != (n, n):
         raise ShapeError(f"M must have shape ({n}, {n}) to match q of length {n}, got {Ma.shape}")
@@ -224,7 +239,7 @@ def solve(
         float(tol),
         max_pivots,
         cover,
-        _basis_indices(warm_start, n),
+        None if warm_start is None else _basis_indices(warm_start, n),
         bool(polish),
         int(restarts),
         int(max_iter),

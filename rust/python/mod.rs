@@ -26,7 +26,8 @@ use crate::error::CoulombError;
 use crate::io::siconos::{NumericsMatrix, SiconosFcFile};
 use crate::io::ReadError;
 use crate::lcp::{
-    self, EnumerateSettings, LcpRef, LcpSolution, LemkeSettings, Method, PgsSettings,
+    self, EnumerateSettings, LcpRef, LcpSolution, LemkeSettings, LemkeWorkspace, Method,
+    PgsSettings,
 };
 
 static SHAPE_ERROR: PyOnceLock<Py<PyType>> = PyOnceLock::new();
@@ -154,6 +155,16 @@ fn solution_dict<'py>(
     Ok(d)
 }
 
+/// problems up to this size reuse one Lemke workspace per thread: for small n the
+/// workspace's allocations cost more than the pivots (at n = 3 about a quarter of a call),
+/// and at this bound it holds under 0.7 MB.
+const REUSED_WORKSPACE_MAX_N: usize = 256;
+
+thread_local! {
+    static LEMKE_WORKSPACE: std::cell::RefCell<LemkeWorkspace> =
+        std::cell::RefCell::new(LemkeWorkspace::new(0));
+}
+
 /// Solves `0 <= z ⊥ M z + q >= 0`. The Python wrapper `coulomb.lcp.solve` documents the
 /// arguments; this takes them already converted to float64 arrays.
 #[pyfunction]
@@ -221,7 +232,16 @@ fn lcp_solve<'py>(
     let (solution, seconds) = guarded(py, n * n, || {
         let start = std::time::Instant::now();
         let lcp = LcpRef::new(n, ms, qs)?;
-        let s = lcp::solve(&lcp, &chosen)?;
+        let s = match &chosen {
+            Method::Lemke(settings) if n <= REUSED_WORKSPACE_MAX_N => {
+                LEMKE_WORKSPACE.with(|cell| match cell.try_borrow_mut() {
+                    Ok(mut ws) => lcp::solve_lemke_with(&mut ws, &lcp, settings),
+                    // re-entered on this thread (cannot happen today): a fresh workspace
+                    Err(_) => lcp::solve_lemke(&lcp, settings),
+                })?
+            }
+            other => lcp::solve(&lcp, other)?,
+        };
         Ok((s, start.elapsed().as_secs_f64()))
     })?;
     solution_dict(py, solution, seconds)
