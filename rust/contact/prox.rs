@@ -68,6 +68,7 @@ use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::{SparseColMat, Triplet};
 
+use super::lcp_finish::finish_2d;
 use super::nsgs::{solve_nsgs, NsgsSettings};
 use super::projection::{project_cone, tangent_norm};
 use super::{measure_into, ContactMeasures, ContactProblem, ContactSolution, ContactStatus};
@@ -350,6 +351,9 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
     // answer is the projection of r on the cones if that passes too (r then exactly feasible);
     // otherwise up to FEASIBILITY_STEPS more Newton steps are taken before r is returned as is
     let mut extra = 0usize;
+    // the 2D LCP finish: tried once; (working-set contacts, rounds, pivots) when it solved
+    let mut finish_tried = false;
+    let mut finish: Option<(usize, usize, usize)> = None;
     while iterations < s.max_iter {
         if measures.error_q <= s.tol {
             r_try.copy_from_slice(&r);
@@ -369,6 +373,18 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
             extra += 1;
         }
         if stalled || iterations - iter_mark >= STALL_WINDOW {
+            // in 2D the problem is an exact LCP: at the first stall, try Lemke's method on a
+            // working set of contacts (see the module notes and `super::lcp_finish`)
+            if !finish_tried && dim == 2 {
+                finish_tried = true;
+                if let Some(fin) = finish_2d(problem, &r, s.tol)? {
+                    r = fin.impulse;
+                    u = fin.velocity;
+                    measures = fin.measures;
+                    finish = Some((fin.contacts, fin.rounds, fin.pivots));
+                    break;
+                }
+            }
             // restart from NSGS sweeps (see the module notes)
             if restarts >= MAX_RESTARTS {
                 stalled = true;
@@ -475,38 +491,49 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
         }
     }
 
-    let (status, message) = if measures.error_q <= s.tol {
-        (
-            ContactStatus::Solved,
-            format!(
-                "solved in {iterations} Newton steps (error_q {:.2e}, error {:.2e})",
-                measures.error_q, measures.error
-            ),
-        )
-    } else if !measures.error_q.is_finite() || r.iter().any(|v| !v.is_finite()) {
-        (
-            ContactStatus::NumericalFailure,
-            format!("the iterates became non-finite after {iterations} Newton steps"),
-        )
-    } else if stalled {
-        (
-            ContactStatus::NumericalFailure,
-            format!(
-                "stalled after {iterations} Newton steps: no step decreases the natural-map \
+    let (status, message) =
+        if let (Some((contacts, rounds, pivots)), true) = (finish, measures.error_q <= s.tol) {
+            (
+                ContactStatus::Solved,
+                format!(
+                    "solved after {iterations} Newton steps by the 2D LCP finish (Lemke, {pivots} \
+                 pivots in {rounds} rounds on {contacts} of {nc} contacts; error_q {:.2e}, \
+                 error {:.2e})",
+                    measures.error_q, measures.error
+                ),
+            )
+        } else if measures.error_q <= s.tol {
+            (
+                ContactStatus::Solved,
+                format!(
+                    "solved in {iterations} Newton steps (error_q {:.2e}, error {:.2e})",
+                    measures.error_q, measures.error
+                ),
+            )
+        } else if !measures.error_q.is_finite() || r.iter().any(|v| !v.is_finite()) {
+            (
+                ContactStatus::NumericalFailure,
+                format!("the iterates became non-finite after {iterations} Newton steps"),
+            )
+        } else if stalled {
+            (
+                ContactStatus::NumericalFailure,
+                format!(
+                    "stalled after {iterations} Newton steps: no step decreases the natural-map \
                  residual even with the proximal parameter at {eta:.1e} (error_q {:.2e} > tol \
                  {:.1e})",
-                measures.error_q, s.tol
-            ),
-        )
-    } else {
-        (
-            ContactStatus::IterationLimit,
-            format!(
-                "stopped at max_iter = {} with error_q {:.2e} > tol {:.1e}",
-                s.max_iter, measures.error_q, s.tol
-            ),
-        )
-    };
+                    measures.error_q, s.tol
+                ),
+            )
+        } else {
+            (
+                ContactStatus::IterationLimit,
+                format!(
+                    "stopped at max_iter = {} with error_q {:.2e} > tol {:.1e}",
+                    s.max_iter, measures.error_q, s.tol
+                ),
+            )
+        };
     Ok(ContactSolution {
         impulse: r,
         velocity: u,

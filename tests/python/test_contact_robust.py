@@ -124,7 +124,8 @@ def test_problems_where_nsgs_stalls_are_solved(fc_dir, name):
 
 
 # not run here: RockPile_tob1 (hard, see test_fclib.py) and fc2d_granularflowonwall_02020_00213
-# (nc = 2020; stalls at ~3e-7 after about 30 s)
+# (nc = 2020, read dense here: its FCLib copy, the same W and q, is solved block-sparse by the
+# 2D LCP finish in test_fclib.py)
 SKIPPED = ("RockPile_tob1", "fc2d_granularflowonwall_02020_00213")
 
 
