@@ -38,6 +38,30 @@
 //! restarts from there with the initial eta (at most 10 restarts): this rescued
 //! FrictionContactProblem00727 (stalled at error_q 5.6e-4 without it) and Capsules-i101-404.
 //!
+//! In 2D, at the first such stall, the answer is first sought by the 2D LCP finish
+//! ([`super::lcp_finish`]): the 2D problem is exactly an LCP (the friction cone is an
+//! interval), solved by Lemke's method on the contacts with `r_n > 0` in the current iterate,
+//! the working set growing by the left-out contacts that close (`u_n < 0`) until the answer
+//! passes on the whole problem; if it does not, the NSGS restarts go on as before. Why it is
+//! needed, measured on fc2d_granularflowonwall_02020_00213 (nc 2020; W printed with 6
+//! significant digits, 18 eigenvalues below 1e-2 in magnitude against a largest 1.7e4, 10 of
+//! them negative down to -3.9e-3): Newton stalls at error_q 3.5e-7 for eta = 0.1, 1 and 10
+//! (and NSGS at 5.5e-7 after 20000 sweeps), and the stall is not an inner-solve accuracy
+//! issue: with the statuses of the stalled iterate (214 steps) fixed (739 pushing contacts,
+//! 460 of them sticking) the linear system of the piece (1199 unknowns) has three singular
+//! values 3.8e-4 to 1.9e-3 against 1.2e4, and its exact (dense LU) solution leaves the cones
+//! (r_n down to -1.9e-4, error_q 2.4e-4): no answer exists with those statuses. The answer Lemke finds (error_q
+//! 1.4e-15) has six contacts with other statuses (three sticking ones slide, a sticking one
+//! separates, a separated one slides, a sliding one sticks) and differs from the stalled
+//! iterate by 11% of `||r||` in r but by 7e-6 in u: a move along W's near-null directions,
+//! which the Newton pieces cannot make one status at a time (a Newton method with an exact
+//! ratio test to the first kink, tried from the stalled iterate, cycles between sticking and
+//! sliding at one contact). Figures: 53 Newton steps, then Lemke in 2 rounds (743 then 744
+//! contacts, 2972 and 2976 LCP unknowns, 3816 pivots), 4.4 to 8.5 s in all on a loaded
+//! 2-core machine with the block-sparse W (the Newton steps 0.4 s of it); Lemke's dense
+//! tableau bounds the working set at [`super::lcp_finish::MAX_CONTACTS`] contacts. In 3D the
+//! polyhedral LCP is an approximation, so there is no such finish.
+//!
 //! Measured choice (release build, 2-core machine, tol 1e-8 on error_q, zero start; the
 //! numbers of `benches/peer_contact.py`):
 //!
@@ -46,8 +70,9 @@
 //!   OneObject-i100000-499 8 / 1 ms, Capsules-i122-1617 26 / 0.30 s, KaplasTower 14 / 0.33 s,
 //!   Spheres (reduced) 20 / 0.14 s, PerioBox 23 / 45 ms), and 42 of the 44
 //!   local siconos-fc problems: all but RockPile_tob1 and the 2D
-//!   fc2d_granularflowonwall_02020_00213 (nc 2020: error_q 3.5e-7 after 200 steps, slow on a
-//!   dense W). RockPile ends at error_q 8e-5 after 200 steps (Siconos NSGS: 3.5e-4).
+//!   fc2d_granularflowonwall_02020_00213 (nc 2020: Newton alone stalls at error_q 3.5e-7;
+//!   solved to 1.4e-15 by the 2D LCP finish above). RockPile ends at error_q 8e-5 after 200
+//!   steps (Siconos NSGS: 3.5e-4).
 //! - eta = 1 solved the same set but slower (Capsules-i122 40 steps, Spheres 41); eta = 10
 //!   failed BoxesStack1; eta = 1e-12 from the start (plain semismooth Newton with a tiny
 //!   regularization) failed Capsules-i122-1617 (3.5e-7 after 200 steps) and took 57 steps on
