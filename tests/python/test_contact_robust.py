@@ -168,6 +168,21 @@ def test_massively_redundant_planar_problems_are_finished_by_the_lcp(seed):
     assert r.min_normal_impulse >= -1e-12 * r.impulse[:, 0].max()
 
 
+def test_a_redundant_pile_rounded_to_6_digits_is_reported_unsolved():
+    """The same pile with W printed with 6 significant digits (as the FCLib 2D file's): W is
+    then indefinite (min eigenvalue -5.8e-5 against 59) and Lemke on the whole 2D LCP
+    ray-terminates; the finish is tried, fails on the whole problem, and the answer is
+    reported as unsolved (error_q 3.3e-5 after 200 steps), never claimed."""
+    W, q, mu = redundant_planar_problem(3)
+    W6 = np.array([float(f"{v:.6g}") for v in W.ravel()]).reshape(W.shape)
+    assert np.linalg.eigvalsh(W6)[0] < -1e-7 * np.abs(W6).max()
+    r = contact.solve(W6, q, mu, 2, method="prox", tol=TOL, max_iter=60)
+    assert not r.success and r.status in ("iteration_limit", "numerical_failure")
+    assert "LCP finish" not in r.message
+    _, err_q = contact_error(W6, q, mu, 2, r.impulse)
+    assert err_q > TOL and abs(err_q - r.error_q) <= 1e-6 * err_q
+
+
 # not run here: RockPile_tob1 (hard, see test_fclib.py) and fc2d_granularflowonwall_02020_00213
 # (nc = 2020, read dense here: its FCLib copy, the same W and q, is solved block-sparse by the
 # 2D LCP finish in test_fclib.py)
