@@ -57,8 +57,9 @@
 //! which the Newton pieces cannot make one status at a time (a Newton method with an exact
 //! ratio test to the first kink, tried from the stalled iterate, cycles between sticking and
 //! sliding at one contact). Figures: 53 Newton steps, then Lemke in 2 rounds (743 then 744
-//! contacts, 2972 and 2976 LCP unknowns, 3816 pivots), 4.4 to 8.5 s in all on a loaded
-//! 2-core machine with the block-sparse W (the Newton steps 0.4 s of it); Lemke's dense
+//! contacts, 2972 and 2976 LCP unknowns, 3816 pivots), 4.4 to 9.5 s in all (solve_time,
+//! block-sparse W, a loaded 2-core machine), of which the 53 Newton steps take 0.18 s and
+//! Lemke the rest (before: stalled after 214 steps, 0.8 to 1.3 s); Lemke's dense
 //! tableau bounds the working set at [`super::lcp_finish::MAX_CONTACTS`] contacts. In 3D the
 //! polyhedral LCP is an approximation, so there is no such finish.
 //!
