@@ -28,8 +28,8 @@ use crate::error::Result;
 
 /// working-set rounds at most.
 pub const MAX_ROUNDS: usize = 6;
-/// contacts in the working set at most: Lemke's dense tableau has `4 |S|` rows and about
-/// twice as many columns (1000 contacts: about 0.3 GB).
+/// contacts in the working set at most: the LCP matrix and Lemke's dense tableau each hold
+/// about `(4 |S|)^2` numbers (1000 contacts: 2 x 128 MB).
 pub const MAX_CONTACTS: usize = 1000;
 /// Lemke pivots per LCP unknown at most, per round.
 pub const PIVOTS_PER_UNKNOWN: usize = 4;
