@@ -517,49 +517,45 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
         }
     }
 
-    let (status, message) =
-        if let (Some((contacts, rounds, pivots)), true) = (finish, measures.error_q <= s.tol) {
-            (
-                ContactStatus::Solved,
-                format!(
-                    "solved after {iterations} Newton steps by the 2D LCP finish (Lemke, {pivots} \
-                 pivots in {rounds} rounds on {contacts} of {nc} contacts; error_q {:.2e}, \
-                 error {:.2e})",
-                    measures.error_q, measures.error
-                ),
-            )
-        } else if measures.error_q <= s.tol {
-            (
-                ContactStatus::Solved,
-                format!(
-                    "solved in {iterations} Newton steps (error_q {:.2e}, error {:.2e})",
-                    measures.error_q, measures.error
-                ),
-            )
-        } else if !measures.error_q.is_finite() || r.iter().any(|v| !v.is_finite()) {
-            (
-                ContactStatus::NumericalFailure,
-                format!("the iterates became non-finite after {iterations} Newton steps"),
-            )
-        } else if stalled {
-            (
-                ContactStatus::NumericalFailure,
-                format!(
-                    "stalled after {iterations} Newton steps: no step decreases the natural-map \
+    let finished = match finish {
+        Some((contacts, rounds, pivots)) => format!(
+            " and the 2D LCP finish (Lemke, {pivots} pivots in {rounds} rounds on {contacts} of \
+             {nc} contacts)"
+        ),
+        None => String::new(),
+    };
+    let (status, message) = if measures.error_q <= s.tol {
+        (
+            ContactStatus::Solved,
+            format!(
+                "solved in {iterations} Newton steps{finished} (error_q {:.2e}, error {:.2e})",
+                measures.error_q, measures.error
+            ),
+        )
+    } else if !measures.error_q.is_finite() || r.iter().any(|v| !v.is_finite()) {
+        (
+            ContactStatus::NumericalFailure,
+            format!("the iterates became non-finite after {iterations} Newton steps"),
+        )
+    } else if stalled {
+        (
+            ContactStatus::NumericalFailure,
+            format!(
+                "stalled after {iterations} Newton steps: no step decreases the natural-map \
                  residual even with the proximal parameter at {eta:.1e} (error_q {:.2e} > tol \
                  {:.1e})",
-                    measures.error_q, s.tol
-                ),
-            )
-        } else {
-            (
-                ContactStatus::IterationLimit,
-                format!(
-                    "stopped at max_iter = {} with error_q {:.2e} > tol {:.1e}",
-                    s.max_iter, measures.error_q, s.tol
-                ),
-            )
-        };
+                measures.error_q, s.tol
+            ),
+        )
+    } else {
+        (
+            ContactStatus::IterationLimit,
+            format!(
+                "stopped at max_iter = {} with error_q {:.2e} > tol {:.1e}",
+                s.max_iter, measures.error_q, s.tol
+            ),
+        )
+    };
     Ok(ContactSolution {
         impulse: r,
         velocity: u,
