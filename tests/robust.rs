@@ -5,7 +5,9 @@
 mod common;
 
 use coulomb::contact::prox::{solve_prox, ProxSettings};
-use coulomb::contact::{measure, solve_nsgs, ContactProblem, ContactStatus, NsgsSettings};
+use coulomb::contact::{
+    measure, solve_nsgs, BlockCsr, ContactProblem, ContactStatus, NsgsSettings,
+};
 use coulomb::io::siconos::{read_siconos_fc, SiconosFcFile};
 use coulomb::testing::SplitMix64;
 use std::path::{Path, PathBuf};
@@ -164,4 +166,39 @@ fn problems_where_nsgs_stalls_are_solved_at_1e_8() {
         assert_eq!(short.status, ContactStatus::IterationLimit, "{name}");
         assert!(short.measures.error_q > 1e-8 && short.iterations == 1);
     }
+}
+
+/// The 2D granular flow (nc = 2020) whose W, printed with 6 significant digits in its source,
+/// is singular up to that rounding and indefinite (min eigenvalue -3.9e-3 against 1.7e4):
+/// Newton stalls at error_q ~3.5e-7 and the 2D LCP finish (Lemke on a working set) solves it.
+#[test]
+fn the_indefinite_2d_granular_flow_is_finished_by_its_lcp() {
+    let Some(root) = data_root() else { return };
+    let (dim, w, q, mu) = local(&root, "fc2d_granularflowonwall_02020_00213.dat");
+    assert_eq!((dim, mu.len()), (2, 2020));
+    let n = dim * mu.len();
+    let blocks = BlockCsr::from_dense(dim, n, &w).unwrap();
+    let p = ContactProblem::with_block_sparse(&blocks, &q, &mu).unwrap();
+    let s = solve_prox(&p, &settings(1e-8)).unwrap();
+    assert!(s.success(), "{}", s.message);
+    assert!(s.message.contains("2D LCP finish"), "{}", s.message);
+    // measured again on the dense W: Lemke's basic answer is exact up to rounding
+    let dense = ContactProblem::new(dim, &w, &q, &mu).unwrap();
+    let (_, m) = measure(&dense, &s.impulse).unwrap();
+    assert!(m.error_q <= 1e-12, "error_q {}", m.error_q);
+    assert!((m.error_q - s.measures.error_q).abs() <= 1e-14);
+    let rmax = s.impulse.iter().step_by(2).fold(0.0_f64, |a, &v| a.max(v));
+    assert!(m.min_normal_impulse >= -1e-12 * rmax && m.cone_violation <= 1e-12 * rmax);
+    // without the finish (an iteration limit before the first stall window) Newton is at
+    // error_q ~3.5e-7: far above the tolerance
+    let short = solve_prox(
+        &p,
+        &ProxSettings {
+            max_iter: 50,
+            ..settings(1e-8)
+        },
+    )
+    .unwrap();
+    assert_eq!(short.status, ContactStatus::IterationLimit);
+    assert!(short.measures.error_q > 1e-8 && short.measures.error_q < 1e-5);
 }

@@ -46,7 +46,11 @@ Methods:
     A proximal-point semismooth Newton method on the natural map (Rust ``contact::prox``):
     each iteration is one Newton step on the proximal subproblem ``W + eta I`` centred at the
     current impulses, with a line search and ``eta`` adapted (``eta`` is relative to W's mean
-    diagonal; default 0.1), restarted from NSGS sweeps when it makes no progress. For the
+    diagonal; default 0.1), restarted from NSGS sweeps when it makes no progress. In 2D, where
+    the problem is exactly an LCP, the first such stall is met instead by Lemke's method on the
+    contacts that push (grown by those that close), kept only if it passes on the whole problem
+    (``message`` then says "2D LCP finish"; Rust ``contact::lcp_finish``): it solves the
+    FCLib granular flow whose rounded W is slightly indefinite and singular. For the
     problems where NSGS stalls at tight tolerances (redundant contacts, FCLib BoxesStack and
     OneObject). ``success`` means ``error_q <= tol`` (which implies ``error <= tol``);
     ``iterations`` counts Newton steps (each one sparse LU factorization); ``max_iter`` defaults

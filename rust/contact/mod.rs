@@ -17,6 +17,7 @@
 //! Every answer is measured with the literature's natural-map error (see [`measure`]).
 
 pub mod assembly;
+pub mod lcp_finish;
 pub mod nsgs;
 pub mod polyhedral;
 pub mod projection;

@@ -38,6 +38,31 @@
 //! restarts from there with the initial eta (at most 10 restarts): this rescued
 //! FrictionContactProblem00727 (stalled at error_q 5.6e-4 without it) and Capsules-i101-404.
 //!
+//! In 2D, at the first such stall, the answer is first sought by the 2D LCP finish
+//! ([`super::lcp_finish`]): the 2D problem is exactly an LCP (the friction cone is an
+//! interval), solved by Lemke's method on the contacts with `r_n > 0` in the current iterate,
+//! the working set growing by the left-out contacts that close (`u_n < 0`) until the answer
+//! passes on the whole problem; if it does not, the NSGS restarts go on as before. Why it is
+//! needed, measured on fc2d_granularflowonwall_02020_00213 (nc 2020; W printed with 6
+//! significant digits, 18 eigenvalues below 1e-2 in magnitude against a largest 1.7e4, 10 of
+//! them negative down to -3.9e-3): Newton stalls at error_q 3.5e-7 for eta = 0.1, 1 and 10
+//! (and NSGS at 5.5e-7 after 20000 sweeps), and the stall is not an inner-solve accuracy
+//! issue: with the statuses of the stalled iterate (214 steps) fixed (739 pushing contacts,
+//! 460 of them sticking) the linear system of the piece (1199 unknowns) has three singular
+//! values 3.8e-4 to 1.9e-3 against 1.2e4, and its exact (dense LU) solution leaves the cones
+//! (r_n down to -1.9e-4, error_q 2.4e-4): no answer exists with those statuses. The answer Lemke finds (error_q
+//! 1.4e-15) has six contacts with other statuses (three sticking ones slide, a sticking one
+//! separates, a separated one slides, a sliding one sticks) and differs from the stalled
+//! iterate by 11% of `||r||` in r but by 7e-6 in u: a move along W's near-null directions,
+//! which the Newton pieces cannot make one status at a time (a Newton method with an exact
+//! ratio test to the first kink, tried from the stalled iterate, cycles between sticking and
+//! sliding at one contact). Figures: 53 Newton steps, then Lemke in 2 rounds (743 then 744
+//! contacts, 2972 and 2976 LCP unknowns, 3816 pivots), 4.4 to 9.5 s in all (solve_time,
+//! block-sparse W, a loaded 2-core machine), of which the 53 Newton steps take 0.18 s and
+//! Lemke the rest (before: stalled after 214 steps, 0.8 to 1.3 s); Lemke's dense
+//! tableau bounds the working set at [`super::lcp_finish::MAX_CONTACTS`] contacts. In 3D the
+//! polyhedral LCP is an approximation, so there is no such finish.
+//!
 //! Measured choice (release build, 2-core machine, tol 1e-8 on error_q, zero start; the
 //! numbers of `benches/peer_contact.py`):
 //!
@@ -46,8 +71,9 @@
 //!   OneObject-i100000-499 8 / 1 ms, Capsules-i122-1617 26 / 0.30 s, KaplasTower 14 / 0.33 s,
 //!   Spheres (reduced) 20 / 0.14 s, PerioBox 23 / 45 ms), and 42 of the 44
 //!   local siconos-fc problems: all but RockPile_tob1 and the 2D
-//!   fc2d_granularflowonwall_02020_00213 (nc 2020: error_q 3.5e-7 after 200 steps, slow on a
-//!   dense W). RockPile ends at error_q 8e-5 after 200 steps (Siconos NSGS: 3.5e-4).
+//!   fc2d_granularflowonwall_02020_00213 (nc 2020: Newton alone stalls at error_q 3.5e-7;
+//!   solved to 1.4e-15 by the 2D LCP finish above). RockPile ends at error_q 8e-5 after 200
+//!   steps (Siconos NSGS: 3.5e-4).
 //! - eta = 1 solved the same set but slower (Capsules-i122 40 steps, Spheres 41); eta = 10
 //!   failed BoxesStack1; eta = 1e-12 from the start (plain semismooth Newton with a tiny
 //!   regularization) failed Capsules-i122-1617 (3.5e-7 after 200 steps) and took 57 steps on
@@ -68,6 +94,7 @@ use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::{SparseColMat, Triplet};
 
+use super::lcp_finish::finish_2d;
 use super::nsgs::{solve_nsgs, NsgsSettings};
 use super::projection::{project_cone, tangent_norm};
 use super::{measure_into, ContactMeasures, ContactProblem, ContactSolution, ContactStatus};
@@ -350,6 +377,9 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
     // answer is the projection of r on the cones if that passes too (r then exactly feasible);
     // otherwise up to FEASIBILITY_STEPS more Newton steps are taken before r is returned as is
     let mut extra = 0usize;
+    // the 2D LCP finish: tried once; (working-set contacts, rounds, pivots) when it solved
+    let mut finish_tried = false;
+    let mut finish: Option<(usize, usize, usize)> = None;
     while iterations < s.max_iter {
         if measures.error_q <= s.tol {
             r_try.copy_from_slice(&r);
@@ -369,6 +399,18 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
             extra += 1;
         }
         if stalled || iterations - iter_mark >= STALL_WINDOW {
+            // in 2D the problem is an exact LCP: at the first stall, try Lemke's method on a
+            // working set of contacts (see the module notes and `super::lcp_finish`)
+            if !finish_tried && dim == 2 {
+                finish_tried = true;
+                if let Some(fin) = finish_2d(problem, &r, s.tol)? {
+                    r = fin.impulse;
+                    u = fin.velocity;
+                    measures = fin.measures;
+                    finish = Some((fin.contacts, fin.rounds, fin.pivots));
+                    break;
+                }
+            }
             // restart from NSGS sweeps (see the module notes)
             if restarts >= MAX_RESTARTS {
                 stalled = true;
@@ -475,11 +517,18 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
         }
     }
 
+    let finished = match finish {
+        Some((contacts, rounds, pivots)) => format!(
+            " and the 2D LCP finish (Lemke, {pivots} pivots in {rounds} rounds on {contacts} of \
+             {nc} contacts)"
+        ),
+        None => String::new(),
+    };
     let (status, message) = if measures.error_q <= s.tol {
         (
             ContactStatus::Solved,
             format!(
-                "solved in {iterations} Newton steps (error_q {:.2e}, error {:.2e})",
+                "solved in {iterations} Newton steps{finished} (error_q {:.2e}, error {:.2e})",
                 measures.error_q, measures.error
             ),
         )

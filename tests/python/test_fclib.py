@@ -5,11 +5,14 @@ ones (``W = H^T M^-1 H``, ``q = H^T M^-1 f + w``) and checked against a scipy or
 ``error_q <= 1e-8``, judged by an independent numpy residual.
 
 Not solved here: RockPile_tob1 (mu = 1, W unsymmetric; hard for every method, Siconos NSGS
-stays at 3.5e-4: the robust mode is only checked to report failure honestly, in 20 steps), and
-the 2D file fc2d_granularflowonwall_02020_00213 (nc = 2020): its W, printed with 6 significant
-digits in the source, is indefinite (10 eigenvalues down to -3.9e-3 against a largest 1.7e4,
--2.3e-7 relative) and the robust mode stalls at error_q ~3.5e-7, the same relative level, for
-every eta tried (0.1, 1, 10); the test checks that this is reported, not claimed solved.
+stays at 3.5e-4: the robust mode is only checked to report failure honestly, in 20 steps).
+
+The 2D file fc2d_granularflowonwall_02020_00213 (nc = 2020) is solved, but not by Newton alone:
+its W, printed with 6 significant digits in the source, is singular up to that rounding and
+indefinite (10 eigenvalues down to -3.9e-3 against a largest 1.7e4, -2.3e-7 relative), the
+Newton iteration stalls at error_q ~3.5e-7 (the same relative level) for every eta tried, and
+the answer is finished by Lemke's method on the exact 2D LCP of a working set of contacts
+(``coulomb::contact::lcp_finish``), at rounding level.
 """
 
 from __future__ import annotations
@@ -29,7 +32,8 @@ sp = pytest.importorskip("scipy.sparse")
 spl = pytest.importorskip("scipy.sparse.linalg")
 
 TOL = 1e-8
-NOT_SOLVED = ("RockPile_tob1", "fc2d_granularflowonwall_02020_00213")
+NOT_SOLVED = ("RockPile_tob1",)
+FINISHED_2D = "fc2d_granularflowonwall_02020_00213"
 ROLLING = "Chute-ndof-768-nc-4-3"
 
 
@@ -143,7 +147,7 @@ SOLVED = (
 
 
 def test_solved_set_is_every_file_but_the_documented_ones(manifest):
-    assert set(SOLVED) | set(NOT_SOLVED) | {ROLLING} == set(manifest)
+    assert set(SOLVED) | set(NOT_SOLVED) | {ROLLING, FINISHED_2D} == set(manifest)
 
 
 @pytest.mark.parametrize("name", SOLVED)
@@ -173,18 +177,29 @@ def test_rockpile_is_reported_honestly(problems):
     assert abs(reported - r.error_q) <= 0.01 * r.error_q
 
 
-def test_the_2d_file_is_indefinite_and_its_stall_reported(problems):
-    p = problems["fc2d_granularflowonwall_02020_00213"]
+def test_the_2d_file_is_indefinite_and_solved_by_the_lcp_finish(problems):
+    p = problems[FINISHED_2D]
     assert p.dim == 2 and p.nc == 2020
     W = p.W.toarray()
     # W is symmetric up to the 6 significant digits of its source, and indefinite at that level
     assert np.abs(W - W.T).max() <= 1e-5 * np.abs(W).max()
     ev = np.linalg.eigvalsh(0.5 * (W + W.T))
     assert ev[0] < -1e-8 * ev[-1]
-    r = contact.solve(p.W, p.q, p.mu, 2, method="prox", tol=TOL, max_iter=300)
-    assert not r.success and r.status in ("iteration_limit", "numerical_failure")
-    _, err_q = contact_error(W, p.q, p.mu, 2, r.impulse)
-    assert TOL < err_q < 1e-5 and abs(err_q - r.error_q) <= 1e-9 * err_q + 1e-15
+    # Newton alone stalls above the tolerance: 50 steps end before the first stall window
+    # closes (where the finish is tried), at error_q ~3.5e-7
+    short = contact.solve(p.W, p.q, p.mu, 2, method="prox", tol=TOL, max_iter=50)
+    assert not short.success and short.status == "iteration_limit"
+    assert TOL < short.error_q < 1e-5
+    r = contact.solve(p.W, p.q, p.mu, 2, method="prox", tol=TOL)
+    assert r.success and r.status == "solved", r.message
+    assert "2D LCP finish" in r.message
+    err, err_q = contact_error(W, p.q, p.mu, 2, r.impulse)
+    # Lemke's basic solution is exact up to rounding: far below the tolerance
+    assert err_q <= 1e-12 and err <= 1e-12, err_q
+    assert abs(err_q - r.error_q) <= 1e-3 * TOL
+    rn = r.impulse[:, 0]
+    assert r.min_normal_impulse >= -1e-12 * rn.max()
+    assert r.cone_violation <= 1e-12 * rn.max()
 
 
 def test_reader_errors(tmp_path, fclib_dir, manifest):
