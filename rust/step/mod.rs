@@ -38,13 +38,16 @@
 //! velocity in the world frame; inertia given in the body frame). Shapes ([`Shape`]) are sets
 //! of body-frame points with a common radius: a point, a disk or sphere (one point), a segment's
 //! ends, a box's or polygon's corners. Pairs ([`Pair`]): shape vs a static half-space, and
-//! sphere vs sphere (every point of one shape against every point of the other).
+//! sphere vs sphere (every point of one shape against every point of the other), declared one
+//! by one or found each step by the broad phase ([`Pair::Spheres`], a uniform grid over the
+//! spheres, O(N) per step: [`broad`]).
 //!
 //! Drift: a velocity-level condition does not enforce `g(q_{k+1}) >= 0` exactly (seed,
 //! "Position drift and restitution"). Gaps are monitored in every step's record, and
 //! [`Drift`] chooses a correction: none (the default), a velocity bias, or a post-step
 //! projection onto `g >= 0`.
 
+pub mod broad;
 mod stepper;
 
 pub use stepper::{simulate, ContactRecord, StepRecord, Stepper, Trajectory};
@@ -144,6 +147,17 @@ pub enum Pair {
         a: usize,
         /// the second shape's index.
         b: usize,
+        /// friction coefficient, `>= 0`.
+        mu: f64,
+        /// Newton restitution coefficient, in `[0, 1]`.
+        e: f64,
+    },
+    /// every pair of spheres on different bodies, found by the stepper itself each step (a
+    /// broad phase: a uniform grid, O(N) per step), so they need not be declared one by one.
+    /// The spheres are the points of the single-point shapes (a sphere or disk; a point is a
+    /// sphere of radius 0). A pair declared by [`Pair::SphereSphere`] keeps its own mu and e.
+    /// At most one per scene.
+    Spheres {
         /// friction coefficient, `>= 0`.
         mu: f64,
         /// Newton restitution coefficient, in `[0, 1]`.
@@ -300,6 +314,19 @@ impl Scene {
                         return Err(bad(format!(
                             "pair {i}: both shapes are on body {}",
                             self.shapes[a].body
+                        )));
+                    }
+                    (mu, e)
+                }
+                Pair::Spheres { mu, e } => {
+                    let count = self
+                        .pairs
+                        .iter()
+                        .filter(|p| matches!(p, Pair::Spheres { .. }))
+                        .count();
+                    if count > 1 {
+                        return Err(bad(format!(
+                            "pair {i}: the scene asks {count} times for every sphere pair;                              at most once"
                         )));
                     }
                     (mu, e)
