@@ -5,6 +5,7 @@
 //! cargo run --release --example step_profile -- ramp 10000
 //! valgrind --tool=callgrind target/release/examples/step_profile resting 2000
 //! cargo run --release --example step_profile -- pile 100 1000
+//! cargo run --release --example step_profile -- pile-declared 100 1000
 //! ```
 use coulomb::step::{simulate, Body, BodyKind, HalfSpace, Pair, Scene, Shape, StepSettings};
 
@@ -70,7 +71,8 @@ fn one_box(gravity: [f64; 3], half: [f64; 3], v0: [f64; 3], mu: f64) -> Scene {
 }
 
 /// `count` spheres of radius 0.05 on a grid above a floor inside four walls, as in
-/// benches/peer_step.py; sphere pairs found by the stepper's broad phase.
+/// benches/peer_step.py; sphere pairs found by the stepper's broad phase, or declared (the
+/// pairs within 3 grid spacings at the start).
 fn pile(count: usize, declared: bool) -> Scene {
     let radius = 0.05;
     let side = (count as f64).cbrt().ceil() as usize;
@@ -124,7 +126,9 @@ fn pile(count: usize, declared: bool) -> Scene {
             });
         }
     }
-    if declared {
+    if !declared {
+        scene.pairs.push(Pair::Spheres { mu: 0.5, e: 0.0 });
+    } else {
         // the benchmark's old candidate list: centres within 3 grid spacings
         let c: Vec<[f64; 3]> = scene
             .bodies
@@ -167,14 +171,49 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             one_box([0.0, 0.0, -G], [0.1, 0.1, 0.05], [0.0; 3], 0.5),
             arg(2, 10_000),
         ),
-        "pile" => (pile(arg(2, 100), true), arg(3, 1000)),
-        other => return Err(format!("unknown scene {other:?}: ramp, resting or pile").into()),
+        "pile" => (pile(arg(2, 100), false), arg(3, 1000)),
+        "pile-declared" => (pile(arg(2, 100), true), arg(3, 1000)),
+        other => {
+            return Err(
+                format!("unknown scene {other:?}: ramp, resting, pile or pile-declared").into(),
+            )
+        }
     };
-    let settings = StepSettings::new(1e-3, steps);
+    let mut settings = StepSettings::new(1e-3, steps);
+    if let (Ok(order), coulomb::step::StepSolver::Nsgs(s)) =
+        (std::env::var("ORDER"), &mut settings.solver)
+    {
+        s.order = match order.as_str() {
+            "symmetric" => coulomb::contact::ContactOrder::Symmetric,
+            "backward" => coulomb::contact::ContactOrder::Backward,
+            _ => coulomb::contact::ContactOrder::Forward,
+        };
+    }
+    if let (Ok(w), coulomb::step::StepSolver::Nsgs(s)) =
+        (std::env::var("RELAX"), &mut settings.solver)
+    {
+        s.relaxation = w.parse()?;
+    }
+    if let (Ok(w), coulomb::step::StepSolver::Nsgs(s)) =
+        (std::env::var("MAXIT"), &mut settings.solver)
+    {
+        s.max_iter = w.parse()?;
+    }
     let start = std::time::Instant::now();
     let tr = simulate(&scene, &settings)?;
     let sec = start.elapsed().as_secs_f64();
     let active: usize = tr.steps.iter().map(|s| s.active).sum();
+    let sweeps: usize = tr.steps.iter().map(|s| s.iterations).sum();
+    let worst = tr.steps.iter().map(|s| s.iterations).max().unwrap_or(0);
+    println!("sweeps {sweeps}, worst step {worst}");
+    for (k, s) in tr.steps.iter().enumerate() {
+        if s.iterations > 300 || s.fallback {
+            println!(
+                "step {k}: {} sweeps, error {:.2e}, fallback {}, {} contacts",
+                s.iterations, s.error, s.fallback, s.active
+            );
+        }
+    }
     let unsolved = tr
         .steps
         .iter()

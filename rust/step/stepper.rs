@@ -1419,6 +1419,14 @@ const SPARSE_FROM: usize = 24;
 /// NSGS's fallback is the polyhedral Lemke up to this many contacts, the robust mode above.
 const LEMKE_FALLBACK_MAX: usize = 32;
 
+/// above [`LEMKE_FALLBACK_MAX`] contacts, NSGS gets at most this many sweeps before the
+/// robust mode is tried; its remaining sweeps follow only if that misses the tolerance.
+const NSGS_BUDGET: usize = 100;
+
+/// the robust mode's Newton steps at most inside a step (it takes a handful when it
+/// converges; more means it has stalled, and NSGS's remaining sweeps take over).
+const PROX_MAX_ITER: usize = 50;
+
 /// the step's contact problem over the dense or the block-sparse W.
 fn step_problem<'a>(
     dim: usize,
@@ -1570,8 +1578,18 @@ fn solve_step_problem(
                     });
                 }
             }
+            // many contacts: a sweep budget before the robust mode (a landing layer on a
+            // tall pile needs sweeps growing with the pile's height, the robust mode a few
+            // Newton steps at a cost linear in the contacts)
+            let large = problem.nc > LEMKE_FALLBACK_MAX && settings.fallback;
+            let budget = if large {
+                s.max_iter.min(NSGS_BUDGET)
+            } else {
+                s.max_iter
+            };
             let nsgs = NsgsSettings {
                 initial: initial.map(<[f64]>::to_vec),
+                max_iter: budget,
                 ..s.clone()
             };
             let first = solve_nsgs(problem, &nsgs)?;
@@ -1584,19 +1602,48 @@ fn solve_step_problem(
             // many, where the dense LCP of nc (facets + 2) unknowns would cost more than the
             // whole run; keep the better answer
             let tol = s.tol.max(1e-9);
-            let second = if problem.nc <= LEMKE_FALLBACK_MAX {
+            let second = if !large {
                 let mut lemke = PolyhedralSettings::for_dim(problem.dim);
                 lemke.lemke.tol = tol;
                 solve_polyhedral_warm(problem, &lemke, guess, ws)?
             } else {
                 let prox = ProxSettings {
-                    tol,
+                    tol: s.tol,
+                    max_iter: PROX_MAX_ITER,
                     initial: Some(first.impulse.clone()),
                     ..ProxSettings::default()
                 };
                 ws.take(solve_prox(problem, &prox)?)
             };
-            if second.measures.error < first.measures.error {
+            let better = second.measures.error < first.measures.error;
+            if large && budget < s.max_iter && !(better && second.measures.error <= s.tol) {
+                // the robust mode did not reach the tolerance either: NSGS's remaining
+                // sweeps from the better answer, and the best of the three
+                let from = if better {
+                    ws.impulse.clone()
+                } else {
+                    first.impulse.clone()
+                };
+                let rest = NsgsSettings {
+                    initial: Some(from),
+                    max_iter: s.max_iter - budget,
+                    ..s.clone()
+                };
+                let third = solve_nsgs(problem, &rest)?;
+                let best_so_far = if better {
+                    second.measures.error
+                } else {
+                    first.measures.error
+                };
+                if third.measures.error <= best_so_far {
+                    record.fallback = better;
+                    return Ok(ws.take(ContactSolution {
+                        iterations: budget + third.iterations,
+                        ..third
+                    }));
+                }
+            }
+            if better {
                 record.fallback = true;
                 Ok(Outcome {
                     status: if second.measures.error <= tol {
