@@ -1423,6 +1423,18 @@ const LEMKE_FALLBACK_MAX: usize = 32;
 /// robust mode is tried; its remaining sweeps follow only if that misses the tolerance.
 const NSGS_BUDGET: usize = 100;
 
+/// a warm start within this factor of NSGS's tolerance counts as nearly solved (up to
+/// [`LEMKE_FALLBACK_MAX`] contacts): NSGS then first takes at most [`POLISH_SWEEPS`] sweeps
+/// towards [`POLISH_TOL`] times its tolerance, and its answer stands if within the tolerance.
+/// The residual velocity a step leaves (up to tol) builds up in the next steps' problems; an
+/// answer well inside the tolerance lets the following steps reuse it as it is for longer
+/// (callgrind, 3000 steps: ramp 107M -> 76M instructions, resting box 99M -> 77M).
+const POLISH_NEAR: f64 = 1e3;
+/// see [`POLISH_NEAR`].
+const POLISH_SWEEPS: usize = 2;
+/// see [`POLISH_NEAR`].
+const POLISH_TOL: f64 = 1e-3;
+
 /// the robust mode's Newton steps at most inside a step (it takes a handful when it
 /// converges; more means it has stalled, and NSGS's remaining sweeps take over).
 const PROX_MAX_ITER: usize = 50;
@@ -1565,6 +1577,7 @@ fn solve_step_problem(
         StepSolver::Nsgs(s) => {
             // a resting or sticking body's impulses often solve the next step's problem as
             // they are: then NSGS (which would stop after 0 sweeps) need not be set up
+            let mut start = initial.map(<[f64]>::to_vec);
             if let Some(init) = initial {
                 ws.velocity.resize(n, 0.0);
                 let m = measure_into(problem, init, &mut ws.velocity);
@@ -1577,6 +1590,24 @@ fn solve_step_problem(
                         measures: m,
                     });
                 }
+                if m.error <= POLISH_NEAR * s.tol && problem.nc <= LEMKE_FALLBACK_MAX {
+                    // nearly solved already (a resting or sticking body whose velocity
+                    // residual has built up): a few sweeps towards POLISH_TOL s.tol, so
+                    // that the next steps' impulses stay within tol for longer
+                    let polish = NsgsSettings {
+                        initial: start.take(),
+                        max_iter: s.max_iter.min(POLISH_SWEEPS),
+                        tol: s.tol * POLISH_TOL,
+                        ..s.clone()
+                    };
+                    let p = solve_nsgs(problem, &polish)?;
+                    if p.measures.error <= s.tol {
+                        let mut out = ws.take(p);
+                        out.status = ContactStatus::Solved;
+                        return Ok(out);
+                    }
+                    start = Some(p.impulse);
+                }
             }
             // many contacts: a sweep budget before the robust mode (a landing layer on a
             // tall pile needs sweeps growing with the pile's height, the robust mode a few
@@ -1588,7 +1619,7 @@ fn solve_step_problem(
                 s.max_iter
             };
             let nsgs = NsgsSettings {
-                initial: initial.map(<[f64]>::to_vec),
+                initial: start,
                 max_iter: budget,
                 ..s.clone()
             };
