@@ -1577,7 +1577,7 @@ fn solve_step_problem(
         StepSolver::Nsgs(s) => {
             // a resting or sticking body's impulses often solve the next step's problem as
             // they are: then NSGS (which would stop after 0 sweeps) need not be set up
-            let mut start = initial.map(<[f64]>::to_vec);
+            let mut start = None;
             if let Some(init) = initial {
                 ws.velocity.resize(n, 0.0);
                 let m = measure_into(problem, init, &mut ws.velocity);
@@ -1595,7 +1595,7 @@ fn solve_step_problem(
                     // residual has built up): a few sweeps towards POLISH_TOL s.tol, so
                     // that the next steps' impulses stay within tol for longer
                     let polish = NsgsSettings {
-                        initial: start.take(),
+                        initial: Some(init.to_vec()),
                         max_iter: s.max_iter.min(POLISH_SWEEPS),
                         tol: s.tol * POLISH_TOL,
                         ..s.clone()
@@ -1609,6 +1609,7 @@ fn solve_step_problem(
                     start = Some(p.impulse);
                 }
             }
+            let start = start.or_else(|| initial.map(<[f64]>::to_vec));
             // many contacts: a sweep budget before the robust mode (a landing layer on a
             // tall pile needs sweeps growing with the pile's height, the robust mode a few
             // Newton steps at a cost linear in the contacts)
