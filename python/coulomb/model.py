@@ -460,8 +460,9 @@ class Scene:
             Start NSGS from the previous step's impulses.
         fallback : bool
             When NSGS misses its tolerance (it can stall on singular, strongly coupled W),
-            also solve by the polyhedral Lemke and keep the answer with the smaller exact-disk
-            error (such steps are marked in ``fallback``).
+            also solve by the polyhedral Lemke (up to 32 contacts) or the robust mode
+            (proximal Newton, above; NSGS then gets 100 sweeps first) and keep the answer with
+            the smaller exact-disk error (such steps are marked in ``fallback``).
         drift : {"none", "bias", "projection"}
             The position-drift correction (a velocity-level step does not enforce
             ``g(q_{k+1}) >= 0`` exactly): none; a velocity bias, a closed contact with ``g < 0``

@@ -28,8 +28,12 @@
 //! (compression, then the normal impulse `e P_comp`) followed by an inelastic smooth phase.
 //!
 //! The friction law is Coulomb's with the exact disk (NSGS, warm-started by contact identity,
-//! with a Lemke fallback when it misses its tolerance) or the polyhedral cone (Lemke), as
-//! [`crate::contact`] solves it. Frictionless contacts (`mu = 0`) get no tangential impulse
+//! with a fallback when it misses its tolerance: see [`StepSettings::fallback`]) or the
+//! polyhedral cone (Lemke, warm-started from the previous step's basis of the same contacts:
+//! when that basis still solves the step's LCP, no pivot is made), as [`crate::contact`]
+//! solves it. Impulses that still solve a step's problem as they are (a resting or sticking
+//! body) are kept without a solve; nearly so, NSGS first takes two sweeps towards a thousandth
+//! of its tolerance, so the following steps can keep them longer. Frictionless contacts (`mu = 0`) get no tangential impulse
 //! (they still carry the tangential row in W: [`crate::contact::ContactProblem`] has one `dim`
 //! for all contacts).
 //!
@@ -413,9 +417,13 @@ pub struct StepSettings {
     pub gap_tolerance: f64,
     /// start each contact solve from the previous step's impulses of the same contacts.
     pub warm_start: bool,
-    /// when NSGS misses its tolerance, also solve by the polyhedral Lemke (tolerance
-    /// `max(tol, 1e-9)`) and keep the answer with the smaller exact-disk error; the step is
-    /// then solved if that error is within the tolerance.
+    /// when NSGS misses its tolerance, also solve by the polyhedral Lemke (up to 32
+    /// contacts; tolerance `max(tol, 1e-9)`) or by the robust mode (proximal Newton, above;
+    /// NSGS's tolerance) and keep the answer with the smaller exact-disk error; the step is
+    /// then solved if that error is within `max(tol, 1e-9)`. Above 32 contacts NSGS gets 100
+    /// sweeps before the robust mode (a landing layer on a tall pile needs sweeps growing
+    /// with its height, the robust mode a few Newton steps), and its remaining sweeps after it
+    /// if the robust mode misses the tolerance too.
     pub fallback: bool,
     /// the drift correction.
     pub drift: Drift,
