@@ -7,6 +7,9 @@
 //! cargo run --release --example step_profile -- pile 100 1000
 //! cargo run --release --example step_profile -- pile-declared 100 1000
 //! ```
+//!
+//! NSGS's sweep order, relaxation and sweep limit can be changed for experiments through the
+//! environment: `ORDER=symmetric|backward|forward`, `RELAX=1.3`, `MAXIT=100`.
 use coulomb::step::{simulate, Body, BodyKind, HalfSpace, Pair, Scene, Shape, StepSettings};
 
 const G: f64 = 9.81;
