@@ -619,3 +619,138 @@ fn poisson_restitution_agrees_with_newton_on_a_frictionless_impact() {
         assert!((w[1] / w[0] - 0.64).abs() < 2e-3, "{ap:?}");
     }
 }
+
+/// Lemke in the stepper starts from the previous step's basis (the same contacts' variables
+/// in the polyhedral LCP): on the resting box the guessed basis solves every step after the
+/// first, so those steps make no pivot, and the answers are those of the cold solves.
+#[test]
+fn lemke_warm_start_reuses_the_previous_basis() {
+    let scene = cube_scene(0.5);
+    let lemke = StepSettings {
+        solver: StepSolver::Lemke(PolyhedralSettings::for_dim(3)),
+        ..StepSettings::new(1e-3, 300)
+    };
+    let warm = simulate(&scene, &lemke).expect("valid");
+    let cold = simulate(
+        &scene,
+        &StepSettings {
+            warm_start: false,
+            ..lemke.clone()
+        },
+    )
+    .expect("valid");
+    assert!(cold.steps.iter().all(|s| s.iterations > 0));
+    for (k, (w, c)) in warm.steps.iter().zip(&cold.steps).enumerate() {
+        assert_eq!(w.status, Some(ContactStatus::Solved), "{k}: {w:?}");
+        if k > 0 {
+            assert_eq!(w.iterations, 0, "step {k} pivoted: {w:?}");
+        }
+        assert!((w.error - c.error).abs() < 1e-9, "{k}: {w:?} {c:?}");
+    }
+    for (a, b) in warm.q.iter().zip(&cold.q) {
+        assert!((a - b).abs() < 1e-12, "{a} {b}");
+    }
+}
+
+/// `count` balls (radius r, on `count` bodies) dropped in a staggered column onto a floor,
+/// close enough that neighbours collide; sphere pairs declared one by one (every pair) or
+/// left to the broad phase.
+fn ball_drop(declared: bool) -> Scene {
+    let (count, r) = (12usize, 0.1);
+    let mut scene = Scene {
+        dim: 3,
+        gravity: vec![0.0, 0.0, -G],
+        bodies: vec![],
+        shapes: vec![],
+        half_spaces: vec![HalfSpace {
+            point: vec![0.0; 3],
+            normal: vec![0.0, 0.0, 1.0],
+        }],
+        pairs: vec![],
+    };
+    let i = 0.4 * r * r;
+    for k in 0..count {
+        let kf = k as f64;
+        scene.bodies.push(Body {
+            kind: BodyKind::Spatial,
+            mass: 1.0,
+            inertia: vec![i, 0.0, 0.0, 0.0, i, 0.0, 0.0, 0.0, i],
+            q0: vec![
+                0.07 * (kf * 1.3).sin(),
+                0.07 * (kf * 2.1).cos(),
+                r + 0.005 + 2.05 * r * kf,
+                1.0,
+                0.0,
+                0.0,
+                0.0,
+            ],
+            v0: vec![0.1 * (kf * 0.7).cos(), 0.0, 0.0, 0.0, 0.0, 0.0],
+            force: vec![0.0; 3],
+        });
+        scene.shapes.push(Shape {
+            body: k,
+            points: vec![vec![0.0; 3]],
+            radius: r,
+        });
+        scene.pairs.push(Pair::ShapeHalfSpace {
+            shape: k,
+            half_space: 0,
+            mu: 0.3,
+            e: 0.0,
+        });
+    }
+    if declared {
+        for a in 0..count {
+            for b in a + 1..count {
+                scene.pairs.push(Pair::SphereSphere {
+                    a,
+                    b,
+                    mu: 0.3,
+                    e: 0.0,
+                });
+            }
+        }
+    } else {
+        // one pair declared anyway: it keeps its own declaration, not a second copy
+        scene.pairs.push(Pair::SphereSphere {
+            a: 1,
+            b: 0,
+            mu: 0.3,
+            e: 0.0,
+        });
+        scene.pairs.push(Pair::Spheres { mu: 0.3, e: 0.0 });
+    }
+    scene
+}
+
+/// The broad phase finds the pairs that matter: a column of balls collapsing onto a floor
+/// steps exactly as with every pair declared (same active contacts, same states).
+#[test]
+fn broad_phase_steps_as_every_pair_declared() {
+    let settings = StepSettings::new(1e-3, 600);
+    let all = simulate(&ball_drop(true), &settings).expect("valid");
+    let found = simulate(&ball_drop(false), &settings).expect("valid");
+    assert!(all.stopped.is_none() && found.stopped.is_none());
+    // ids: 0..12 the floor, 12 the declared pair (0, 1), 13.. the broad phase's pairs
+    let declared = found.contacts.iter().filter(|c| c.id == 12).count();
+    let broad = found.contacts.iter().filter(|c| c.id > 12).count();
+    assert!(
+        declared > 0 && broad > 100,
+        "the balls must collide: {declared} {broad}"
+    );
+    for (k, (a, b)) in all.steps.iter().zip(&found.steps).enumerate() {
+        assert_eq!(a.active, b.active, "step {k}");
+        assert_eq!(a.status, b.status, "step {k}");
+    }
+    for (x, y) in all.q.iter().zip(&found.q) {
+        assert!((x - y).abs() < 1e-9, "{x} {y}");
+    }
+    every_step_solved(&found);
+}
+
+#[test]
+fn spheres_pair_asked_twice_is_refused() {
+    let mut scene = ball_drop(false);
+    scene.pairs.push(Pair::Spheres { mu: 0.1, e: 0.0 });
+    assert!(simulate(&scene, &StepSettings::new(1e-3, 1)).is_err());
+}

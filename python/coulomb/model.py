@@ -365,6 +365,24 @@ class Scene:
             raise InvalidParameterError("both spheres are on the same body")
         self.pairs.append(("sphere", a, b, mu, e))
 
+    def contact_spheres(self, mu: float = 0.0, e: float = 0.0) -> None:
+        """Lets every pair of spheres on different bodies touch, with friction coefficient
+        ``mu >= 0`` and Newton restitution ``e`` in [0, 1], without declaring the pairs: the
+        stepper finds the pairs near each other itself every step (a broad phase, a uniform
+        grid over the spheres, O(N) per step). The spheres are the single-point shapes
+        (:class:`Sphere`; a :class:`Point` counts as a sphere of radius 0). A pair also
+        declared with :meth:`contact` keeps that declaration's ``mu`` and ``e``. Contact ids
+        of these pairs are ``D + i B + j`` (``D`` declared candidates, ``B`` spheres, ``i < j``
+        the spheres' indices in the order they were attached)."""
+        mu, e = float(mu), float(e)
+        if not (math.isfinite(mu) and mu >= 0.0):
+            raise InvalidParameterError(f"mu must be finite and >= 0, got {mu}")
+        if not (math.isfinite(e) and 0.0 <= e <= 1.0):
+            raise InvalidParameterError(f"e must be in [0, 1], got {e}")
+        if any(p[0] == "spheres" for p in self.pairs):
+            raise InvalidParameterError("contact_spheres was already called on this scene")
+        self.pairs.append(("spheres", 0, 0, mu, e))
+
     def _spec(self) -> dict[str, Any]:
         bodies = []
         for b in self.bodies:
@@ -442,8 +460,9 @@ class Scene:
             Start NSGS from the previous step's impulses.
         fallback : bool
             When NSGS misses its tolerance (it can stall on singular, strongly coupled W),
-            also solve by the polyhedral Lemke and keep the answer with the smaller exact-disk
-            error (such steps are marked in ``fallback``).
+            also solve by the polyhedral Lemke (up to 32 contacts) or the robust mode
+            (proximal Newton, above; NSGS then gets 100 sweeps first) and keep the answer with
+            the smaller exact-disk error (such steps are marked in ``fallback``).
         drift : {"none", "bias", "projection"}
             The position-drift correction (a velocity-level step does not enforce
             ``g(q_{k+1}) >= 0`` exactly): none; a velocity bias, a closed contact with ``g < 0``

@@ -6,7 +6,7 @@ use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1};
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
+use pyo3::types::{PyDict, PyList, PyString};
 
 use super::{guarded, to_py};
 use crate::contact::{NsgsSettings, PolyhedralSettings};
@@ -89,12 +89,13 @@ fn scene_from_dict(d: &Bound<'_, PyDict>) -> PyResult<Scene> {
     let mut pairs = vec![];
     for p in dicts(d, "pairs")? {
         let kind: String = item(&p, "kind")?;
-        let (a, b, mu, e): (usize, usize, f64, f64) = (
-            item(&p, "a")?,
-            item(&p, "b")?,
-            item(&p, "mu")?,
-            item(&p, "e")?,
-        );
+        let (mu, e): (f64, f64) = (item(&p, "mu")?, item(&p, "e")?);
+        if kind == "spheres" {
+            // every sphere pair, found by the stepper's broad phase: no indices
+            pairs.push(Pair::Spheres { mu, e });
+            continue;
+        }
+        let (a, b): (usize, usize) = (item(&p, "a")?, item(&p, "b")?);
         pairs.push(match kind.as_str() {
             "half_space" => Pair::ShapeHalfSpace {
                 shape: a,
@@ -246,10 +247,21 @@ pub(super) fn step_simulate<'py>(
         "active",
         PyArray1::from_vec(py, s.iter().map(|r| r.active as i64).collect::<Vec<_>>()),
     )?;
-    let status: Vec<&str> = s
-        .iter()
-        .map(|r| r.status.map_or("no_contact", |x| x.as_str()))
-        .collect();
+    // one Python string per distinct status, shared by the steps
+    let mut names: Vec<(&str, Bound<'py, PyString>)> = Vec::new();
+    let mut status = Vec::with_capacity(s.len());
+    for r in s {
+        let name = r.status.map_or("no_contact", |x| x.as_str());
+        let obj = match names.iter().find(|(k, _)| *k == name) {
+            Some((_, o)) => o.clone(),
+            None => {
+                let o = PyString::intern(py, name);
+                names.push((name, o.clone()));
+                o
+            }
+        };
+        status.push(obj);
+    }
     d.set_item("status", PyList::new(py, status)?)?;
     d.set_item("error", PyArray1::from_vec(py, col_f(|r| r.error)))?;
     d.set_item(
@@ -297,9 +309,15 @@ pub(super) fn step_simulate<'py>(
         "contact_id",
         PyArray1::from_vec(py, c.iter().map(|r| r.id as i64).collect::<Vec<_>>()),
     )?;
-    let imp: Vec<f64> = c.iter().flat_map(|r| r.impulse[..dim].to_vec()).collect();
+    let imp: Vec<f64> = c
+        .iter()
+        .flat_map(|r| r.impulse.into_iter().take(dim))
+        .collect();
     d.set_item("contact_impulse", matrix(py, nrec, dim, imp)?)?;
-    let vel: Vec<f64> = c.iter().flat_map(|r| r.velocity[..dim].to_vec()).collect();
+    let vel: Vec<f64> = c
+        .iter()
+        .flat_map(|r| r.velocity.into_iter().take(dim))
+        .collect();
     d.set_item("contact_velocity", matrix(py, nrec, dim, vel)?)?;
     d.set_item(
         "contact_approach",

@@ -28,8 +28,12 @@
 //! (compression, then the normal impulse `e P_comp`) followed by an inelastic smooth phase.
 //!
 //! The friction law is Coulomb's with the exact disk (NSGS, warm-started by contact identity,
-//! with a Lemke fallback when it misses its tolerance) or the polyhedral cone (Lemke), as
-//! [`crate::contact`] solves it. Frictionless contacts (`mu = 0`) get no tangential impulse
+//! with a fallback when it misses its tolerance: see [`StepSettings::fallback`]) or the
+//! polyhedral cone (Lemke, warm-started from the previous step's basis of the same contacts:
+//! when that basis still solves the step's LCP, no pivot is made), as [`crate::contact`]
+//! solves it. Impulses that still solve a step's problem as they are (a resting or sticking
+//! body) are kept without a solve; nearly so, NSGS first takes two sweeps towards a thousandth
+//! of its tolerance, so the following steps can keep them longer. Frictionless contacts (`mu = 0`) get no tangential impulse
 //! (they still carry the tangential row in W: [`crate::contact::ContactProblem`] has one `dim`
 //! for all contacts).
 //!
@@ -38,13 +42,16 @@
 //! velocity in the world frame; inertia given in the body frame). Shapes ([`Shape`]) are sets
 //! of body-frame points with a common radius: a point, a disk or sphere (one point), a segment's
 //! ends, a box's or polygon's corners. Pairs ([`Pair`]): shape vs a static half-space, and
-//! sphere vs sphere (every point of one shape against every point of the other).
+//! sphere vs sphere (every point of one shape against every point of the other), declared one
+//! by one or found each step by the broad phase ([`Pair::Spheres`], a uniform grid over the
+//! spheres, O(N) per step: [`broad`]).
 //!
 //! Drift: a velocity-level condition does not enforce `g(q_{k+1}) >= 0` exactly (seed,
 //! "Position drift and restitution"). Gaps are monitored in every step's record, and
 //! [`Drift`] chooses a correction: none (the default), a velocity bias, or a post-step
 //! projection onto `g >= 0`.
 
+pub mod broad;
 mod stepper;
 
 pub use stepper::{simulate, ContactRecord, StepRecord, Stepper, Trajectory};
@@ -144,6 +151,17 @@ pub enum Pair {
         a: usize,
         /// the second shape's index.
         b: usize,
+        /// friction coefficient, `>= 0`.
+        mu: f64,
+        /// Newton restitution coefficient, in `[0, 1]`.
+        e: f64,
+    },
+    /// every pair of spheres on different bodies, found by the stepper itself each step (a
+    /// broad phase: a uniform grid, O(N) per step), so they need not be declared one by one.
+    /// The spheres are the points of the single-point shapes (a sphere or disk; a point is a
+    /// sphere of radius 0). A pair declared by [`Pair::SphereSphere`] keeps its own mu and e.
+    /// At most one per scene.
+    Spheres {
         /// friction coefficient, `>= 0`.
         mu: f64,
         /// Newton restitution coefficient, in `[0, 1]`.
@@ -304,6 +322,19 @@ impl Scene {
                     }
                     (mu, e)
                 }
+                Pair::Spheres { mu, e } => {
+                    let count = self
+                        .pairs
+                        .iter()
+                        .filter(|p| matches!(p, Pair::Spheres { .. }))
+                        .count();
+                    if count > 1 {
+                        return Err(bad(format!(
+                            "pair {i}: the scene asks {count} times for every sphere pair;                              at most once"
+                        )));
+                    }
+                    (mu, e)
+                }
             };
             if !(mu.is_finite() && mu >= 0.0) {
                 return Err(bad(format!(
@@ -386,9 +417,13 @@ pub struct StepSettings {
     pub gap_tolerance: f64,
     /// start each contact solve from the previous step's impulses of the same contacts.
     pub warm_start: bool,
-    /// when NSGS misses its tolerance, also solve by the polyhedral Lemke (tolerance
-    /// `max(tol, 1e-9)`) and keep the answer with the smaller exact-disk error; the step is
-    /// then solved if that error is within the tolerance.
+    /// when NSGS misses its tolerance, also solve by the polyhedral Lemke (up to 32
+    /// contacts; tolerance `max(tol, 1e-9)`) or by the robust mode (proximal Newton, above;
+    /// NSGS's tolerance) and keep the answer with the smaller exact-disk error; the step is
+    /// then solved if that error is within `max(tol, 1e-9)`. Above 32 contacts NSGS gets 100
+    /// sweeps before the robust mode (a landing layer on a tall pile needs sweeps growing
+    /// with its height, the robust mode a few Newton steps), and its remaining sweeps after it
+    /// if the robust mode misses the tolerance too.
     pub fallback: bool,
     /// the drift correction.
     pub drift: Drift,

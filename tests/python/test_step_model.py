@@ -119,6 +119,43 @@ def test_two_spheres_collide_head_on():
     assert tr.check().ok
 
 
+def _row_of_balls(declare: str) -> Scene:
+    # a Newton's cradle: one ball sent along a row of 6 touching-apart balls (e = 1, no
+    # friction, no gravity); the pairs are declared, or found by the broad phase
+    scene = Scene(dim=3, gravity=(0.0, 0.0, 0.0))
+    shapes = []
+    for k in range(7):
+        v = (1.0, 0.0, 0.0) if k == 0 else (0.0, 0.0, 0.0)
+        body = scene.add(Particle(mass=1.0, position=(1.05 * k, 0.0, 0.0), velocity=v))
+        shapes.append(scene.attach(body, Sphere(0.5)))
+    if declare == "all":
+        for i in range(7):
+            for j in range(i + 1, 7):
+                scene.contact(shapes[i], shapes[j], e=1.0)
+    else:
+        scene.contact_spheres(e=1.0)
+    return scene
+
+
+def test_contact_spheres_finds_the_pairs_itself():
+    declared = _row_of_balls("all").simulate(1.0, 1e-3)
+    found = _row_of_balls("broad").simulate(1.0, 1e-3)
+    assert found.success
+    np.testing.assert_allclose(found.q, declared.q, rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(found.active, declared.active)
+    # the momentum has passed down the row to the last ball
+    assert found.body(6).v[-1] == pytest.approx([1.0, 0.0, 0.0], abs=1e-9)
+    assert found.kinetic_energy[-1] == pytest.approx(0.5, rel=1e-9)
+    # broad-phase ids are D + i B + j (D = 0 declared candidates, B = 7 spheres)
+    ids = set(found.contact_id.tolist())
+    assert ids and all(i // 7 < i % 7 for i in ids)
+    with pytest.raises(InvalidParameterError):
+        found_scene = _row_of_balls("broad")
+        found_scene.contact_spheres()
+    with pytest.raises(InvalidParameterError):
+        Scene(dim=3).contact_spheres(mu=-1.0)
+
+
 def test_check_flags_penetration_and_strict_raises():
     # a block started below the floor is a violation the check must report
     scene = Scene(dim=2)
