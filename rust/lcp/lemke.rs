@@ -29,6 +29,7 @@
 //!   smaller.
 
 use super::kernel::{self, axpy, Isa};
+use super::revised::{PathEnd, RevisedLemke};
 use super::scaling::Equilibration;
 use super::small::solve_principal;
 use super::{check_tol, passes, LcpMeasures, LcpRef, LcpSolution, LcpStatus, WarmStart};
@@ -54,6 +55,23 @@ pub struct LemkeSettings {
     /// `covering_vector` is `None`). A secondary ray proves infeasibility only for
     /// copositive-plus M; for other matrices a different path may still find a solution.
     pub restarts: usize,
+    /// how the basis inverse is kept along the path (see [`LemkeEngine`]).
+    pub engine: LemkeEngine,
+}
+
+/// How Lemke's path keeps the basis inverse. Both follow the same lexicographic rule; they
+/// differ in cost and in rounding.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LemkeEngine {
+    /// the product form for 16 <= n <= 1024, where it is fastest, and the tableau otherwise;
+    /// a product-form path that does not end in a solution within `2n + 16` pivots is
+    /// re-run on the tableau, whose answer is then reported.
+    #[default]
+    Auto,
+    /// the condensed tableau: O(n^2) per pivot.
+    Tableau,
+    /// the product form (eta file): O(n p) for the p-th pivot, no fallback.
+    ProductForm,
 }
 
 impl Default for LemkeSettings {
@@ -65,6 +83,7 @@ impl Default for LemkeSettings {
             warm_start: None,
             polish: true,
             restarts: 2,
+            engine: LemkeEngine::Auto,
         }
     }
 }
@@ -100,6 +119,10 @@ enum Blocking {
 
 /// problems at least this large delay their rank-one updates (see [`LemkeWorkspace`]).
 const BLOCKED_FROM: usize = 64;
+/// the sizes for which [`LemkeEngine::Auto`] takes the product form: below, a pivot is too
+/// cheap for it to matter; above, the eta file outgrows the caches and the tableau's blocked
+/// rank-k updates win.
+const PRODUCT_FORM_SIZES: std::ops::RangeInclusive<usize> = 16..=1024;
 /// how many rank-one updates are gathered before one rank-k update applies them.
 const BLOCK: usize = 16;
 
@@ -138,18 +161,28 @@ pub struct LemkeWorkspace {
     ties: Vec<usize>,
     ties_next: Vec<usize>,
     isa: Isa,
+    product_form: RevisedLemke,
 }
 
 impl LemkeWorkspace {
-    /// a workspace for problems of size n: one n x (n+2) tableau, 16 pending update pairs
-    /// (for n >= 64) and O(n) bookkeeping.
+    /// a workspace for problems of size n: for 16 <= n <= 1024 the product form's eta file
+    /// (at most n etas of length n; an explicit n x n inverse only for paths longer than n),
+    /// otherwise one n x (n+2) tableau with 16 pending update pairs (for n >= 64); the
+    /// tableau of a product-form size is made only if a path falls back to it. O(n)
+    /// bookkeeping besides.
     pub fn new(n: usize) -> Self {
         let width = n + 2;
         let block = if n >= BLOCKED_FROM { BLOCK } else { 0 };
+        let product_form = PRODUCT_FORM_SIZES.contains(&n);
+        let tableau = if product_form {
+            Vec::new()
+        } else {
+            vec![0.0; n * width]
+        };
         Self {
             n,
             width,
-            tableau: vec![0.0; n * width],
+            tableau,
             block,
             pending: 0,
             pending_u: vec![0.0; block * n],
@@ -165,6 +198,7 @@ impl LemkeWorkspace {
             ties: Vec::with_capacity(n),
             ties_next: Vec::with_capacity(n),
             isa: kernel::detect(),
+            product_form: RevisedLemke::new(if product_form { n } else { 0 }),
         }
     }
 
@@ -177,6 +211,7 @@ impl LemkeWorkspace {
     pub fn tableau_bytes(&self) -> usize {
         (self.tableau.len() + self.pending_u.len() + self.pending_v.len())
             * std::mem::size_of::<f64>()
+            + self.product_form.bytes()
     }
 
     #[inline(always)]
@@ -197,6 +232,10 @@ impl LemkeWorkspace {
     fn load(&mut self, lcp: &LcpRef<'_>, eq: &Equilibration, cover: &[f64]) {
         let n = self.n;
         let w = self.width;
+        if self.tableau.len() != n * w {
+            // a product-form size falling back to the tableau
+            self.tableau = vec![0.0; n * w];
+        }
         for (i, (row, mrow)) in self
             .tableau
             .chunks_exact_mut(w)
@@ -506,6 +545,16 @@ impl LemkeWorkspace {
     }
 }
 
+/// says in the message when a product-form path was abandoned for the tableau.
+fn with_fallback_note(mut out: LcpSolution, abandoned: usize) -> LcpSolution {
+    if abandoned > 0 {
+        out.message.push_str(&format!(
+            " (after {abandoned} product-form pivots were abandoned for the tableau)"
+        ));
+    }
+    out
+}
+
 /// `a` is better than `b` when its worse relative measure is smaller.
 fn better(a: &LcpMeasures, b: &LcpMeasures) -> bool {
     a.error.max(a.scaled_error) < b.error.max(b.scaled_error)
@@ -672,16 +721,72 @@ pub fn solve_lemke_with(
     let mut cover = vec![0.0; n];
     let mut z = vec![0.0; n];
     let mut basis = Vec::with_capacity(n);
+    let mut abandoned = 0;
     for attempt in 0..tries {
         covering(attempt, &eq, user, &mut cover);
-        ws.load(lcp, &eq, &cover);
-        let (ending, pivots) = ws.run(max_pivots);
+        let product_form = match settings.engine {
+            LemkeEngine::Auto => ws.product_form.size() == n && n > 0,
+            LemkeEngine::Tableau => false,
+            LemkeEngine::ProductForm => true,
+        };
+        let mut on_product_form = false;
+        let mut ending = Ending::NonFinite;
+        let mut pivots = 0;
+        if product_form {
+            if ws.product_form.size() != n {
+                ws.product_form = RevisedLemke::new(n);
+            }
+            // Rounding can break the lexicographic rule's ties differently from exact
+            // arithmetic; under Auto a path that wanders (or ends without a solution) is
+            // re-run on the tableau, whose verdict is then the one reported.
+            let budget = if settings.engine == LemkeEngine::Auto {
+                max_pivots.min(2 * n + 16)
+            } else {
+                max_pivots
+            };
+            let pf = &mut ws.product_form;
+            pf.load(lcp, &eq, &cover);
+            let (end, k) = pf.run(lcp, &eq, budget);
+            ending = match end {
+                PathEnd::Terminal => Ending::Terminal,
+                PathEnd::Ray => Ending::Ray,
+                PathEnd::Limit => Ending::Limit,
+                PathEnd::NonFinite => Ending::NonFinite,
+            };
+            pivots = k;
+            on_product_form = true;
+            if ending != Ending::Terminal && settings.engine == LemkeEngine::Auto {
+                abandoned += k;
+                on_product_form = false;
+            }
+        }
+        if !on_product_form {
+            ws.load(lcp, &eq, &cover);
+            (ending, pivots) = ws.run(max_pivots);
+            ws.extract(&eq, &mut z, &mut basis);
+        } else {
+            ws.product_form.extract(&eq, &mut z, &mut basis);
+        }
         out.pivots += pivots;
         out.restarts = attempt;
-        ws.extract(&eq, &mut z, &mut basis);
-        // The polished answer is usually the better one: when it passes, the tableau's answer
-        // need not be evaluated at all.
-        let polished_answer = if ending == Ending::Terminal && settings.polish {
+        // On the product form one refinement step through the eta file usually brings the
+        // answer to rounding level at the cost of one pivot's column; the principal system
+        // is factorized afresh only when that answer fails. The polished answer is usually
+        // the better one: when it passes, the path's own answer need not be evaluated.
+        let refined = if ending == Ending::Terminal && settings.polish && on_product_form {
+            let pf = &mut ws.product_form;
+            pf.refine(lcp, &eq);
+            let mut zr = vec![0.0; n];
+            let mut br = Vec::with_capacity(basis.len());
+            pf.extract(&eq, &mut zr, &mut br);
+            let c = candidate(lcp, &eq, zr);
+            passes(&c.measures, tol).then_some(c)
+        } else {
+            None
+        };
+        let polished_answer = if refined.is_some() {
+            refined
+        } else if ending == Ending::Terminal && settings.polish {
             principal(lcp, &eq, &basis)
         } else {
             None
@@ -713,7 +818,7 @@ pub fn solve_lemke_with(
                     m.error,
                     if polished { ", polished" } else { "" }
                 );
-                return Ok(out);
+                return Ok(with_fallback_note(out, abandoned));
             }
             Ending::Terminal => {
                 out.status = LcpStatus::NumericalFailure;
@@ -722,7 +827,7 @@ pub fn solve_lemke_with(
                      scaled error {:.2e} (ill-conditioned basis)",
                     m.error, m.scaled_error
                 );
-                return Ok(out);
+                return Ok(with_fallback_note(out, abandoned));
             }
             Ending::Ray => {
                 out.status = LcpStatus::RayTermination;
@@ -740,16 +845,16 @@ pub fn solve_lemke_with(
                     "stopped at the pivot limit ({max_pivots}) with error {:.2e}",
                     m.error
                 );
-                return Ok(out);
+                return Ok(with_fallback_note(out, abandoned));
             }
             Ending::NonFinite => {
                 out.status = LcpStatus::NumericalFailure;
                 out.message = format!("the tableau became non-finite after {} pivots", out.pivots);
-                return Ok(out);
+                return Ok(with_fallback_note(out, abandoned));
             }
         }
     }
-    Ok(out)
+    Ok(with_fallback_note(out, abandoned))
 }
 
 #[cfg(test)]

@@ -20,6 +20,7 @@ pub mod enumerate;
 mod kernel;
 pub mod lemke;
 pub mod pgs;
+mod revised;
 mod scaling;
 mod small;
 
@@ -27,7 +28,7 @@ use crate::error::{check_finite, CoulombError, Result};
 use crate::matrix::DenseMatrix;
 
 pub use enumerate::{solve_enumerate, EnumerateSettings};
-pub use lemke::{solve_lemke, solve_lemke_with, LemkeSettings, LemkeWorkspace};
+pub use lemke::{solve_lemke, solve_lemke_with, LemkeEngine, LemkeSettings, LemkeWorkspace};
 pub use pgs::{solve_pgs, PgsSettings};
 
 /// the vector instruction set Lemke's pivot kernel uses on this CPU.

@@ -212,6 +212,7 @@ fn lcp_solve<'py>(
             warm_start,
             polish,
             restarts,
+            engine: Default::default(),
         }),
         "pgs" => Method::Pgs(PgsSettings {
             tol,

@@ -1,0 +1,651 @@
+//! Lemke's path in product form: the basis inverse is kept as a file of elementary
+//! ("eta") matrices instead of a tableau.
+//!
+//! With the basis B after p pivots written as
+//!
+//! ```text
+//!     B^{-1} = E_p ⋯ E_1 B_0^{-1},   E_j = I + η̃_j e_{r_j}^T,  η̃_j = η_j - e_{r_j},
+//! ```
+//!
+//! (B_0 = I, the all-w basis, until the file is folded into an explicit inverse), a pivot needs
+//! only the entering column `f = B^{-1} a_s` and the basic values `x_B = B^{-1} q'`: the
+//! ratio test reads nothing else. Forming f costs one pass over each stored η (an axpy of
+//! length n), so the k-th pivot costs O(n k) instead of the tableau's O(n^2): on Lemke's
+//! typical path of about n/2 pivots that is n^3/8 multiply-adds in all instead of n^3/2.
+//! The η of a pivot on row r with column f is `η_i = -f_i / f_r` (i ≠ r), `η_r = 1 / f_r`.
+//!
+//! The lexicographic tie-break reads rows of B^{-1}; they are formed on demand (rare: only
+//! when ratios tie) from `e_i^T E_p ⋯ E_1 B_0^{-1}`, where each `y^T E_j` changes only
+//! entry r_j, to `y · η_j`.
+//!
+//! When the file holds `cap` etas (long, degenerate paths) it is folded into an explicit
+//! dense `B_0^{-1}` (each η applied to it as a rank-one update) and a new file starts.
+
+use super::kernel::{self, axpy, Isa};
+use super::scaling::Equilibration;
+use super::LcpRef;
+
+/// How a pivoting run ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum PathEnd {
+    /// z0 left the basis: the basis is complementary.
+    Terminal,
+    /// the entering column has no blocking row: a secondary ray.
+    Ray,
+    /// the pivot limit was reached.
+    Limit,
+    /// the arithmetic broke down (non-finite or no admissible pivot).
+    NonFinite,
+}
+
+/// relative size under which a column entry counts as zero in the ratio test.
+const PIVOT_EPS: f64 = 1e-11;
+/// relative gap within which two ratios count as tied.
+const TIE_EPS: f64 = 1e-9;
+/// relative size under which a basic variable's value counts as zero (degenerate).
+const RHS_EPS: f64 = 1e-13;
+
+/// etas applied together to a column (see [`RevisedLemke::apply_etas`]).
+const ETA_BLOCK: usize = 8;
+/// at most this many tied rows are broken lexicographically (their rows of B^{-1} are
+/// stored, LEX_ROWS x n).
+const LEX_ROWS: usize = 64;
+/// etas folded together into the explicit inverse by one matrix product.
+const FOLD_BLOCK: usize = 16;
+
+/// Storage of the product-form path, sized once for n and reused.
+pub(super) struct RevisedLemke {
+    n: usize,
+    /// at most this many etas before they are folded into `base`.
+    cap: usize,
+    /// the eta vectors, `cap x n` row-major; `eta_rows[j]` is r_j.
+    etas: Vec<f64>,
+    eta_rows: Vec<usize>,
+    count: usize,
+    /// explicit `B_0^{-1}` (row-major n x n) once the file has been folded; empty before.
+    base: Vec<f64>,
+    has_base: bool,
+    /// the rows a fold block reads (FOLD_BLOCK x n), allocated with `base`.
+    fold_rows: Vec<f64>,
+    /// the equilibrated covering vector d' and the entering variable's original column.
+    cover: Vec<f64>,
+    acol: Vec<f64>,
+    /// the entering column, the basic values and the ratio test's ratios.
+    column: Vec<f64>,
+    values: Vec<f64>,
+    ratios: Vec<f64>,
+    scratch: Vec<f64>,
+    /// `basic[i]`: the variable basic in row i (w_k = k, z_k = n + k, z0 = 2n).
+    basic: Vec<usize>,
+    /// `row_of[v]`: the row where variable v is basic, or `usize::MAX`.
+    row_of: Vec<usize>,
+    ties: Vec<usize>,
+    ties_next: Vec<usize>,
+    /// rows of B^{-1} for the tied rows (ties.len() x n), formed on demand.
+    lex_rows: Vec<f64>,
+    lex_index: Vec<usize>,
+    isa: Isa,
+}
+
+impl RevisedLemke {
+    /// storage for problems of size n: at most max(n, 16) etas of length n, M' once (n^2),
+    /// and O(n) vectors; the explicit inverse (another n^2) only if a path is long enough to
+    /// need folding.
+    pub(super) fn new(n: usize) -> Self {
+        let cap = n.max(16);
+        Self {
+            n,
+            cap,
+            etas: vec![0.0; cap * n],
+            eta_rows: vec![0; cap],
+            count: 0,
+            base: Vec::new(),
+            has_base: false,
+            fold_rows: Vec::new(),
+            cover: vec![0.0; n],
+            acol: vec![0.0; n],
+            column: vec![0.0; n],
+            values: vec![0.0; n],
+            ratios: vec![0.0; n],
+            scratch: vec![0.0; n],
+            basic: vec![0; n],
+            row_of: vec![usize::MAX; 2 * n + 1],
+            ties: Vec::with_capacity(n),
+            ties_next: Vec::with_capacity(n),
+            lex_rows: vec![0.0; LEX_ROWS.min(n) * n],
+            lex_index: vec![usize::MAX; n],
+            isa: kernel::detect(),
+        }
+    }
+
+    /// the problem size this storage holds.
+    pub(super) fn size(&self) -> usize {
+        self.n
+    }
+
+    /// bytes held (for the workspace's memory report).
+    pub(super) fn bytes(&self) -> usize {
+        (self.etas.len() + self.base.len() + self.fold_rows.len() + self.lex_rows.len())
+            * std::mem::size_of::<f64>()
+    }
+
+    #[inline(always)]
+    fn z0(&self) -> usize {
+        2 * self.n
+    }
+
+    #[inline(always)]
+    fn complement(&self, var: usize) -> usize {
+        if var < self.n {
+            var + self.n
+        } else {
+            var - self.n
+        }
+    }
+
+    /// the all-w basis of the equilibrated problem `w = q' + M' z + d' z0`, i.e. the system
+    /// `[I, -M', -d'] x = q'`.
+    pub(super) fn load(&mut self, lcp: &LcpRef<'_>, eq: &Equilibration, cover: &[f64]) {
+        let n = self.n;
+        for i in 0..n {
+            self.values[i] = eq.row[i] * lcp.q[i] / eq.sigma;
+            self.basic[i] = i;
+        }
+        self.cover.copy_from_slice(cover);
+        self.row_of.iter_mut().for_each(|v| *v = usize::MAX);
+        for i in 0..n {
+            self.row_of[i] = i;
+        }
+        self.count = 0;
+        self.has_base = false;
+    }
+
+    /// `out = B^{-1} a_var` for the original column of variable `var`.
+    #[inline(always)]
+    fn column_of(&mut self, lcp: &LcpRef<'_>, eq: &Equilibration, var: usize) {
+        let n = self.n;
+        let mut out = std::mem::take(&mut self.column);
+        if var >= n {
+            // the original column, -M'[:, k] = -R M[:, k] c_k (read down M's rows: a
+            // strided pass of n entries, cheaper than keeping a transposed copy), or -d'
+            if var == 2 * n {
+                self.acol.copy_from_slice(&self.cover);
+            } else {
+                let k = var - n;
+                let c = eq.col[k];
+                for ((a, r), mrow) in self.acol.iter_mut().zip(&eq.row).zip(lcp.m.chunks_exact(n)) {
+                    *a = r * mrow[k] * c;
+                }
+            }
+        }
+        if self.has_base {
+            // a = e_k: column k of the base; a = -M'[:, k] or -d': minus the base times it
+            if var < n {
+                for (o, brow) in out.iter_mut().zip(self.base.chunks_exact(n)) {
+                    *o = brow[var];
+                }
+            } else {
+                for (o, brow) in out.iter_mut().zip(self.base.chunks_exact(n)) {
+                    *o = -dot(brow, &self.acol);
+                }
+            }
+        } else if var < n {
+            out.iter_mut().for_each(|v| *v = 0.0);
+            out[var] = 1.0;
+        } else {
+            for (o, v) in out.iter_mut().zip(&self.acol) {
+                *o = -v;
+            }
+        }
+        self.apply_etas(&mut out);
+        self.column = out;
+    }
+
+    /// row i of B^{-1} into `self.scratch`.
+    #[inline(always)]
+    fn inverse_row(&mut self, i: usize) {
+        let n = self.n;
+        let mut y = std::mem::take(&mut self.scratch);
+        y.iter_mut().for_each(|v| *v = 0.0);
+        y[i] = 1.0;
+        for j in (0..self.count).rev() {
+            let r = self.eta_rows[j];
+            y[r] += dot(&y, &self.etas[j * n..(j + 1) * n]);
+        }
+        if self.has_base {
+            // y^T B_0^{-1}: the base's rows weighted by y (the ratios are free here: the ratio
+            // test has read them before it breaks ties)
+            let mut out = std::mem::take(&mut self.ratios);
+            out.iter_mut().for_each(|v| *v = 0.0);
+            for (yk, brow) in y.iter().zip(self.base.chunks_exact(n)) {
+                if *yk != 0.0 {
+                    axpy(&mut out, *yk, brow);
+                }
+            }
+            y.copy_from_slice(&out);
+            self.ratios = out;
+        }
+        self.scratch = y;
+    }
+
+    /// Keeps, among `self.ties`, the rows whose lexicographic ratio `B^{-1}[i, :] / f_i` is
+    /// smallest (`sign` +1), or largest (`sign` -1, the initial maximum-ratio test).
+    #[inline(always)]
+    fn lexicographic(&mut self, sign: f64) -> Option<usize> {
+        let n = self.n;
+        let k = self.ties.len();
+        if k > LEX_ROWS {
+            // more tied rows than the storage holds: the caller treats this as a breakdown
+            // (under Auto the path is re-run on the tableau)
+            return None;
+        }
+        for t in 0..k {
+            let i = self.ties[t];
+            self.inverse_row(i);
+            self.lex_rows[t * n..(t + 1) * n].copy_from_slice(&self.scratch);
+            self.lex_index[i] = t;
+        }
+        // Rounding leaves ~1e-16 where exact arithmetic has 0, so entries are compared at the
+        // scale of the tied rows' whole lexicographic vectors, not entry by entry.
+        let mut scale: f64 = 0.0;
+        for t in 0..k {
+            let f = self.column[self.ties[t]];
+            for v in &self.lex_rows[t * n..(t + 1) * n] {
+                scale = scale.max((v / f).abs());
+            }
+        }
+        if !scale.is_finite() {
+            return None;
+        }
+        let tol = TIE_EPS * scale;
+        for col in 0..n {
+            if self.ties.len() <= 1 {
+                break;
+            }
+            let mut best = f64::INFINITY;
+            for &i in &self.ties {
+                let v = self.lex_rows[self.lex_index[i] * n + col];
+                best = best.min(sign * v / self.column[i]);
+            }
+            self.ties_next.clear();
+            for &i in &self.ties {
+                let v = self.lex_rows[self.lex_index[i] * n + col];
+                if sign * v / self.column[i] <= best + tol {
+                    self.ties_next.push(i);
+                }
+            }
+            if self.ties_next.is_empty() {
+                return None;
+            }
+            std::mem::swap(&mut self.ties, &mut self.ties_next);
+        }
+        // Exact arithmetic leaves one row; with rounding, prefer the largest pivot.
+        let mut pick = *self.ties.first()?;
+        for &i in &self.ties {
+            if self.column[i].abs() > self.column[pick].abs() {
+                pick = i;
+            }
+        }
+        Some(pick)
+    }
+
+    /// the blocking row when the variable in `self.column` enters.
+    #[inline(always)]
+    fn ratio_test(&mut self) -> Result<Option<usize>, ()> {
+        let colmax = max_abs(&self.column);
+        let rhsmax = max_abs(&self.values).max(1.0);
+        if !(colmax.is_finite() && rhsmax.is_finite()) {
+            return Err(());
+        }
+        let piv_tol = PIVOT_EPS * colmax.max(1.0);
+        let zero_rhs = RHS_EPS * rhsmax;
+        let theta = kernel::min_ratio(
+            &self.column,
+            &mut self.values,
+            &mut self.ratios,
+            piv_tol,
+            zero_rhs,
+        );
+        if theta == f64::INFINITY {
+            return Ok(None);
+        }
+        let bound = theta + TIE_EPS * theta;
+        self.ties.clear();
+        let z0 = self.z0();
+        for (i, t) in self.ratios.iter().enumerate() {
+            if *t <= bound {
+                if self.basic[i] == z0 {
+                    return Ok(Some(i));
+                }
+                self.ties.push(i);
+            }
+        }
+        match self.ties.len() {
+            0 => Err(()),
+            1 => Ok(Some(self.ties[0])),
+            _ => self.lexicographic(1.0).map(Some).ok_or(()),
+        }
+    }
+
+    /// the row that leaves when z0 first enters: the one needing the largest z0.
+    #[inline(always)]
+    fn initial_row(&mut self) -> Option<usize> {
+        let n = self.n;
+        let mut theta = f64::NEG_INFINITY;
+        for (b, f) in self.values.iter().zip(&self.column) {
+            theta = theta.max(b / f);
+        }
+        if !theta.is_finite() {
+            return None;
+        }
+        let tie = TIE_EPS * theta.abs().max(1e-12);
+        self.ties.clear();
+        for i in 0..n {
+            if self.values[i] / self.column[i] >= theta - tie {
+                self.ties.push(i);
+            }
+        }
+        match self.ties.len() {
+            0 => None,
+            1 => Some(self.ties[0]),
+            _ => self.lexicographic(-1.0),
+        }
+    }
+
+    /// `x <- E_p ⋯ E_1 x`, ETA_BLOCK etas at a time: the block's multipliers
+    /// `t_a = x[r_a]` (as updated by the block's earlier etas) come first from a tiny
+    /// triangular recurrence, then one pass over x adds `Σ_a t_a η̃_a`, so x is read and
+    /// written once per block instead of once per eta.
+    #[inline(always)]
+    fn apply_etas(&self, x: &mut [f64]) {
+        let n = self.n;
+        let p = self.count;
+        let mut j = 0;
+        while j + ETA_BLOCK <= p {
+            let mut t = [0.0f64; ETA_BLOCK];
+            let mut any = false;
+            for a in 0..ETA_BLOCK {
+                let r = self.eta_rows[j + a];
+                let mut v = x[r];
+                for (b, tb) in t.iter().enumerate().take(a) {
+                    v += tb * self.etas[(j + b) * n + r];
+                }
+                t[a] = v;
+                any |= v != 0.0;
+            }
+            if any {
+                let block = &self.etas[j * n..(j + ETA_BLOCK) * n];
+                let (e0, rest) = block.split_at(n);
+                let (e1, rest) = rest.split_at(n);
+                let (e2, rest) = rest.split_at(n);
+                let (e3, rest) = rest.split_at(n);
+                let (e4, rest) = rest.split_at(n);
+                let (e5, rest) = rest.split_at(n);
+                let (e6, e7) = rest.split_at(n);
+                // equal lengths let the compiler drop the bounds checks and vectorize
+                let len = x.len();
+                let (e0, e1, e2, e3) = (&e0[..len], &e1[..len], &e2[..len], &e3[..len]);
+                let (e4, e5, e6, e7) = (&e4[..len], &e5[..len], &e6[..len], &e7[..len]);
+                for (i, xi) in x.iter_mut().enumerate() {
+                    *xi += t[0] * e0[i]
+                        + t[1] * e1[i]
+                        + t[2] * e2[i]
+                        + t[3] * e3[i]
+                        + t[4] * e4[i]
+                        + t[5] * e5[i]
+                        + t[6] * e6[i]
+                        + t[7] * e7[i];
+                }
+            }
+            j += ETA_BLOCK;
+        }
+        for k in j..p {
+            let t = x[self.eta_rows[k]];
+            if t != 0.0 {
+                axpy(x, t, &self.etas[k * n..(k + 1) * n]);
+            }
+        }
+    }
+
+    /// folds the eta file into the explicit inverse, `B_0^{-1} <- E_p ⋯ E_1 B_0^{-1}`: per
+    /// block of etas, the rows they read are brought up to date by the block's earlier etas,
+    /// then one rank-k product applies the block (`X += H̃^T R`).
+    fn fold(&mut self) {
+        let n = self.n;
+        if !self.has_base {
+            if self.base.len() != n * n {
+                self.base = vec![0.0; n * n];
+            }
+            self.base.iter_mut().for_each(|v| *v = 0.0);
+            for i in 0..n {
+                self.base[i * n + i] = 1.0;
+            }
+            self.has_base = true;
+        }
+        if self.fold_rows.len() != FOLD_BLOCK * n {
+            self.fold_rows = vec![0.0; FOLD_BLOCK * n];
+        }
+        let mut j = 0;
+        while j < self.count {
+            let k = FOLD_BLOCK.min(self.count - j);
+            for a in 0..k {
+                let r = self.eta_rows[j + a];
+                let (done, row) = self.fold_rows.split_at_mut(a * n);
+                let row = &mut row[..n];
+                row.copy_from_slice(&self.base[r * n..(r + 1) * n]);
+                for b in 0..a {
+                    let c = self.etas[(j + b) * n + r];
+                    if c != 0.0 {
+                        axpy(row, c, &done[b * n..(b + 1) * n]);
+                    }
+                }
+            }
+            let dst = faer::MatMut::from_row_major_slice_mut(&mut self.base, n, n);
+            let ht = faer::MatRef::from_row_major_slice(&self.etas[j * n..(j + k) * n], k, n)
+                .transpose();
+            let rows = faer::MatRef::from_row_major_slice(&self.fold_rows[..k * n], k, n);
+            faer::linalg::matmul::matmul(dst, faer::Accum::Add, ht, rows, 1.0, faer::Par::Seq);
+            j += k;
+        }
+        self.count = 0;
+    }
+
+    /// exchanges the basic variable of row r with `entering`, whose column is `self.column`.
+    #[inline(always)]
+    fn pivot(&mut self, r: usize, entering: usize) -> bool {
+        let n = self.n;
+        if self.count == self.cap {
+            self.fold();
+        }
+        let piv = self.column[r];
+        let inv = 1.0 / piv;
+        let j = self.count;
+        let eta = &mut self.etas[j * n..(j + 1) * n];
+        for (e, f) in eta.iter_mut().zip(&self.column) {
+            *e = -f * inv;
+        }
+        // η̃ = η - e_r: applying E is then x += x_r η̃
+        eta[r] = inv - 1.0;
+        self.eta_rows[j] = r;
+        self.count += 1;
+        let t = self.values[r];
+        axpy(&mut self.values, t, &self.etas[j * n..(j + 1) * n]);
+        let leaving = self.basic[r];
+        self.basic[r] = entering;
+        self.row_of[entering] = r;
+        self.row_of[leaving] = usize::MAX;
+        inv.is_finite() && self.values[r].is_finite()
+    }
+
+    /// Runs the complementary pivots from the all-w basis, compiled for the CPU's vector
+    /// instructions. Returns how it ended and the pivots.
+    pub(super) fn run(
+        &mut self,
+        lcp: &LcpRef<'_>,
+        eq: &Equilibration,
+        max_pivots: usize,
+    ) -> (PathEnd, usize) {
+        kernel::dispatch!(self.isa, (PathEnd, usize), || self
+            .run_body(lcp, eq, max_pivots))
+    }
+
+    #[inline(always)]
+    fn run_body(
+        &mut self,
+        lcp: &LcpRef<'_>,
+        eq: &Equilibration,
+        max_pivots: usize,
+    ) -> (PathEnd, usize) {
+        let z0 = self.z0();
+        self.column_of(lcp, eq, z0);
+        let Some(r) = self.initial_row() else {
+            return (PathEnd::NonFinite, 0);
+        };
+        let mut leaving = self.basic[r];
+        if !self.pivot(r, z0) {
+            return (PathEnd::NonFinite, 1);
+        }
+        let mut pivots = 1;
+        loop {
+            if leaving == z0 {
+                return (PathEnd::Terminal, pivots);
+            }
+            if pivots >= max_pivots {
+                return (PathEnd::Limit, pivots);
+            }
+            let entering = self.complement(leaving);
+            if self.row_of[entering] != usize::MAX {
+                // cannot happen: the complement of a variable that just left is nonbasic
+                return (PathEnd::NonFinite, pivots);
+            }
+            self.column_of(lcp, eq, entering);
+            let r = match self.ratio_test() {
+                Ok(Some(r)) => r,
+                Ok(None) => return (PathEnd::Ray, pivots),
+                Err(()) => return (PathEnd::NonFinite, pivots),
+            };
+            leaving = self.basic[r];
+            pivots += 1;
+            if !self.pivot(r, entering) {
+                return (PathEnd::NonFinite, pivots);
+            }
+        }
+    }
+
+    /// One step of iterative refinement of the basic values on the equilibrated data,
+    /// `x_B <- x_B + B^{-1} (q' - B x_B)`: the residual is formed from M itself (the basic
+    /// z columns of M', the basic w's unit columns, z0's d') and `B^{-1}` is applied through
+    /// the eta file (O(n p)). This re-solves the final basis's system against the original
+    /// data at the cost of one pivot's column, where a fresh factorization of the principal
+    /// block would cost O(k^3).
+    pub(super) fn refine(&mut self, lcp: &LcpRef<'_>, eq: &Equilibration) {
+        let isa = self.isa;
+        kernel::dispatch!(isa, (), || self.refine_body(lcp, eq))
+    }
+
+    #[inline(always)]
+    fn refine_body(&mut self, lcp: &LcpRef<'_>, eq: &Equilibration) {
+        let n = self.n;
+        // z' of the basis, in the scratch vector (z' = 0 off the basis)
+        let mut zb = std::mem::take(&mut self.scratch);
+        zb.iter_mut().for_each(|v| *v = 0.0);
+        let mut z0 = 0.0;
+        for i in 0..n {
+            let var = self.basic[i];
+            if var >= n && var < 2 * n {
+                zb[var - n] = self.values[i];
+            } else if var == 2 * n {
+                z0 = self.values[i];
+            }
+        }
+        // residual q' - B x_B: row i of M' z' is r_i Σ_k M_ik c_k z'_k
+        let mut res = std::mem::take(&mut self.acol);
+        for (k, v) in zb.iter_mut().enumerate() {
+            *v *= eq.col[k];
+        }
+        for (i, mrow) in lcp.m.chunks_exact(n).enumerate() {
+            let mz = eq.row[i] * dot(mrow, &zb);
+            res[i] = eq.row[i] * lcp.q[i] / eq.sigma + mz + self.cover[i] * z0;
+        }
+        for i in 0..n {
+            let var = self.basic[i];
+            if var < n {
+                res[var] -= self.values[i];
+            }
+        }
+        let mut delta = std::mem::take(&mut self.column);
+        if self.has_base {
+            for (o, brow) in delta.iter_mut().zip(self.base.chunks_exact(n)) {
+                *o = dot(brow, &res);
+            }
+        } else {
+            delta.copy_from_slice(&res);
+        }
+        self.apply_etas(&mut delta);
+        for (v, d) in self.values.iter_mut().zip(&delta) {
+            *v += d;
+        }
+        self.column = delta;
+        self.acol = res;
+        self.scratch = zb;
+    }
+
+    /// z in original units from the current basis (z0 ignored), and the basic z indices.
+    pub(super) fn extract(&self, eq: &Equilibration, z: &mut [f64], basis: &mut Vec<usize>) {
+        let n = self.n;
+        z.iter_mut().for_each(|v| *v = 0.0);
+        basis.clear();
+        for i in 0..n {
+            let var = self.basic[i];
+            if var >= n && var < 2 * n {
+                let k = var - n;
+                z[k] = eq.sigma * eq.col[k] * self.values[i].max(0.0);
+                basis.push(k);
+            }
+        }
+        basis.sort_unstable();
+    }
+}
+
+/// `Σ a_i b_i` with eight partial sums (one vector register, no sequential chain).
+#[inline(always)]
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let mut acc = [0.0f64; 8];
+    let split = a.len().min(b.len()) / 8 * 8;
+    for (ca, cb) in a[..split].chunks_exact(8).zip(b[..split].chunks_exact(8)) {
+        for k in 0..8 {
+            acc[k] += ca[k] * cb[k];
+        }
+    }
+    let mut d: f64 = acc.iter().sum();
+    for (x, y) in a[split..].iter().zip(&b[split..]) {
+        d += x * y;
+    }
+    d
+}
+
+/// `max_i |x_i|` with eight running maxima; NaN if any entry is not finite (x * 0 is NaN
+/// exactly for NaN and infinite x, and the sum keeps it).
+#[inline(always)]
+fn max_abs(x: &[f64]) -> f64 {
+    let mut lanes = [0.0f64; 8];
+    let mut finite = [0.0f64; 8];
+    let split = x.len() / 8 * 8;
+    for c in x[..split].chunks_exact(8) {
+        for k in 0..8 {
+            let v = c[k].abs();
+            lanes[k] = if v > lanes[k] { v } else { lanes[k] };
+            finite[k] += c[k] * 0.0;
+        }
+    }
+    let mut m = lanes
+        .iter()
+        .fold(0.0f64, |m, v| if *v > m { *v } else { m });
+    let mut check: f64 = finite.iter().sum();
+    for v in &x[split..] {
+        let a = v.abs();
+        m = if a > m { a } else { m };
+        check += v * 0.0;
+    }
+    m + check
+}
