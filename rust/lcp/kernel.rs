@@ -146,6 +146,28 @@ pub fn max_abs_scaled(x: &[f64], s: &[f64]) -> f64 {
     m
 }
 
+/// `max_j |x_j|` with eight running maxima (a single running maximum is a sequential chain
+/// the compiler will not vectorize).
+#[inline(always)]
+pub fn max_abs(x: &[f64]) -> f64 {
+    let mut lanes = [0.0f64; 8];
+    let split = x.len() / 8 * 8;
+    for c in x[..split].chunks_exact(8) {
+        for k in 0..8 {
+            let v = c[k].abs();
+            lanes[k] = if v > lanes[k] { v } else { lanes[k] };
+        }
+    }
+    let mut m = lanes
+        .iter()
+        .fold(0.0f64, |m, v| if *v > m { *v } else { m });
+    for a in &x[split..] {
+        let v = a.abs();
+        m = if v > m { v } else { m };
+    }
+    m
+}
+
 /// The minimum-ratio step of Lemke's ratio test, branch-free so it runs as vector
 /// instructions: zeroes the basic values `b_i <= zero` (degenerate rows), writes
 /// `t_i = b_i / f_i` for the blocking rows `f_i > piv_tol` (infinity for the others) and
@@ -201,5 +223,7 @@ mod tests {
             .map(|(a, b)| (a * b).abs())
             .fold(0.0, f64::max);
         assert_eq!(m, want);
+        let a = dispatch!(detect(), f64, || max_abs(&x));
+        assert_eq!(a, x.iter().fold(0.0, |m: f64, v| m.max(v.abs())));
     }
 }

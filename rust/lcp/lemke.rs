@@ -316,8 +316,8 @@ impl LemkeWorkspace {
         let mut column = std::mem::take(&mut self.column);
         self.gather_column(s, &mut column);
         self.column = column;
-        let colmax = self.column.iter().fold(0.0f64, |m, a| m.max(a.abs()));
-        let rhsmax = self.values.iter().fold(1.0f64, |m, b| m.max(b.abs()));
+        let colmax = kernel::max_abs(&self.column);
+        let rhsmax = kernel::max_abs(&self.values).max(1.0);
         if !(colmax.is_finite() && rhsmax.is_finite()) {
             return Blocking::NonFinite;
         }
@@ -487,6 +487,55 @@ impl LemkeWorkspace {
                 return (Ending::NonFinite, pivots);
             }
         }
+    }
+
+    /// One step of iterative refinement of a terminal answer z (z0 nonbasic) on the original
+    /// data. With a the basic z's (the rows whose w is nonbasic) and `r = M_aa z_a + q_a`,
+    ///
+    /// ```text
+    ///     z_a <- z_a - M_aa^{-1} r,   M_aa^{-1} = D_c (M'_aa)^{-1} D_r,
+    /// ```
+    ///
+    /// and `-(M'_aa)^{-1}` is the block of `B^{-1}` the tableau holds in the columns of the
+    /// nonbasic w's (rows of the basic z's), so a step costs `O(|a| n)`, no factorization.
+    /// Returns false (z unchanged) when z0 is still basic.
+    #[inline(always)]
+    fn refine_body(&mut self, lcp: &LcpRef<'_>, eq: &Equilibration, z: &mut [f64]) -> bool {
+        let (n, w) = (self.n, self.width);
+        if matches!(self.loc[self.z0()], Loc::Row(_)) {
+            return false;
+        }
+        self.flush();
+        // the basic z's, and `D_r r` scattered onto the columns of the nonbasic w's
+        self.ties.clear();
+        for j in 0..n {
+            if matches!(self.loc[n + j], Loc::Row(_)) {
+                self.ties.push(j);
+            }
+        }
+        self.row.iter_mut().for_each(|v| *v = 0.0);
+        for k in 0..n {
+            if let Loc::Col(c) = self.loc[k] {
+                let mrow = &lcp.m[k * n..(k + 1) * n];
+                let mut s = lcp.q[k];
+                for &j in &self.ties {
+                    s += mrow[j] * z[j];
+                }
+                self.row[c] = eq.row[k] * s;
+            }
+        }
+        for &j in &self.ties {
+            if let Loc::Row(i) = self.loc[n + j] {
+                let d = kernel::dot_and_abs(&self.tableau[i * w..(i + 1) * w], &self.row).0;
+                z[j] = (z[j] + eq.col[j] * d).max(0.0);
+            }
+        }
+        true
+    }
+
+    /// [`Self::refine_body`] compiled for the CPU's vector instructions.
+    fn refine(&mut self, lcp: &LcpRef<'_>, eq: &Equilibration, z: &mut [f64]) -> bool {
+        kernel::dispatch!(self.isa, bool, || self.refine_body(lcp, eq, z))
     }
 
     /// z in original units from the current basis (z0 ignored), and the basic z indices.
@@ -681,8 +730,17 @@ pub fn solve_lemke_with(
         ws.extract(&eq, &mut z, &mut basis);
         // The polished answer is usually the better one: when it passes, the tableau's answer
         // need not be evaluated at all.
+        // The tableau holds the terminal basis's inverse: one refinement step on the original
+        // data usually reaches the principal solution; the factorization is the fallback.
         let polished_answer = if ending == Ending::Terminal && settings.polish {
-            principal(lcp, &eq, &basis)
+            let mut zr = z.clone();
+            match ws
+                .refine(lcp, &eq, &mut zr)
+                .then(|| candidate(lcp, &eq, zr))
+            {
+                Some(c) if passes(&c.measures, tol) => Some(c),
+                _ => principal(lcp, &eq, &basis),
+            }
         } else {
             None
         };
