@@ -404,9 +404,10 @@ impl LemkeWorkspace {
         let (n, w) = (self.n, self.width);
         let piv = self.column[r];
         // column s now stands for the leaving variable, whose column is e_r
-        for (i, row) in self.tableau.chunks_exact_mut(w).enumerate() {
-            row[s] += if i == r { 1.0 } else { 0.0 } - self.column[i];
+        for (row, f) in self.tableau.chunks_exact_mut(w).zip(&self.column) {
+            row[s] -= f;
         }
+        self.tableau[r * w + s] += 1.0;
         // the pivot row of the current tableau
         self.row.copy_from_slice(&self.tableau[r * w..(r + 1) * w]);
         for p in 0..self.pending {
