@@ -527,7 +527,7 @@ impl LemkeWorkspace {
         }
         for &j in &self.ties {
             if let Loc::Row(i) = self.loc[n + j] {
-                let d = kernel::dot_and_abs(&self.tableau[i * w..(i + 1) * w], &self.row).0;
+                let d = kernel::dot(&self.tableau[i * w..(i + 1) * w], &self.row);
                 z[j] = (z[j] + eq.col[j] * d).max(0.0);
             }
         }
