@@ -506,7 +506,6 @@ impl LemkeWorkspace {
         if matches!(self.loc[self.z0()], Loc::Row(_)) {
             return false;
         }
-        self.flush();
         // the basic z's, and `D_r r` scattered onto the columns of the nonbasic w's
         self.ties.clear();
         for j in 0..n {
@@ -525,9 +524,16 @@ impl LemkeWorkspace {
                 self.row[c] = eq.row[k] * s;
             }
         }
+        // the pending updates enter as (T + U^T V) s = T s + U^T (V s): no flush needed
+        for p in 0..self.pending {
+            self.ratios[p] = kernel::dot(&self.pending_v[p * w..(p + 1) * w], &self.row);
+        }
         for &j in &self.ties {
             if let Loc::Row(i) = self.loc[n + j] {
-                let d = kernel::dot(&self.tableau[i * w..(i + 1) * w], &self.row);
+                let mut d = kernel::dot(&self.tableau[i * w..(i + 1) * w], &self.row);
+                for p in 0..self.pending {
+                    d += self.pending_u[p * n + i] * self.ratios[p];
+                }
                 z[j] = (z[j] + eq.col[j] * d).max(0.0);
             }
         }
