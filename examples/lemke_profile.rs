@@ -1,12 +1,18 @@
-//! Repeats one Lemke solve for profiling: `cargo run --release --example lemke_profile N REPS`.
+//! Repeats one Lemke solve for profiling:
+//! `cargo run --release --example lemke_profile N REPS [polish|nopolish] [spd|psd]`.
 use coulomb::lcp::{solve_lemke_with, LcpRef, LemkeSettings, LemkeWorkspace};
-use coulomb::testing::dense_spd;
+use coulomb::testing::{dense_spd, planted_psd};
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
     let n: usize = args.next().and_then(|a| a.parse().ok()).unwrap_or(100);
     let reps: usize = args.next().and_then(|a| a.parse().ok()).unwrap_or(1000);
     let polish = args.next().is_none_or(|a| a != "nopolish");
-    let (m, q) = dense_spd(n, n as u64);
+    let (m, q) = if args.next().is_some_and(|a| a == "psd") {
+        let (m, q, _, _) = planted_psd(n, n / 2, 1);
+        (m, q)
+    } else {
+        dense_spd(n, n as u64)
+    };
     let lcp = LcpRef::new(n, &m.data, &q)?;
     let s = LemkeSettings {
         polish,

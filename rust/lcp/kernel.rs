@@ -101,27 +101,53 @@ pub fn axpy(y: &mut [f64], a: f64, x: &[f64]) {
 }
 
 /// `(Σ_j a_j b_j, Σ_j |a_j b_j|)` with eight partial sums, so the compiler can keep them in
-/// one vector register (a single running sum forces sequential adds).
+/// one vector register (a single running sum forces sequential adds). The two sums are two
+/// passes: fused into one loop, the shared product defeats the vectorizer (it emits scalar
+/// multiplies), and the second pass reads data the first left in L1.
 #[inline(always)]
 pub fn dot_and_abs(a: &[f64], b: &[f64]) -> (f64, f64) {
+    let n = a.len().min(b.len());
+    let (a, b) = (&a[..n], &b[..n]);
     let mut dot = [0.0f64; 8];
-    let mut abs = [0.0f64; 8];
-    let split = a.len().min(b.len()) / 8 * 8;
-    for (ca, cb) in a[..split].chunks_exact(8).zip(b[..split].chunks_exact(8)) {
+    for (x, y) in a.chunks_exact(8).zip(b.chunks_exact(8)) {
         for k in 0..8 {
-            let t = ca[k] * cb[k];
-            dot[k] += t;
-            abs[k] += t.abs();
+            dot[k] += x[k] * y[k];
+        }
+    }
+    let mut abs = [0.0f64; 8];
+    for (x, y) in a.chunks_exact(8).zip(b.chunks_exact(8)) {
+        for k in 0..8 {
+            abs[k] += (x[k] * y[k]).abs();
         }
     }
     let mut d: f64 = dot.iter().sum();
     let mut s: f64 = abs.iter().sum();
+    let split = n / 8 * 8;
     for (x, y) in a[split..].iter().zip(&b[split..]) {
         let t = x * y;
         d += t;
         s += t.abs();
     }
     (d, s)
+}
+
+/// `Σ_j a_j b_j` with eight partial sums (see [`dot_and_abs`]).
+#[inline(always)]
+pub fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    let (a, b) = (&a[..n], &b[..n]);
+    let mut acc = [0.0f64; 8];
+    for (x, y) in a.chunks_exact(8).zip(b.chunks_exact(8)) {
+        for k in 0..8 {
+            acc[k] += x[k] * y[k];
+        }
+    }
+    let mut d: f64 = acc.iter().sum();
+    let split = n / 8 * 8;
+    for (x, y) in a[split..].iter().zip(&b[split..]) {
+        d += x * y;
+    }
+    d
 }
 
 /// `max_j |x_j s_j|` with eight running maxima (one vector register; a single running
@@ -144,6 +170,32 @@ pub fn max_abs_scaled(x: &[f64], s: &[f64]) -> f64 {
         m = if v > m { v } else { m };
     }
     m
+}
+
+/// `max_i |x_i|` with eight running maxima; NaN if any entry is not finite (x * 0 is NaN
+/// exactly for NaN and infinite x, and the sum keeps it).
+#[inline(always)]
+pub fn max_abs(x: &[f64]) -> f64 {
+    let mut lanes = [0.0f64; 8];
+    let mut finite = [0.0f64; 8];
+    let split = x.len() / 8 * 8;
+    for c in x[..split].chunks_exact(8) {
+        for k in 0..8 {
+            let v = c[k].abs();
+            lanes[k] = if v > lanes[k] { v } else { lanes[k] };
+            finite[k] += c[k] * 0.0;
+        }
+    }
+    let mut m = lanes
+        .iter()
+        .fold(0.0f64, |m, v| if *v > m { *v } else { m });
+    let mut check: f64 = finite.iter().sum();
+    for v in &x[split..] {
+        let a = v.abs();
+        m = if a > m { a } else { m };
+        check += v * 0.0;
+    }
+    m + check
 }
 
 /// The minimum-ratio step of Lemke's ratio test, branch-free so it runs as vector
@@ -201,5 +253,13 @@ mod tests {
             .map(|(a, b)| (a * b).abs())
             .fold(0.0, f64::max);
         assert_eq!(m, want);
+        let (d, s_abs) = dispatch!(detect(), (f64, f64), || dot_and_abs(&x, &s));
+        let d1 = dispatch!(detect(), f64, || dot(&x, &s));
+        let want_d: f64 = x.iter().zip(&s).map(|(a, b)| a * b).sum();
+        let want_s: f64 = x.iter().zip(&s).map(|(a, b)| (a * b).abs()).sum();
+        assert!((d - want_d).abs() < 1e-13 && (s_abs - want_s).abs() < 1e-13);
+        assert_eq!(d, d1);
+        let a = dispatch!(detect(), f64, || max_abs(&x));
+        assert_eq!(a, x.iter().fold(0.0, |m: f64, v| m.max(v.abs())));
     }
 }

@@ -355,8 +355,8 @@ impl LemkeWorkspace {
         let mut column = std::mem::take(&mut self.column);
         self.gather_column(s, &mut column);
         self.column = column;
-        let colmax = self.column.iter().fold(0.0f64, |m, a| m.max(a.abs()));
-        let rhsmax = self.values.iter().fold(1.0f64, |m, b| m.max(b.abs()));
+        let colmax = kernel::max_abs(&self.column);
+        let rhsmax = kernel::max_abs(&self.values).max(1.0);
         if !(colmax.is_finite() && rhsmax.is_finite()) {
             return Blocking::NonFinite;
         }
@@ -443,9 +443,10 @@ impl LemkeWorkspace {
         let (n, w) = (self.n, self.width);
         let piv = self.column[r];
         // column s now stands for the leaving variable, whose column is e_r
-        for (i, row) in self.tableau.chunks_exact_mut(w).enumerate() {
-            row[s] += if i == r { 1.0 } else { 0.0 } - self.column[i];
+        for (row, f) in self.tableau.chunks_exact_mut(w).zip(&self.column) {
+            row[s] -= f;
         }
+        self.tableau[r * w + s] += 1.0;
         // the pivot row of the current tableau
         self.row.copy_from_slice(&self.tableau[r * w..(r + 1) * w]);
         for p in 0..self.pending {
@@ -526,6 +527,61 @@ impl LemkeWorkspace {
                 return (Ending::NonFinite, pivots);
             }
         }
+    }
+
+    /// One step of iterative refinement of a terminal answer z (z0 nonbasic) on the original
+    /// data. With a the basic z's (the rows whose w is nonbasic) and `r = M_aa z_a + q_a`,
+    ///
+    /// ```text
+    ///     z_a <- z_a - M_aa^{-1} r,   M_aa^{-1} = D_c (M'_aa)^{-1} D_r,
+    /// ```
+    ///
+    /// and `-(M'_aa)^{-1}` is the block of `B^{-1}` the tableau holds in the columns of the
+    /// nonbasic w's (rows of the basic z's), so a step costs `O(|a| n)`, no factorization.
+    /// Returns false (z unchanged) when z0 is still basic.
+    #[inline(always)]
+    fn refine_body(&mut self, lcp: &LcpRef<'_>, eq: &Equilibration, z: &mut [f64]) -> bool {
+        let (n, w) = (self.n, self.width);
+        if matches!(self.loc[self.z0()], Loc::Row(_)) {
+            return false;
+        }
+        // the basic z's, and `D_r r` scattered onto the columns of the nonbasic w's
+        self.ties.clear();
+        for j in 0..n {
+            if matches!(self.loc[n + j], Loc::Row(_)) {
+                self.ties.push(j);
+            }
+        }
+        self.row.iter_mut().for_each(|v| *v = 0.0);
+        for k in 0..n {
+            if let Loc::Col(c) = self.loc[k] {
+                let mrow = &lcp.m[k * n..(k + 1) * n];
+                let mut s = lcp.q[k];
+                for &j in &self.ties {
+                    s += mrow[j] * z[j];
+                }
+                self.row[c] = eq.row[k] * s;
+            }
+        }
+        // the pending updates enter as (T + U^T V) s = T s + U^T (V s): no flush needed
+        for p in 0..self.pending {
+            self.ratios[p] = kernel::dot(&self.pending_v[p * w..(p + 1) * w], &self.row);
+        }
+        for &j in &self.ties {
+            if let Loc::Row(i) = self.loc[n + j] {
+                let mut d = kernel::dot(&self.tableau[i * w..(i + 1) * w], &self.row);
+                for p in 0..self.pending {
+                    d += self.pending_u[p * n + i] * self.ratios[p];
+                }
+                z[j] = (z[j] + eq.col[j] * d).max(0.0);
+            }
+        }
+        true
+    }
+
+    /// [`Self::refine_body`] compiled for the CPU's vector instructions.
+    fn refine(&mut self, lcp: &LcpRef<'_>, eq: &Equilibration, z: &mut [f64]) -> bool {
+        kernel::dispatch!(self.isa, bool, || self.refine_body(lcp, eq, z))
     }
 
     /// z in original units from the current basis (z0 ignored), and the basic z indices.
@@ -769,25 +825,27 @@ pub fn solve_lemke_with(
         }
         out.pivots += pivots;
         out.restarts = attempt;
-        // On the product form one refinement step through the eta file usually brings the
-        // answer to rounding level at the cost of one pivot's column; the principal system
-        // is factorized afresh only when that answer fails. The polished answer is usually
-        // the better one: when it passes, the path's own answer need not be evaluated.
-        let refined = if ending == Ending::Terminal && settings.polish && on_product_form {
-            let pf = &mut ws.product_form;
-            pf.refine(lcp, &eq);
-            let mut zr = vec![0.0; n];
-            let mut br = Vec::with_capacity(basis.len());
-            pf.extract(&eq, &mut zr, &mut br);
-            let c = candidate(lcp, &eq, zr);
-            passes(&c.measures, tol).then_some(c)
-        } else {
-            None
-        };
-        let polished_answer = if refined.is_some() {
-            refined
-        } else if ending == Ending::Terminal && settings.polish {
-            principal(lcp, &eq, &basis)
+        // One refinement step on the original data through the basis inverse the path
+        // already holds (the eta file, or the tableau's block) usually brings the answer to
+        // rounding level; the principal system is factorized afresh only when that answer
+        // fails. When the polished answer passes, the path's own need not be evaluated.
+        let polished_answer = if ending == Ending::Terminal && settings.polish {
+            let refined = if on_product_form {
+                let pf = &mut ws.product_form;
+                pf.refine(lcp, &eq);
+                let mut zr = vec![0.0; n];
+                let mut br = Vec::with_capacity(basis.len());
+                pf.extract(&eq, &mut zr, &mut br);
+                Some(candidate(lcp, &eq, zr))
+            } else {
+                let mut zr = z.clone();
+                ws.refine(lcp, &eq, &mut zr)
+                    .then(|| candidate(lcp, &eq, zr))
+            };
+            match refined {
+                Some(c) if passes(&c.measures, tol) => Some(c),
+                _ => principal(lcp, &eq, &basis),
+            }
         } else {
             None
         };

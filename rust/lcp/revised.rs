@@ -186,7 +186,7 @@ impl RevisedLemke {
                 }
             } else {
                 for (o, brow) in out.iter_mut().zip(self.base.chunks_exact(n)) {
-                    *o = -dot(brow, &self.acol);
+                    *o = -kernel::dot(brow, &self.acol);
                 }
             }
         } else if var < n {
@@ -210,7 +210,7 @@ impl RevisedLemke {
         y[i] = 1.0;
         for j in (0..self.count).rev() {
             let r = self.eta_rows[j];
-            y[r] += dot(&y, &self.etas[j * n..(j + 1) * n]);
+            y[r] += kernel::dot(&y, &self.etas[j * n..(j + 1) * n]);
         }
         if self.has_base {
             // y^T B_0^{-1}: the base's rows weighted by y (the ratios are free here: the ratio
@@ -292,8 +292,8 @@ impl RevisedLemke {
     /// the blocking row when the variable in `self.column` enters.
     #[inline(always)]
     fn ratio_test(&mut self) -> Result<Option<usize>, ()> {
-        let colmax = max_abs(&self.column);
-        let rhsmax = max_abs(&self.values).max(1.0);
+        let colmax = kernel::max_abs(&self.column);
+        let rhsmax = kernel::max_abs(&self.values).max(1.0);
         if !(colmax.is_finite() && rhsmax.is_finite()) {
             return Err(());
         }
@@ -564,7 +564,7 @@ impl RevisedLemke {
             *v *= eq.col[k];
         }
         for (i, mrow) in lcp.m.chunks_exact(n).enumerate() {
-            let mz = eq.row[i] * dot(mrow, &zb);
+            let mz = eq.row[i] * kernel::dot(mrow, &zb);
             res[i] = eq.row[i] * lcp.q[i] / eq.sigma + mz + self.cover[i] * z0;
         }
         for i in 0..n {
@@ -576,7 +576,7 @@ impl RevisedLemke {
         let mut delta = std::mem::take(&mut self.column);
         if self.has_base {
             for (o, brow) in delta.iter_mut().zip(self.base.chunks_exact(n)) {
-                *o = dot(brow, &res);
+                *o = kernel::dot(brow, &res);
             }
         } else {
             delta.copy_from_slice(&res);
@@ -605,47 +605,4 @@ impl RevisedLemke {
         }
         basis.sort_unstable();
     }
-}
-
-/// `Σ a_i b_i` with eight partial sums (one vector register, no sequential chain).
-#[inline(always)]
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let mut acc = [0.0f64; 8];
-    let split = a.len().min(b.len()) / 8 * 8;
-    for (ca, cb) in a[..split].chunks_exact(8).zip(b[..split].chunks_exact(8)) {
-        for k in 0..8 {
-            acc[k] += ca[k] * cb[k];
-        }
-    }
-    let mut d: f64 = acc.iter().sum();
-    for (x, y) in a[split..].iter().zip(&b[split..]) {
-        d += x * y;
-    }
-    d
-}
-
-/// `max_i |x_i|` with eight running maxima; NaN if any entry is not finite (x * 0 is NaN
-/// exactly for NaN and infinite x, and the sum keeps it).
-#[inline(always)]
-fn max_abs(x: &[f64]) -> f64 {
-    let mut lanes = [0.0f64; 8];
-    let mut finite = [0.0f64; 8];
-    let split = x.len() / 8 * 8;
-    for c in x[..split].chunks_exact(8) {
-        for k in 0..8 {
-            let v = c[k].abs();
-            lanes[k] = if v > lanes[k] { v } else { lanes[k] };
-            finite[k] += c[k] * 0.0;
-        }
-    }
-    let mut m = lanes
-        .iter()
-        .fold(0.0f64, |m, v| if *v > m { *v } else { m });
-    let mut check: f64 = finite.iter().sum();
-    for v in &x[split..] {
-        let a = v.abs();
-        m = if a > m { a } else { m };
-        check += v * 0.0;
-    }
-    m + check
 }
