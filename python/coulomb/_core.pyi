@@ -20,6 +20,7 @@ def lcp_solve(
     max_iter: int = 10000,
     relaxation: float = 1.0,
     initial: NDArray[np.float64] | None = None,
+    engine: str = "auto",
 ) -> dict[str, Any]: ...
 def lcp_measures(
     m: NDArray[np.float64], q: NDArray[np.float64], z: NDArray[np.float64]

@@ -42,6 +42,8 @@ __all__ = ["LcpResult", "check", "solve"]
 
 Method = Literal["lemke", "pgs", "enumerate"]
 _METHODS = ("lemke", "pgs", "enumerate")
+Engine = Literal["auto", "tableau", "product_form"]
+_ENGINES = ("auto", "tableau", "product_form")
 _F64 = np.dtype(np.float64)
 
 
@@ -162,6 +164,7 @@ def solve(
     max_iter: int = 10_000,
     relaxation: float = 1.0,
     initial: ArrayLike | None = None,
+    engine: Engine = "auto",
 ) -> LcpResult:
     """Solve the LCP ``0 <= z ⊥ M z + q >= 0``.
 
@@ -195,6 +198,11 @@ def solve(
         PGS over-relaxation ω in (0, 2).
     initial : (n,) array_like, optional
         PGS starting point.
+    engine : {"auto", "tableau", "product_form"}
+        How Lemke keeps the basis inverse. ``"product_form"`` (a file of eta vectors) costs
+        O(n k) for the k-th pivot, ``"tableau"`` O(n^2). ``"auto"`` takes the product form for
+        16 <= n <= 1024 and re-runs the path on the tableau if it does not end in a solution
+        within 2n + 16 pivots (the message then says so).
 
     Returns
     -------
@@ -226,6 +234,8 @@ def solve(
         raise ShapeError(f"M must have shape ({n}, {n}) to match q of length {n}, got {Ma.shape}")
     if method not in _METHODS:
         raise InvalidParameterError(f"unknown method {method!r}: expected one of {_METHODS}")
+    if engine not in _ENGINES:
+        raise InvalidParameterError(f"unknown engine {engine!r}: expected one of {_ENGINES}")
     cover = None if covering_vector is None else _as_array(covering_vector, "covering_vector", 1)
     init = None if initial is None else _as_array(initial, "initial", 1)
     if max_pivots is not None and max_pivots < 1:
@@ -245,6 +255,7 @@ def solve(
         int(max_iter),
         float(relaxation),
         init,
+        engine,
     )
     return LcpResult(out)
 

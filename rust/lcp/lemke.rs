@@ -17,6 +17,11 @@
 //! - The data are equilibrated first (see `scaling`), so the pivot tolerance and the
 //!   tie test are relative to the data's units; the default covering vector is all ones on the
 //!   equilibrated problem.
+//! - For 16 <= n <= 1024 the basis inverse is kept in product form (`revised`): a pivot
+//!   forms only the entering column through the file of eta vectors, O(n k) for the k-th
+//!   pivot, about a quarter of the tableau's work on a path of n/2 pivots. Rounding can
+//!   break a degenerate tie differently there, so under [`LemkeEngine::Auto`] a path that
+//!   does not end in a solution within 2n + 16 pivots is re-run on the tableau.
 //! - The tableau is *condensed*: only the n+1 nonbasic columns and the right-hand side are
 //!   stored, n x (n+2) row-major, and a pivot is one rank-one update of it (about n^2 fused
 //!   multiply-adds, contiguous by rows). It is allocated once per workspace; pivots allocate
@@ -24,9 +29,10 @@
 //! - Ties in the minimum-ratio test are broken lexicographically on the rows of
 //!   `[q̄, B^{-1}]`, which makes the method finite on degenerate problems; z0 leaves first
 //!   whenever its row is among the ties (so the path stops at the first solution it meets).
-//! - The final basis is polished: its principal system `M_aa z_a = -q_a` is re-solved on the
-//!   original data by one factorization, and the polished answer is kept if its error is
-//!   smaller.
+//! - The final basis is polished: its system is re-solved on the original data by one step
+//!   of iterative refinement through the inverse the path holds (eta file or tableau), or,
+//!   when that answer fails, by factorizing the principal block `M_aa z_a = -q_a`; the
+//!   polished answer is kept if its error is smaller.
 
 use super::kernel::{self, axpy, Isa};
 use super::revised::{PathEnd, RevisedLemke};

@@ -26,8 +26,8 @@ use crate::error::CoulombError;
 use crate::io::siconos::{NumericsMatrix, SiconosFcFile};
 use crate::io::ReadError;
 use crate::lcp::{
-    self, EnumerateSettings, LcpRef, LcpSolution, LemkeSettings, LemkeWorkspace, Method,
-    PgsSettings,
+    self, EnumerateSettings, LcpRef, LcpSolution, LemkeEngine, LemkeSettings, LemkeWorkspace,
+    Method, PgsSettings,
 };
 
 static SHAPE_ERROR: PyOnceLock<Py<PyType>> = PyOnceLock::new();
@@ -155,6 +155,9 @@ fn solution_dict<'py>(
     Ok(d)
 }
 
+/// Lemke solves from this size on release the GIL.
+const LCP_DETACH_N: usize = 128;
+
 /// problems up to this size reuse one Lemke workspace per thread: for small n the
 /// workspace's allocations cost more than the pivots (at n = 3 about a quarter of a call),
 /// and at this bound it holds under 0.7 MB.
@@ -169,7 +172,8 @@ thread_local! {
 /// arguments; this takes them already converted to float64 arrays.
 #[pyfunction]
 #[pyo3(signature = (m, q, method, tol, max_pivots=None, covering_vector=None, warm_start=None,
-                    polish=true, restarts=2, max_iter=10_000, relaxation=1.0, initial=None))]
+                    polish=true, restarts=2, max_iter=10_000, relaxation=1.0, initial=None,
+                    engine="auto"))]
 #[allow(clippy::too_many_arguments)]
 fn lcp_solve<'py>(
     py: Python<'py>,
@@ -185,7 +189,21 @@ fn lcp_solve<'py>(
     max_iter: usize,
     relaxation: f64,
     initial: Option<PyReadonlyArray1<'py, f64>>,
+    engine: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let engine = match engine {
+        "auto" => LemkeEngine::Auto,
+        "tableau" => LemkeEngine::Tableau,
+        "product_form" => LemkeEngine::ProductForm,
+        other => {
+            return Err(to_py(
+                py,
+                CoulombError::InvalidParameter(format!(
+                    "unknown engine {other:?}: expected 'auto', 'tableau' or 'product_form'"
+                )),
+            ))
+        }
+    };
     let shape = m.shape();
     if shape[0] != shape[1] {
         return Err(to_py(
@@ -212,7 +230,7 @@ fn lcp_solve<'py>(
             warm_start,
             polish,
             restarts,
-            engine: Default::default(),
+            engine,
         }),
         "pgs" => Method::Pgs(PgsSettings {
             tol,
@@ -230,7 +248,14 @@ fn lcp_solve<'py>(
             ))
         }
     };
-    let (solution, seconds) = guarded(py, n * n, || {
+    // Lemke's solves below n = 128 take under about 0.1 ms: releasing and re-taking the GIL
+    // would cost a noticeable share of them for no one's benefit. PGS and enumeration can
+    // run long at any size.
+    let work = match &chosen {
+        Method::Lemke(_) if n < LCP_DETACH_N => 0,
+        _ => n * n,
+    };
+    let (solution, seconds) = guarded(py, work, || {
         let start = std::time::Instant::now();
         let lcp = LcpRef::new(n, ms, qs)?;
         let s = match &chosen {

@@ -3,9 +3,8 @@ previous call left in it, every answer must equal an independent oracle's."""
 
 from __future__ import annotations
 
-import numpy as np
-
 import coulomb
+import numpy as np
 
 
 def _spd(rng: np.random.Generator, n: int) -> tuple[np.ndarray, np.ndarray]:
