@@ -38,6 +38,7 @@ use super::kernel::{self, axpy, Isa};
 use super::revised::{PathEnd, RevisedLemke};
 use super::scaling::Equilibration;
 use super::small::solve_principal;
+use super::ties;
 use super::{check_tol, passes, LcpMeasures, LcpRef, LcpSolution, LcpStatus, WarmStart};
 use crate::error::{check_finite, CoulombError, Result};
 
@@ -96,8 +97,6 @@ impl Default for LemkeSettings {
 
 /// relative size under which a tableau entry counts as zero in the ratio test.
 const PIVOT_EPS: f64 = 1e-11;
-/// relative gap within which two ratios count as tied.
-const TIE_EPS: f64 = 1e-9;
 /// relative size under which a basic variable's value counts as zero (degenerate).
 const RHS_EPS: f64 = 1e-13;
 
@@ -311,47 +310,19 @@ impl LemkeWorkspace {
     /// `sign` is +1 for a minimum-ratio test and -1 for the initial maximum-ratio test.
     #[inline(always)]
     fn lexicographic(&mut self, sign: f64) -> Option<usize> {
-        let n = self.n;
-        // Rounding leaves ~1e-16 where exact arithmetic has 0, so entries are compared at the
-        // scale of the tied rows' whole lexicographic vectors, not entry by entry.
-        let mut scale: f64 = 0.0;
-        for &i in &self.ties {
-            let f = self.column[i];
-            for k in 0..n {
-                scale = scale.max((self.inverse_basis(i, k) / f).abs());
-            }
-        }
-        if !scale.is_finite() {
-            return None;
-        }
-        let tol = TIE_EPS * scale;
-        for k in 0..n {
-            if self.ties.len() <= 1 {
-                break;
-            }
-            let mut best = f64::INFINITY;
-            for &i in &self.ties {
-                best = best.min(sign * self.inverse_basis(i, k) / self.column[i]);
-            }
-            self.ties_next.clear();
-            for &i in &self.ties {
-                if sign * self.inverse_basis(i, k) / self.column[i] <= best + tol {
-                    self.ties_next.push(i);
-                }
-            }
-            if self.ties_next.is_empty() {
-                return None;
-            }
-            std::mem::swap(&mut self.ties, &mut self.ties_next);
-        }
-        // Exact arithmetic leaves one row; with rounding, prefer the largest pivot.
-        let mut pick = *self.ties.first()?;
-        for &i in &self.ties {
-            if self.column[i].abs() > self.column[pick].abs() {
-                pick = i;
-            }
-        }
-        Some(pick)
+        let mut ties = std::mem::take(&mut self.ties);
+        let mut ties_next = std::mem::take(&mut self.ties_next);
+        let pick = ties::lexicographic(
+            &mut ties,
+            &mut ties_next,
+            &self.column,
+            self.n,
+            sign,
+            |i, k| self.inverse_basis(i, k),
+        );
+        self.ties = ties;
+        self.ties_next = ties_next;
+        pick
     }
 
     /// the blocking row when the variable in column s enters (its column is left in
@@ -378,16 +349,9 @@ impl LemkeWorkspace {
         if theta == f64::INFINITY {
             return Blocking::Ray;
         }
-        let bound = theta + TIE_EPS * theta;
-        self.ties.clear();
         let z0 = self.z0();
-        for (i, t) in self.ratios.iter().enumerate() {
-            if *t <= bound {
-                if self.basic[i] == z0 {
-                    return Blocking::Row(i);
-                }
-                self.ties.push(i);
-            }
+        if let Some(r) = ties::tied_rows(&self.ratios, theta, &self.basic, z0, &mut self.ties) {
+            return Blocking::Row(r);
         }
         match self.ties.len() {
             0 => Blocking::NonFinite,
@@ -405,20 +369,8 @@ impl LemkeWorkspace {
         let mut column = std::mem::take(&mut self.column);
         self.gather_column(n, &mut column);
         self.column = column;
-        // x_B = q' + d' z0 >= 0 needs z0 >= -q'_i / d'_i = values_i / column_i
-        let mut theta = f64::NEG_INFINITY;
-        for (b, f) in self.values.iter().zip(&self.column) {
-            theta = theta.max(b / f);
-        }
-        if !theta.is_finite() {
+        if !ties::initial_tied_rows(&self.values, &self.column, &mut self.ties) {
             return None;
-        }
-        let tie = TIE_EPS * theta.abs().max(1e-12);
-        self.ties.clear();
-        for i in 0..n {
-            if self.values[i] / self.column[i] >= theta - tie {
-                self.ties.push(i);
-            }
         }
         match self.ties.len() {
             0 => None,

@@ -23,6 +23,7 @@ pub mod pgs;
 mod revised;
 mod scaling;
 mod small;
+mod ties;
 
 use crate::error::{check_finite, CoulombError, Result};
 use crate::matrix::DenseMatrix;

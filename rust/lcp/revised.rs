@@ -23,6 +23,7 @@
 
 use super::kernel::{self, axpy, Isa};
 use super::scaling::Equilibration;
+use super::ties;
 use super::LcpRef;
 
 /// How a pivoting run ended.
@@ -40,8 +41,6 @@ pub(super) enum PathEnd {
 
 /// relative size under which a column entry counts as zero in the ratio test.
 const PIVOT_EPS: f64 = 1e-11;
-/// relative gap within which two ratios count as tied.
-const TIE_EPS: f64 = 1e-9;
 /// relative size under which a basic variable's value counts as zero (degenerate).
 const RHS_EPS: f64 = 1e-13;
 
@@ -245,48 +244,15 @@ impl RevisedLemke {
             self.lex_rows[t * n..(t + 1) * n].copy_from_slice(&self.scratch);
             self.lex_index[i] = t;
         }
-        // Rounding leaves ~1e-16 where exact arithmetic has 0, so entries are compared at the
-        // scale of the tied rows' whole lexicographic vectors, not entry by entry.
-        let mut scale: f64 = 0.0;
-        for t in 0..k {
-            let f = self.column[self.ties[t]];
-            for v in &self.lex_rows[t * n..(t + 1) * n] {
-                scale = scale.max((v / f).abs());
-            }
-        }
-        if !scale.is_finite() {
-            return None;
-        }
-        let tol = TIE_EPS * scale;
-        for col in 0..n {
-            if self.ties.len() <= 1 {
-                break;
-            }
-            let mut best = f64::INFINITY;
-            for &i in &self.ties {
-                let v = self.lex_rows[self.lex_index[i] * n + col];
-                best = best.min(sign * v / self.column[i]);
-            }
-            self.ties_next.clear();
-            for &i in &self.ties {
-                let v = self.lex_rows[self.lex_index[i] * n + col];
-                if sign * v / self.column[i] <= best + tol {
-                    self.ties_next.push(i);
-                }
-            }
-            if self.ties_next.is_empty() {
-                return None;
-            }
-            std::mem::swap(&mut self.ties, &mut self.ties_next);
-        }
-        // Exact arithmetic leaves one row; with rounding, prefer the largest pivot.
-        let mut pick = *self.ties.first()?;
-        for &i in &self.ties {
-            if self.column[i].abs() > self.column[pick].abs() {
-                pick = i;
-            }
-        }
-        Some(pick)
+        let mut ties = std::mem::take(&mut self.ties);
+        let mut ties_next = std::mem::take(&mut self.ties_next);
+        let (rows, index) = (&self.lex_rows, &self.lex_index);
+        let pick = ties::lexicographic(&mut ties, &mut ties_next, &self.column, n, sign, |i, k| {
+            rows[index[i] * n + k]
+        });
+        self.ties = ties;
+        self.ties_next = ties_next;
+        pick
     }
 
     /// the blocking row when the variable in `self.column` enters.
@@ -309,16 +275,9 @@ impl RevisedLemke {
         if theta == f64::INFINITY {
             return Ok(None);
         }
-        let bound = theta + TIE_EPS * theta;
-        self.ties.clear();
         let z0 = self.z0();
-        for (i, t) in self.ratios.iter().enumerate() {
-            if *t <= bound {
-                if self.basic[i] == z0 {
-                    return Ok(Some(i));
-                }
-                self.ties.push(i);
-            }
+        if let Some(r) = ties::tied_rows(&self.ratios, theta, &self.basic, z0, &mut self.ties) {
+            return Ok(Some(r));
         }
         match self.ties.len() {
             0 => Err(()),
@@ -330,20 +289,8 @@ impl RevisedLemke {
     /// the row that leaves when z0 first enters: the one needing the largest z0.
     #[inline(always)]
     fn initial_row(&mut self) -> Option<usize> {
-        let n = self.n;
-        let mut theta = f64::NEG_INFINITY;
-        for (b, f) in self.values.iter().zip(&self.column) {
-            theta = theta.max(b / f);
-        }
-        if !theta.is_finite() {
+        if !ties::initial_tied_rows(&self.values, &self.column, &mut self.ties) {
             return None;
-        }
-        let tie = TIE_EPS * theta.abs().max(1e-12);
-        self.ties.clear();
-        for i in 0..n {
-            if self.values[i] / self.column[i] >= theta - tie {
-                self.ties.push(i);
-            }
         }
         match self.ties.len() {
             0 => None,

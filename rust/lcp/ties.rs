@@ -1,0 +1,107 @@
+//! The tie-breaking rules Lemke's two engines share (the tableau in `lemke`, the product
+//! form in `revised`): they differ only in how an entry of B^{-1} is read.
+
+/// relative gap within which two ratios count as tied.
+pub(super) const TIE_EPS: f64 = 1e-9;
+
+/// Keeps, among `ties`, the rows whose lexicographic ratio `B^{-1}[i, :] / f_i` is smallest
+/// (`sign` +1, the minimum-ratio test) or largest (`sign` -1, the initial maximum-ratio
+/// test): the perturbation `q + (ε, ε², …)` argument that makes the method finite on
+/// degenerate problems. `inverse(i, k)` is `B^{-1}[i, k]`, `column` the entering column f.
+/// Returns the chosen row, or None if the arithmetic broke down.
+#[inline(always)]
+pub(super) fn lexicographic(
+    ties: &mut Vec<usize>,
+    ties_next: &mut Vec<usize>,
+    column: &[f64],
+    n: usize,
+    sign: f64,
+    inverse: impl Fn(usize, usize) -> f64,
+) -> Option<usize> {
+    // Rounding leaves ~1e-16 where exact arithmetic has 0, so entries are compared at the
+    // scale of the tied rows' whole lexicographic vectors, not entry by entry.
+    let mut scale: f64 = 0.0;
+    for &i in ties.iter() {
+        let f = column[i];
+        for k in 0..n {
+            scale = scale.max((inverse(i, k) / f).abs());
+        }
+    }
+    if !scale.is_finite() {
+        return None;
+    }
+    let tol = TIE_EPS * scale;
+    for k in 0..n {
+        if ties.len() <= 1 {
+            break;
+        }
+        let mut best = f64::INFINITY;
+        for &i in ties.iter() {
+            best = best.min(sign * inverse(i, k) / column[i]);
+        }
+        ties_next.clear();
+        for &i in ties.iter() {
+            if sign * inverse(i, k) / column[i] <= best + tol {
+                ties_next.push(i);
+            }
+        }
+        if ties_next.is_empty() {
+            return None;
+        }
+        std::mem::swap(ties, ties_next);
+    }
+    // Exact arithmetic leaves one row; with rounding, prefer the largest pivot.
+    let mut pick = *ties.first()?;
+    for &i in ties.iter() {
+        if column[i].abs() > column[pick].abs() {
+            pick = i;
+        }
+    }
+    Some(pick)
+}
+
+/// The rows tied within TIE_EPS at the minimum ratio `theta` (into `ties`), or, when z0's
+/// row is among them, that row alone: z0 leaves first, so the path stops at the first
+/// solution it meets. `basic[i]` is row i's basic variable.
+#[inline(always)]
+pub(super) fn tied_rows(
+    ratios: &[f64],
+    theta: f64,
+    basic: &[usize],
+    z0: usize,
+    ties: &mut Vec<usize>,
+) -> Option<usize> {
+    let bound = theta + TIE_EPS * theta;
+    ties.clear();
+    for (i, t) in ratios.iter().enumerate() {
+        if *t <= bound {
+            if basic[i] == z0 {
+                return Some(i);
+            }
+            ties.push(i);
+        }
+    }
+    None
+}
+
+/// The rows tied at the largest ratio `values_i / column_i` (into `ties`): when z0 first
+/// enters with column `-d'`, `x_B = q' + d' z0 >= 0` needs `z0 >= values_i / column_i`, and
+/// the row needing the largest z0 leaves. False if the ratios are not finite.
+#[inline(always)]
+pub(super) fn initial_tied_rows(values: &[f64], column: &[f64], ties: &mut Vec<usize>) -> bool {
+    let mut theta = f64::NEG_INFINITY;
+    for (b, f) in values.iter().zip(column) {
+        theta = theta.max(b / f);
+    }
+    if !theta.is_finite() {
+        return false;
+    }
+    let tie = TIE_EPS * theta.abs().max(1e-12);
+    ties.clear();
+    for (i, (b, f)) in values.iter().zip(column).enumerate() {
+        if b / f >= theta - tie {
+            ties.push(i);
+        }
+    }
+    true
+}
