@@ -129,6 +129,16 @@ pub fn murty(n: usize) -> (DenseMatrix, Vec<f64>) {
     (m, q)
 }
 
+/// `max_i |a_i - b_i| / max(1, max_i |b_i|)`: how far an answer is from a reference, relative
+/// to the reference's size.
+pub fn max_rel_diff(a: &[f64], b: &[f64]) -> f64 {
+    let scale = b.iter().fold(1.0f64, |s, v| s.max(v.abs()));
+    a.iter()
+        .zip(b)
+        .fold(0.0f64, |d, (x, y)| d.max((x - y).abs()))
+        / scale
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

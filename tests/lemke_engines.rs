@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use coulomb::io::siconos::read_siconos_lcp;
 use coulomb::lcp::{solve_lemke, LcpRef, LcpSolution, LemkeEngine, LemkeSettings};
-use coulomb::testing::{dense_spd, murty, planted_psd};
+use coulomb::testing::{dense_spd, max_rel_diff, murty, planted_psd};
 use coulomb::DenseMatrix;
 
 fn run(m: &DenseMatrix, q: &[f64], engine: LemkeEngine) -> LcpSolution {
@@ -17,14 +17,6 @@ fn run(m: &DenseMatrix, q: &[f64], engine: LemkeEngine) -> LcpSolution {
         ..Default::default()
     };
     solve_lemke(&lcp, &s).expect("valid settings")
-}
-
-fn max_rel_diff(a: &[f64], b: &[f64]) -> f64 {
-    let scale = b.iter().fold(1.0f64, |s, v| s.max(v.abs()));
-    a.iter()
-        .zip(b)
-        .fold(0.0f64, |d, (x, y)| d.max((x - y).abs()))
-        / scale
 }
 
 /// dense SPD problems (unique solution, nondegenerate paths): the same pivots and the same z.

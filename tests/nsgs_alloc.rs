@@ -2,40 +2,12 @@
 //! the number of sweeps (the diagonal blocks, impulses and velocities are sized once; a sweep
 //! reads W through the block row accessors and the error is measured into a buffer).
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
-
 use coulomb::contact::{solve_nsgs, BlockCsr, ContactProblem, NsgsSettings};
 
 mod pile;
 
-struct Counting;
-
-thread_local! {
-    // per thread, so the test harness's own threads do not count
-    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
-}
-
-fn count() -> usize {
-    ALLOCATIONS.with(|c| c.get())
-}
-
-// SAFETY: forwards to the system allocator, only counting calls.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        // try_with: the slot may be gone while the thread shuts down
-        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
-        // SAFETY: same contract as the caller's.
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: same contract as the caller's.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-}
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
+mod alloc_count;
+use alloc_count::count;
 
 /// (allocations, sweeps) of one solve that runs exactly `sweeps` sweeps (a tolerance no
 /// iterate reaches).

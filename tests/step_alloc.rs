@@ -2,38 +2,10 @@
 //! workspaces (W, q, impulses, the broad phase's grid) are kept from step to step, and a
 //! record goes into a vector with room for it.
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
-
 use coulomb::step::{Body, BodyKind, HalfSpace, Pair, Scene, Shape, StepSettings, Stepper};
 
-struct Counting;
-
-thread_local! {
-    // per thread, so the test harness's own threads do not count
-    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
-}
-
-fn count() -> usize {
-    ALLOCATIONS.with(|c| c.get())
-}
-
-// SAFETY: forwards to the system allocator, only counting calls.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        // try_with: the slot may be gone while the thread shuts down
-        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
-        // SAFETY: same contract as the caller's.
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: same contract as the caller's.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-}
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
+mod alloc_count;
+use alloc_count::count;
 
 /// a box (8 corners) resting on the floor, and two balls resting on it beside each other
 /// (their pair found by the broad phase).
