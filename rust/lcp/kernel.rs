@@ -172,65 +172,114 @@ pub fn max_abs_scaled(x: &[f64], s: &[f64]) -> f64 {
     m
 }
 
-/// `max_i |x_i|` with eight running maxima; NaN if any entry is not finite (x * 0 is NaN
-/// exactly for NaN and infinite x, and the sum keeps it).
+/// `(max_i |a_i|, max_i |b_i|)` in one pass, each NaN when its vector holds a non-finite entry
+/// (x * 0 is NaN exactly for NaN and infinite x, and the sum keeps
+/// it).
 #[inline(always)]
-pub fn max_abs(x: &[f64]) -> f64 {
-    let mut lanes = [0.0f64; 8];
-    let mut finite = [0.0f64; 8];
-    let split = x.len() / 8 * 8;
-    for c in x[..split].chunks_exact(8) {
+pub fn max_abs_pair(a: &[f64], b: &[f64]) -> (f64, f64) {
+    let n = a.len().min(b.len());
+    let split = n / 8 * 8;
+    let (mut la, mut lb) = ([0.0f64; 8], [0.0f64; 8]);
+    let (mut fa, mut fb) = ([0.0f64; 8], [0.0f64; 8]);
+    for (ca, cb) in a[..split].chunks_exact(8).zip(b[..split].chunks_exact(8)) {
         for k in 0..8 {
-            let v = c[k].abs();
-            lanes[k] = if v > lanes[k] { v } else { lanes[k] };
-            finite[k] += c[k] * 0.0;
+            let (u, v) = (ca[k].abs(), cb[k].abs());
+            la[k] = if u > la[k] { u } else { la[k] };
+            lb[k] = if v > lb[k] { v } else { lb[k] };
+            fa[k] += ca[k] * 0.0;
+            fb[k] += cb[k] * 0.0;
         }
     }
-    let mut m = lanes
-        .iter()
-        .fold(0.0f64, |m, v| if *v > m { *v } else { m });
-    let mut check: f64 = finite.iter().sum();
-    for v in &x[split..] {
-        let a = v.abs();
-        m = if a > m { a } else { m };
-        check += v * 0.0;
+    let fold = |l: &[f64; 8]| l.iter().fold(0.0f64, |m, v| if *v > m { *v } else { m });
+    let (mut ma, mut mb) = (fold(&la), fold(&lb));
+    let (mut ca, mut cb): (f64, f64) = (fa.iter().sum(), fb.iter().sum());
+    for (u, v) in a[split..n].iter().zip(&b[split..n]) {
+        ma = if u.abs() > ma { u.abs() } else { ma };
+        mb = if v.abs() > mb { v.abs() } else { mb };
+        ca += u * 0.0;
+        cb += v * 0.0;
     }
-    m + check
+    (ma + ca, mb + cb)
 }
 
-/// The minimum-ratio step of Lemke's ratio test, branch-free so it runs as vector
-/// instructions: zeroes the basic values `b_i <= zero` (degenerate rows), writes
-/// `t_i = b_i / f_i` for the blocking rows `f_i > piv_tol` (infinity for the others) and
-/// returns `min_i t_i`.
+/// The minimum ratio of Lemke's ratio test, `θ = min { b_i / f_i : f_i > piv_tol }` (infinity
+/// when no row blocks), after zeroing the basic values `b_i <= zero` (degenerate rows).
+///
+/// No division per row: each of eight lanes keeps its best ratio as a fraction `num / den`
+/// and a row replaces it when `b_i den < num f_i` (both denominators positive), so the loop is
+/// comparisons and products, which vectorize (a division per row does not: the compiler
+/// guards it with a branch). Only the eight lanes' fractions are divided at the end.
 #[inline(always)]
-pub fn min_ratio(f: &[f64], b: &mut [f64], t: &mut [f64], piv_tol: f64, zero: f64) -> f64 {
-    let n = f.len().min(b.len()).min(t.len());
+pub fn min_ratio(f: &[f64], b: &mut [f64], piv_tol: f64, zero: f64) -> f64 {
+    let n = f.len().min(b.len());
     let split = n / 8 * 8;
-    let mut lanes = [f64::INFINITY; 8];
-    let step = |fi: f64, bi: &mut f64, ti: &mut f64| {
+    let mut num = [f64::INFINITY; 8];
+    let mut den = [1.0f64; 8];
+    let step = |fi: f64, bi: &mut f64, num: &mut f64, den: &mut f64| {
         let v = if *bi <= zero { 0.0 } else { *bi };
         *bi = v;
-        let r = v / fi;
-        *ti = if fi > piv_tol { r } else { f64::INFINITY };
+        // with num = +inf, den = 1 the product num * f_i is +inf for every blocking row
+        let better = (fi > piv_tol) & (v * *den < *num * fi);
+        *num = if better { v } else { *num };
+        *den = if better { fi } else { *den };
     };
-    for ((cf, cb), ct) in f[..split]
+    for (cf, cb) in f[..split]
         .chunks_exact(8)
         .zip(b[..split].chunks_exact_mut(8))
-        .zip(t[..split].chunks_exact_mut(8))
     {
         for k in 0..8 {
-            step(cf[k], &mut cb[k], &mut ct[k]);
-            lanes[k] = if ct[k] < lanes[k] { ct[k] } else { lanes[k] };
+            step(cf[k], &mut cb[k], &mut num[k], &mut den[k]);
         }
     }
-    let mut m = lanes
-        .iter()
-        .fold(f64::INFINITY, |m, v| if *v < m { *v } else { m });
+    let (mut tn, mut td) = (f64::INFINITY, 1.0);
     for i in split..n {
-        step(f[i], &mut b[i], &mut t[i]);
-        m = if t[i] < m { t[i] } else { m };
+        step(f[i], &mut b[i], &mut tn, &mut td);
     }
-    m
+    let mut theta = tn / td;
+    for k in 0..8 {
+        let t = num[k] / den[k];
+        theta = if t < theta { t } else { theta };
+    }
+    theta
+}
+
+/// The rows of the ratio test tied at the bound, `f_i > piv_tol` and `b_i <= bound f_i`, in
+/// increasing order: `visit(i)` is called for each until it returns true, and that row is
+/// returned. A vector comparison per eight rows finds them; rows are visited only from the
+/// (usually one) block that holds a tie.
+#[inline(always)]
+pub fn find_ties(
+    f: &[f64],
+    b: &[f64],
+    piv_tol: f64,
+    bound: f64,
+    mut visit: impl FnMut(usize) -> bool,
+) -> Option<usize> {
+    let n = f.len().min(b.len());
+    let split = n / 8 * 8;
+    for (c, (cf, cb)) in f[..split]
+        .chunks_exact(8)
+        .zip(b[..split].chunks_exact(8))
+        .enumerate()
+    {
+        let mut mask = 0u32;
+        for k in 0..8 {
+            mask |= (((cf[k] > piv_tol) & (cb[k] <= bound * cf[k])) as u32) << k;
+        }
+        while mask != 0 {
+            let i = c * 8 + mask.trailing_zeros() as usize;
+            if visit(i) {
+                return Some(i);
+            }
+            mask &= mask - 1;
+        }
+    }
+    for i in split..n {
+        if (f[i] > piv_tol) & (b[i] <= bound * f[i]) && visit(i) {
+            return Some(i);
+        }
+    }
+    None
 }
 
 #[cfg(test)]
@@ -259,7 +308,61 @@ mod tests {
         let want_s: f64 = x.iter().zip(&s).map(|(a, b)| (a * b).abs()).sum();
         assert!((d - want_d).abs() < 1e-13 && (s_abs - want_s).abs() < 1e-13);
         assert_eq!(d, d1);
-        let a = dispatch!(detect(), f64, || max_abs(&x));
-        assert_eq!(a, x.iter().fold(0.0, |m: f64, v| m.max(v.abs())));
+        let (pa, ps) = dispatch!(detect(), (f64, f64), || max_abs_pair(&x, &s));
+        assert_eq!(pa, x.iter().fold(0.0, |m: f64, v| m.max(v.abs())));
+        assert_eq!(ps, s.iter().fold(0.0, |m: f64, v| m.max(v.abs())));
+        let mut bad = x.clone();
+        bad[35] = f64::INFINITY;
+        assert!(dispatch!(detect(), (f64, f64), || max_abs_pair(&s, &bad))
+            .1
+            .is_nan());
+    }
+
+    /// the division-free minimum ratio and the tie scan against the ratios themselves
+    #[test]
+    fn ratio_test_kernels_agree_with_the_ratios() {
+        for n in [1usize, 7, 8, 9, 37, 100] {
+            let f: Vec<f64> = (0..n).map(|k| (k as f64 * 1.3).sin()).collect();
+            let b0: Vec<f64> = (0..n)
+                .map(|k| (k as f64 * 0.7).cos().abs() - 0.05)
+                .collect();
+            let (piv_tol, zero) = (1e-11, 1e-13);
+            let mut b = b0.clone();
+            let theta = dispatch!(detect(), f64, || min_ratio(&f, &mut b, piv_tol, zero));
+            let clipped: Vec<f64> = b0
+                .iter()
+                .map(|v| if *v <= zero { 0.0 } else { *v })
+                .collect();
+            assert_eq!(b, clipped);
+            let want = (0..n)
+                .filter(|&i| f[i] > piv_tol)
+                .map(|i| clipped[i] / f[i])
+                .fold(f64::INFINITY, f64::min);
+            assert_eq!(theta, want, "n = {n}");
+            let bound = theta * 1.5;
+            let mut seen = Vec::new();
+            let stop = dispatch!(detect(), Option<usize>, || find_ties(
+                &f,
+                &b,
+                piv_tol,
+                bound,
+                |i| {
+                    seen.push(i);
+                    false
+                }
+            ));
+            assert_eq!(stop, None);
+            let tied: Vec<usize> = (0..n)
+                .filter(|&i| f[i] > piv_tol && clipped[i] / f[i] <= bound)
+                .collect();
+            assert_eq!(seen, tied, "n = {n}");
+            if let Some(&last) = tied.last() {
+                let first = find_ties(&f, &b, piv_tol, bound, |i| i == last);
+                assert_eq!(first, Some(last));
+            }
+        }
+        // no blocking row: a ray
+        let mut b = vec![1.0; 9];
+        assert_eq!(min_ratio(&[-1.0; 9], &mut b, 1e-11, 0.0), f64::INFINITY);
     }
 }

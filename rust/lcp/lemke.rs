@@ -38,7 +38,7 @@ use super::kernel::{self, axpy, Isa};
 use super::revised::{PathEnd, RevisedLemke};
 use super::scaling::Equilibration;
 use super::small::solve_principal;
-use super::ties;
+use super::ties::{self, Blocking};
 use super::{check_tol, passes, LcpMeasures, LcpRef, LcpSolution, LcpStatus, WarmStart};
 use crate::error::{check_finite, CoulombError, Result};
 
@@ -95,11 +95,6 @@ impl Default for LemkeSettings {
     }
 }
 
-/// relative size under which a tableau entry counts as zero in the ratio test.
-const PIVOT_EPS: f64 = 1e-11;
-/// relative size under which a basic variable's value counts as zero (degenerate).
-const RHS_EPS: f64 = 1e-13;
-
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Loc {
     Row(usize),
@@ -112,13 +107,6 @@ enum Ending {
     Terminal,
     Ray,
     Limit,
-    NonFinite,
-}
-
-/// The outcome of a ratio test.
-enum Blocking {
-    Row(usize),
-    Ray,
     NonFinite,
 }
 
@@ -157,7 +145,7 @@ pub struct LemkeWorkspace {
     pending_v: Vec<f64>,
     column: Vec<f64>,
     values: Vec<f64>,
-    ratios: Vec<f64>,
+    spare: Vec<f64>,
     row: Vec<f64>,
     u: Vec<f64>,
     basic: Vec<usize>,
@@ -194,7 +182,7 @@ impl LemkeWorkspace {
             pending_v: vec![0.0; block * width],
             column: vec![0.0; n],
             values: vec![0.0; n],
-            ratios: vec![0.0; n],
+            spare: vec![0.0; n],
             row: vec![0.0; width],
             u: vec![0.0; n],
             basic: vec![0; n],
@@ -332,33 +320,18 @@ impl LemkeWorkspace {
         let mut column = std::mem::take(&mut self.column);
         self.gather_column(s, &mut column);
         self.column = column;
-        let colmax = kernel::max_abs(&self.column);
-        let rhsmax = kernel::max_abs(&self.values).max(1.0);
-        if !(colmax.is_finite() && rhsmax.is_finite()) {
-            return Blocking::NonFinite;
-        }
-        let piv_tol = PIVOT_EPS * colmax.max(1.0);
-        let zero_rhs = RHS_EPS * rhsmax;
-        let theta = kernel::min_ratio(
+        let z0 = self.z0();
+        match ties::blocking_rows(
             &self.column,
             &mut self.values,
-            &mut self.ratios,
-            piv_tol,
-            zero_rhs,
-        );
-        if theta == f64::INFINITY {
-            return Blocking::Ray;
-        }
-        let z0 = self.z0();
-        if let Some(r) = ties::tied_rows(&self.ratios, theta, &self.basic, z0, &mut self.ties) {
-            return Blocking::Row(r);
-        }
-        match self.ties.len() {
-            0 => Blocking::NonFinite,
-            1 => Blocking::Row(self.ties[0]),
-            _ => self
+            &self.basic,
+            z0,
+            &mut self.ties,
+        ) {
+            Blocking::Tied => self
                 .lexicographic(1.0)
                 .map_or(Blocking::NonFinite, Blocking::Row),
+            other => other,
         }
     }
 
@@ -477,7 +450,7 @@ impl LemkeWorkspace {
             let r = match self.ratio_test(s) {
                 Blocking::Row(r) => r,
                 Blocking::Ray => return (Ending::Ray, pivots),
-                Blocking::NonFinite => return (Ending::NonFinite, pivots),
+                Blocking::NonFinite | Blocking::Tied => return (Ending::NonFinite, pivots),
             };
             leaving = self.basic[r];
             pivots += 1;
@@ -523,13 +496,13 @@ impl LemkeWorkspace {
         }
         // the pending updates enter as (T + U^T V) s = T s + U^T (V s): no flush needed
         for p in 0..self.pending {
-            self.ratios[p] = kernel::dot(&self.pending_v[p * w..(p + 1) * w], &self.row);
+            self.spare[p] = kernel::dot(&self.pending_v[p * w..(p + 1) * w], &self.row);
         }
         for &j in &self.ties {
             if let Loc::Row(i) = self.loc[n + j] {
                 let mut d = kernel::dot(&self.tableau[i * w..(i + 1) * w], &self.row);
                 for p in 0..self.pending {
-                    d += self.pending_u[p * n + i] * self.ratios[p];
+                    d += self.pending_u[p * n + i] * self.spare[p];
                 }
                 z[j] = (z[j] + eq.col[j] * d).max(0.0);
             }

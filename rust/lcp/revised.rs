@@ -39,11 +39,6 @@ pub(super) enum PathEnd {
     NonFinite,
 }
 
-/// relative size under which a column entry counts as zero in the ratio test.
-const PIVOT_EPS: f64 = 1e-11;
-/// relative size under which a basic variable's value counts as zero (degenerate).
-const RHS_EPS: f64 = 1e-13;
-
 /// etas applied together to a column (see [`RevisedLemke::apply_etas`]).
 const ETA_BLOCK: usize = 8;
 /// at most this many tied rows are broken lexicographically (their rows of B^{-1} are
@@ -69,10 +64,10 @@ pub(super) struct RevisedLemke {
     /// the equilibrated covering vector d' and the entering variable's original column.
     cover: Vec<f64>,
     acol: Vec<f64>,
-    /// the entering column, the basic values and the ratio test's ratios.
+    /// the entering column, the basic values, and two scratch vectors.
     column: Vec<f64>,
     values: Vec<f64>,
-    ratios: Vec<f64>,
+    spare: Vec<f64>,
     scratch: Vec<f64>,
     /// `basic[i]`: the variable basic in row i (w_k = k, z_k = n + k, z0 = 2n).
     basic: Vec<usize>,
@@ -105,7 +100,7 @@ impl RevisedLemke {
             acol: vec![0.0; n],
             column: vec![0.0; n],
             values: vec![0.0; n],
-            ratios: vec![0.0; n],
+            spare: vec![0.0; n],
             scratch: vec![0.0; n],
             basic: vec![0; n],
             row_of: vec![usize::MAX; 2 * n + 1],
@@ -212,9 +207,8 @@ impl RevisedLemke {
             y[r] += kernel::dot(&y, &self.etas[j * n..(j + 1) * n]);
         }
         if self.has_base {
-            // y^T B_0^{-1}: the base's rows weighted by y (the ratios are free here: the ratio
-            // test has read them before it breaks ties)
-            let mut out = std::mem::take(&mut self.ratios);
+            // y^T B_0^{-1}: the base's rows weighted by y, summed in the second scratch vector
+            let mut out = std::mem::take(&mut self.spare);
             out.iter_mut().for_each(|v| *v = 0.0);
             for (yk, brow) in y.iter().zip(self.base.chunks_exact(n)) {
                 if *yk != 0.0 {
@@ -222,7 +216,7 @@ impl RevisedLemke {
                 }
             }
             y.copy_from_slice(&out);
-            self.ratios = out;
+            self.spare = out;
         }
         self.scratch = y;
     }
@@ -258,31 +252,18 @@ impl RevisedLemke {
     /// the blocking row when the variable in `self.column` enters.
     #[inline(always)]
     fn ratio_test(&mut self) -> Result<Option<usize>, ()> {
-        let colmax = kernel::max_abs(&self.column);
-        let rhsmax = kernel::max_abs(&self.values).max(1.0);
-        if !(colmax.is_finite() && rhsmax.is_finite()) {
-            return Err(());
-        }
-        let piv_tol = PIVOT_EPS * colmax.max(1.0);
-        let zero_rhs = RHS_EPS * rhsmax;
-        let theta = kernel::min_ratio(
+        let z0 = self.z0();
+        match ties::blocking_rows(
             &self.column,
             &mut self.values,
-            &mut self.ratios,
-            piv_tol,
-            zero_rhs,
-        );
-        if theta == f64::INFINITY {
-            return Ok(None);
-        }
-        let z0 = self.z0();
-        if let Some(r) = ties::tied_rows(&self.ratios, theta, &self.basic, z0, &mut self.ties) {
-            return Ok(Some(r));
-        }
-        match self.ties.len() {
-            0 => Err(()),
-            1 => Ok(Some(self.ties[0])),
-            _ => self.lexicographic(1.0).map(Some).ok_or(()),
+            &self.basic,
+            z0,
+            &mut self.ties,
+        ) {
+            ties::Blocking::Row(r) => Ok(Some(r)),
+            ties::Blocking::Ray => Ok(None),
+            ties::Blocking::NonFinite => Err(()),
+            ties::Blocking::Tied => self.lexicographic(1.0).map(Some).ok_or(()),
         }
     }
 

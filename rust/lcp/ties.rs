@@ -1,8 +1,67 @@
 //! The tie-breaking rules Lemke's two engines share (the tableau in `lemke`, the product
 //! form in `revised`): they differ only in how an entry of B^{-1} is read.
 
+use super::kernel;
+
 /// relative gap within which two ratios count as tied.
 pub(super) const TIE_EPS: f64 = 1e-9;
+/// relative size under which an entry of the entering column counts as zero in the ratio test.
+pub(super) const PIVOT_EPS: f64 = 1e-11;
+/// relative size under which a basic variable's value counts as zero (degenerate).
+pub(super) const RHS_EPS: f64 = 1e-13;
+
+/// The outcome of the minimum-ratio test before the lexicographic rule.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Blocking {
+    /// one row blocks (or z0's row is among the tied ones): it leaves.
+    Row(usize),
+    /// several rows tie (listed in `ties`): the lexicographic rule picks one.
+    Tied,
+    /// no row blocks: a secondary ray.
+    Ray,
+    /// the column or the basic values are not finite.
+    NonFinite,
+}
+
+/// Lemke's minimum-ratio test for the entering column f and basic values b (zeroing the
+/// degenerate values `b_i <= RHS_EPS max(1, ||b||_inf)`): the rows with `f_i > PIVOT_EPS
+/// max(1, ||f||_inf)` whose ratio `b_i / f_i` lies within TIE_EPS of the minimum θ. z0's row
+/// among them leaves alone (so the path stops at the first solution it meets); otherwise
+/// several tied rows are left in `ties`. Three passes over two vectors, none with a division
+/// per row.
+#[inline(always)]
+pub(super) fn blocking_rows(
+    column: &[f64],
+    values: &mut [f64],
+    basic: &[usize],
+    z0: usize,
+    ties: &mut Vec<usize>,
+) -> Blocking {
+    let (colmax, rhsmax) = kernel::max_abs_pair(column, values);
+    if !(colmax.is_finite() && rhsmax.is_finite()) {
+        return Blocking::NonFinite;
+    }
+    let piv_tol = PIVOT_EPS * colmax.max(1.0);
+    let zero_rhs = RHS_EPS * rhsmax.max(1.0);
+    let theta = kernel::min_ratio(column, values, piv_tol, zero_rhs);
+    if theta == f64::INFINITY {
+        return Blocking::Ray;
+    }
+    let bound = theta + TIE_EPS * theta;
+    ties.clear();
+    let z0_row = kernel::find_ties(column, values, piv_tol, bound, |i| {
+        ties.push(i);
+        basic[i] == z0
+    });
+    if let Some(r) = z0_row {
+        return Blocking::Row(r);
+    }
+    match ties.len() {
+        0 => Blocking::NonFinite,
+        1 => Blocking::Row(ties[0]),
+        _ => Blocking::Tied,
+    }
+}
 
 /// Keeps, among `ties`, the rows whose lexicographic ratio `B^{-1}[i, :] / f_i` is smallest
 /// (`sign` +1, the minimum-ratio test) or largest (`sign` -1, the initial maximum-ratio
@@ -58,30 +117,6 @@ pub(super) fn lexicographic(
         }
     }
     Some(pick)
-}
-
-/// The rows tied within TIE_EPS at the minimum ratio `theta` (into `ties`), or, when z0's
-/// row is among them, that row alone: z0 leaves first, so the path stops at the first
-/// solution it meets. `basic[i]` is row i's basic variable.
-#[inline(always)]
-pub(super) fn tied_rows(
-    ratios: &[f64],
-    theta: f64,
-    basic: &[usize],
-    z0: usize,
-    ties: &mut Vec<usize>,
-) -> Option<usize> {
-    let bound = theta + TIE_EPS * theta;
-    ties.clear();
-    for (i, t) in ratios.iter().enumerate() {
-        if *t <= bound {
-            if basic[i] == z0 {
-                return Some(i);
-            }
-            ties.push(i);
-        }
-    }
-    None
 }
 
 /// The rows tied at the largest ratio `values_i / column_i` (into `ties`): when z0 first
