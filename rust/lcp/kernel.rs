@@ -274,12 +274,7 @@ pub fn find_ties(
             mask &= mask - 1;
         }
     }
-    for i in split..n {
-        if (f[i] > piv_tol) & (b[i] <= bound * f[i]) && visit(i) {
-            return Some(i);
-        }
-    }
-    None
+    (split..n).find(|&i| (f[i] > piv_tol) & (b[i] <= bound * f[i]) && visit(i))
 }
 
 #[cfg(test)]
