@@ -1,5 +1,7 @@
 //! Repeats one Lemke solve for profiling:
-//! `cargo run --release --example lemke_profile N REPS [polish|nopolish] [spd|psd]`.
+//! `cargo run --release --example lemke_profile N REPS [polish|nopolish] [spd|psd|FILE_PREFIX]`,
+//! where `FILE_PREFIX` names `PREFIX_M.txt` and `PREFIX_q.txt` (whitespace-separated numbers, as
+//! `numpy.savetxt` writes them), to profile the very problem a Python benchmark times.
 use coulomb::lcp::{solve_lemke_with, LcpRef, LemkeSettings, LemkeWorkspace};
 use coulomb::testing::{dense_spd, planted_psd};
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -7,13 +9,26 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let n: usize = args.next().and_then(|a| a.parse().ok()).unwrap_or(100);
     let reps: usize = args.next().and_then(|a| a.parse().ok()).unwrap_or(1000);
     let polish = args.next().is_none_or(|a| a != "nopolish");
-    let (m, q) = if args.next().is_some_and(|a| a == "psd") {
-        let (m, q, _, _) = planted_psd(n, n / 2, 1);
-        (m, q)
-    } else {
-        dense_spd(n, n as u64)
+    let family = args.next().unwrap_or_default();
+    let read = |path: String| -> Result<Vec<f64>, Box<dyn std::error::Error>> {
+        let text = std::fs::read_to_string(path)?;
+        Ok(text
+            .split_whitespace()
+            .map(|t| t.parse::<f64>())
+            .collect::<Result<_, _>>()?)
     };
-    let lcp = LcpRef::new(n, &m.data, &q)?;
+    let (m, q) = match family.as_str() {
+        "psd" => {
+            let (m, q, _, _) = planted_psd(n, n / 2, 1);
+            (m.data, q)
+        }
+        "" | "spd" => {
+            let (m, q) = dense_spd(n, n as u64);
+            (m.data, q)
+        }
+        prefix => (read(format!("{prefix}_M.txt"))?, read(format!("{prefix}_q.txt"))?),
+    };
+    let lcp = LcpRef::new(n, &m, &q)?;
     let s = LemkeSettings {
         polish,
         ..Default::default()
