@@ -176,7 +176,7 @@ pub fn max_abs_scaled(x: &[f64], s: &[f64]) -> f64 {
 /// (x * 0 is NaN exactly for NaN and infinite x, and the sum keeps
 /// it).
 #[inline(always)]
-pub fn max_abs_pair(a: &[f64], b: &[f64]) -> (f64, f64) {
+pub fn max_abs_pair_portable(a: &[f64], b: &[f64]) -> (f64, f64) {
     let n = a.len().min(b.len());
     let split = n / 8 * 8;
     let (mut la, mut lb) = ([0.0f64; 8], [0.0f64; 8]);
@@ -210,7 +210,7 @@ pub fn max_abs_pair(a: &[f64], b: &[f64]) -> (f64, f64) {
 /// comparisons and products, which vectorize (a division per row does not: the compiler
 /// guards it with a branch). Only the eight lanes' fractions are divided at the end.
 #[inline(always)]
-pub fn min_ratio(f: &[f64], b: &mut [f64], piv_tol: f64, zero: f64) -> f64 {
+pub fn min_ratio_portable(f: &[f64], b: &mut [f64], piv_tol: f64, zero: f64) -> f64 {
     let n = f.len().min(b.len());
     let split = n / 8 * 8;
     let mut num = [f64::INFINITY; 8];
@@ -248,7 +248,7 @@ pub fn min_ratio(f: &[f64], b: &mut [f64], piv_tol: f64, zero: f64) -> f64 {
 /// returned. A vector comparison per eight rows finds them; rows are visited only from the
 /// (usually one) block that holds a tie.
 #[inline(always)]
-pub fn find_ties(
+pub fn find_ties_portable(
     f: &[f64],
     b: &[f64],
     piv_tol: f64,
@@ -277,6 +277,52 @@ pub fn find_ties(
     (split..n).find(|&i| (f[i] > piv_tol) & (b[i] <= bound * f[i]) && visit(i))
 }
 
+/// [`max_abs_pair_portable`] with the AVX-512 form on CPUs that have it.
+#[inline(always)]
+pub fn max_abs_pair(isa: Isa, a: &[f64], b: &[f64]) -> (f64, f64) {
+    #[cfg(target_arch = "x86_64")]
+    if isa == Isa::Avx512 {
+        let n = a.len().min(b.len());
+        // SAFETY: `detect` found AVX-512F on this CPU; both slices hold n entries.
+        return unsafe { super::simd512::max_abs_pair(a, b, n) };
+    }
+    let _ = isa;
+    max_abs_pair_portable(a, b)
+}
+
+/// [`min_ratio_portable`] with the AVX-512 form on CPUs that have it.
+#[inline(always)]
+pub fn min_ratio(isa: Isa, f: &[f64], b: &mut [f64], piv_tol: f64, zero: f64) -> f64 {
+    #[cfg(target_arch = "x86_64")]
+    if isa == Isa::Avx512 {
+        let n = f.len().min(b.len());
+        // SAFETY: as in `max_abs_pair`.
+        return unsafe { super::simd512::min_ratio(f, b, n, piv_tol, zero) };
+    }
+    let _ = isa;
+    min_ratio_portable(f, b, piv_tol, zero)
+}
+
+/// [`find_ties_portable`] with the AVX-512 form on CPUs that have it.
+#[inline(always)]
+pub fn find_ties(
+    isa: Isa,
+    f: &[f64],
+    b: &[f64],
+    piv_tol: f64,
+    bound: f64,
+    visit: impl FnMut(usize) -> bool,
+) -> Option<usize> {
+    #[cfg(target_arch = "x86_64")]
+    if isa == Isa::Avx512 {
+        let n = f.len().min(b.len());
+        // SAFETY: as in `max_abs_pair`.
+        return unsafe { super::simd512::find_ties(f, b, n, piv_tol, bound, visit) };
+    }
+    let _ = isa;
+    find_ties_portable(f, b, piv_tol, bound, visit)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -303,27 +349,32 @@ mod tests {
         let want_s: f64 = x.iter().zip(&s).map(|(a, b)| (a * b).abs()).sum();
         assert!((d - want_d).abs() < 1e-13 && (s_abs - want_s).abs() < 1e-13);
         assert_eq!(d, d1);
-        let (pa, ps) = dispatch!(detect(), (f64, f64), || max_abs_pair(&x, &s));
+        let (pa, ps) = dispatch!(detect(), (f64, f64), || max_abs_pair(detect(), &x, &s));
         assert_eq!(pa, x.iter().fold(0.0, |m: f64, v| m.max(v.abs())));
         assert_eq!(ps, s.iter().fold(0.0, |m: f64, v| m.max(v.abs())));
         let mut bad = x.clone();
         bad[35] = f64::INFINITY;
-        assert!(dispatch!(detect(), (f64, f64), || max_abs_pair(&s, &bad))
-            .1
-            .is_nan());
+        for isa in [detect(), Isa::Baseline] {
+            let (a, b) = dispatch!(isa, (f64, f64), || max_abs_pair(isa, &s, &bad));
+            assert!(a.is_finite() && !b.is_finite());
+            bad[35] = f64::NAN;
+        }
     }
 
     /// the division-free minimum ratio and the tie scan against the ratios themselves
     #[test]
     fn ratio_test_kernels_agree_with_the_ratios() {
-        for n in [1usize, 7, 8, 9, 37, 100] {
+        for (isa, n) in [detect(), Isa::Baseline]
+            .into_iter()
+            .flat_map(|isa| [1usize, 7, 8, 9, 37, 100].map(|n| (isa, n)))
+        {
             let f: Vec<f64> = (0..n).map(|k| (k as f64 * 1.3).sin()).collect();
             let b0: Vec<f64> = (0..n)
                 .map(|k| (k as f64 * 0.7).cos().abs() - 0.05)
                 .collect();
             let (piv_tol, zero) = (1e-11, 1e-13);
             let mut b = b0.clone();
-            let theta = dispatch!(detect(), f64, || min_ratio(&f, &mut b, piv_tol, zero));
+            let theta = dispatch!(isa, f64, || min_ratio(isa, &f, &mut b, piv_tol, zero));
             let clipped: Vec<f64> = b0
                 .iter()
                 .map(|v| if *v <= zero { 0.0 } else { *v })
@@ -336,7 +387,8 @@ mod tests {
             assert_eq!(theta, want, "n = {n}");
             let bound = theta * 1.5;
             let mut seen = Vec::new();
-            let stop = dispatch!(detect(), Option<usize>, || find_ties(
+            let stop = dispatch!(isa, Option<usize>, || find_ties(
+                isa,
                 &f,
                 &b,
                 piv_tol,
@@ -352,12 +404,22 @@ mod tests {
                 .collect();
             assert_eq!(seen, tied, "n = {n}");
             if let Some(&last) = tied.last() {
-                let first = find_ties(&f, &b, piv_tol, bound, |i| i == last);
+                let first = dispatch!(isa, Option<usize>, || find_ties(
+                    isa,
+                    &f,
+                    &b,
+                    piv_tol,
+                    bound,
+                    |i| i == last
+                ));
                 assert_eq!(first, Some(last));
             }
         }
         // no blocking row: a ray
         let mut b = vec![1.0; 9];
-        assert_eq!(min_ratio(&[-1.0; 9], &mut b, 1e-11, 0.0), f64::INFINITY);
+        for isa in [detect(), Isa::Baseline] {
+            let theta = dispatch!(isa, f64, || min_ratio(isa, &[-1.0; 9], &mut b, 1e-11, 0.0));
+            assert_eq!(theta, f64::INFINITY);
+        }
     }
 }

@@ -322,6 +322,7 @@ impl LemkeWorkspace {
         self.column = column;
         let z0 = self.z0();
         match ties::blocking_rows(
+            self.isa,
             &self.column,
             &mut self.values,
             &self.basic,

@@ -22,6 +22,8 @@ pub mod lemke;
 pub mod pgs;
 mod revised;
 mod scaling;
+#[cfg(target_arch = "x86_64")]
+mod simd512;
 mod small;
 mod ties;
 

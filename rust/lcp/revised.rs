@@ -56,6 +56,9 @@ pub(super) struct RevisedLemke {
     etas: Vec<f64>,
     eta_rows: Vec<usize>,
     count: usize,
+    /// per complete block of ETA_BLOCK etas, the 8 x 8 matrix G (column-major) that gives
+    /// the block's multipliers from the entries it reads, `t = G x_R` (see `apply_etas`).
+    block_maps: Vec<f64>,
     /// explicit `B_0^{-1}` (row-major n x n) once the file has been folded; empty before.
     base: Vec<f64>,
     has_base: bool,
@@ -93,6 +96,7 @@ impl RevisedLemke {
             etas: vec![0.0; cap * n],
             eta_rows: vec![0; cap],
             count: 0,
+            block_maps: vec![0.0; cap.div_ceil(ETA_BLOCK) * ETA_BLOCK * ETA_BLOCK],
             base: Vec::new(),
             has_base: false,
             fold_rows: Vec::new(),
@@ -254,6 +258,7 @@ impl RevisedLemke {
     fn ratio_test(&mut self) -> Result<Option<usize>, ()> {
         let z0 = self.z0();
         match ties::blocking_rows(
+            self.isa,
             &self.column,
             &mut self.values,
             &self.basic,
@@ -280,28 +285,37 @@ impl RevisedLemke {
         }
     }
 
-    /// `x <- E_p ⋯ E_1 x`, ETA_BLOCK etas at a time: the block's multipliers
-    /// `t_a = x[r_a]` (as updated by the block's earlier etas) come first from a tiny
-    /// triangular recurrence, then one pass over x adds `Σ_a t_a η̃_a`, so x is read and
-    /// written once per block instead of once per eta.
+    /// `x <- E_p ⋯ E_1 x`, ETA_BLOCK etas at a time. Eta a of a block adds `t_a η̃_a` with
+    /// `t_a = x[r_a]` as updated by the block's earlier etas,
+    ///
+    /// ```text
+    ///     t_a = x[r_a] + Σ_{b<a} η̃_b[r_a] t_b,   i.e.   (I - L) t = x_R,   t = G x_R,
+    /// ```
+    ///
+    /// with L strictly lower triangular. G = (I - L)^{-1} is formed once when the block is
+    /// complete (`close_block`), so the multipliers are a small matrix-vector product with no
+    /// chain of dependent loads; then one pass over x adds `Σ_a t_a η̃_a`, reading and writing
+    /// x once per block instead of once per eta.
     #[inline(always)]
     fn apply_etas(&self, x: &mut [f64]) {
         let n = self.n;
         let p = self.count;
         let mut j = 0;
         while j + ETA_BLOCK <= p {
-            let mut t = [0.0f64; ETA_BLOCK];
+            let mut xr = [0.0f64; ETA_BLOCK];
             let mut any = false;
-            for a in 0..ETA_BLOCK {
-                let r = self.eta_rows[j + a];
-                let mut v = x[r];
-                for (b, tb) in t.iter().enumerate().take(a) {
-                    v += tb * self.etas[(j + b) * n + r];
-                }
-                t[a] = v;
-                any |= v != 0.0;
+            for (a, v) in xr.iter_mut().enumerate() {
+                *v = x[self.eta_rows[j + a]];
+                any |= *v != 0.0;
             }
             if any {
+                let g = &self.block_maps[j * ETA_BLOCK..(j + ETA_BLOCK) * ETA_BLOCK];
+                let mut t = [0.0f64; ETA_BLOCK];
+                for (b, gcol) in g.chunks_exact(ETA_BLOCK).enumerate() {
+                    for a in 0..ETA_BLOCK {
+                        t[a] += gcol[a] * xr[b];
+                    }
+                }
                 let block = &self.etas[j * n..(j + ETA_BLOCK) * n];
                 let (e0, rest) = block.split_at(n);
                 let (e1, rest) = rest.split_at(n);
@@ -314,15 +328,32 @@ impl RevisedLemke {
                 let len = x.len();
                 let (e0, e1, e2, e3) = (&e0[..len], &e1[..len], &e2[..len], &e3[..len]);
                 let (e4, e5, e6, e7) = (&e4[..len], &e5[..len], &e6[..len], &e7[..len]);
-                for (i, xi) in x.iter_mut().enumerate() {
-                    *xi += t[0] * e0[i]
-                        + t[1] * e1[i]
-                        + t[2] * e2[i]
-                        + t[3] * e3[i]
-                        + t[4] * e4[i]
-                        + t[5] * e5[i]
-                        + t[6] * e6[i]
-                        + t[7] * e7[i];
+                if self.isa == Isa::Baseline {
+                    for (i, xi) in x.iter_mut().enumerate() {
+                        *xi += t[0] * e0[i]
+                            + t[1] * e1[i]
+                            + t[2] * e2[i]
+                            + t[3] * e3[i]
+                            + t[4] * e4[i]
+                            + t[5] * e5[i]
+                            + t[6] * e6[i]
+                            + t[7] * e7[i];
+                    }
+                } else {
+                    // fused multiply-adds (a library call without FMA hardware, hence the
+                    // baseline branch) in two chains of four, so a lane waits on four
+                    // dependent operations, not eight
+                    for (i, xi) in x.iter_mut().enumerate() {
+                        let a = e0[i].mul_add(t[0], *xi);
+                        let a = e1[i].mul_add(t[1], a);
+                        let a = e2[i].mul_add(t[2], a);
+                        let a = e3[i].mul_add(t[3], a);
+                        let b = e4[i] * t[4];
+                        let b = e5[i].mul_add(t[5], b);
+                        let b = e6[i].mul_add(t[6], b);
+                        let b = e7[i].mul_add(t[7], b);
+                        *xi = a + b;
+                    }
                 }
             }
             j += ETA_BLOCK;
@@ -331,6 +362,26 @@ impl RevisedLemke {
             let t = x[self.eta_rows[k]];
             if t != 0.0 {
                 axpy(x, t, &self.etas[k * n..(k + 1) * n]);
+            }
+        }
+    }
+
+    /// forms G = (I - L)^{-1} for the block of etas starting at j, `L_ab = η̃_b[r_a]` (b < a),
+    /// column by column: `g_a = δ_ac + Σ_{b<a} L_ab g_b` for column c.
+    fn close_block(&mut self, j: usize) {
+        let n = self.n;
+        let g = &mut self.block_maps[j * ETA_BLOCK..(j + ETA_BLOCK) * ETA_BLOCK];
+        for c in 0..ETA_BLOCK {
+            let col = &mut g[c * ETA_BLOCK..(c + 1) * ETA_BLOCK];
+            col.iter_mut().for_each(|v| *v = 0.0);
+            col[c] = 1.0;
+            for a in c + 1..ETA_BLOCK {
+                let r = self.eta_rows[j + a];
+                let mut v = 0.0;
+                for b in c..a {
+                    v += self.etas[(j + b) * n + r] * col[b];
+                }
+                col[a] = v;
             }
         }
     }
@@ -396,6 +447,9 @@ impl RevisedLemke {
         eta[r] = inv - 1.0;
         self.eta_rows[j] = r;
         self.count += 1;
+        if self.count % ETA_BLOCK == 0 {
+            self.close_block(self.count - ETA_BLOCK);
+        }
         let t = self.values[r];
         axpy(&mut self.values, t, &self.etas[j * n..(j + 1) * n]);
         let leaving = self.basic[r];

@@ -1,7 +1,7 @@
 //! The tie-breaking rules Lemke's two engines share (the tableau in `lemke`, the product
 //! form in `revised`): they differ only in how an entry of B^{-1} is read.
 
-use super::kernel;
+use super::kernel::{self, Isa};
 
 /// relative gap within which two ratios count as tied.
 pub(super) const TIE_EPS: f64 = 1e-9;
@@ -31,25 +31,26 @@ pub(super) enum Blocking {
 /// per row.
 #[inline(always)]
 pub(super) fn blocking_rows(
+    isa: Isa,
     column: &[f64],
     values: &mut [f64],
     basic: &[usize],
     z0: usize,
     ties: &mut Vec<usize>,
 ) -> Blocking {
-    let (colmax, rhsmax) = kernel::max_abs_pair(column, values);
+    let (colmax, rhsmax) = kernel::max_abs_pair(isa, column, values);
     if !(colmax.is_finite() && rhsmax.is_finite()) {
         return Blocking::NonFinite;
     }
     let piv_tol = PIVOT_EPS * colmax.max(1.0);
     let zero_rhs = RHS_EPS * rhsmax.max(1.0);
-    let theta = kernel::min_ratio(column, values, piv_tol, zero_rhs);
+    let theta = kernel::min_ratio(isa, column, values, piv_tol, zero_rhs);
     if theta == f64::INFINITY {
         return Blocking::Ray;
     }
     let bound = theta + TIE_EPS * theta;
     ties.clear();
-    let z0_row = kernel::find_ties(column, values, piv_tol, bound, |i| {
+    let z0_row = kernel::find_ties(isa, column, values, piv_tol, bound, |i| {
         ties.push(i);
         basic[i] == z0
     });
