@@ -26,7 +26,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let (m, q) = dense_spd(n, n as u64);
             (m.data, q)
         }
-        prefix => (read(format!("{prefix}_M.txt"))?, read(format!("{prefix}_q.txt"))?),
+        prefix => (
+            read(format!("{prefix}_M.txt"))?,
+            read(format!("{prefix}_q.txt"))?,
+        ),
     };
     let lcp = LcpRef::new(n, &m, &q)?;
     let s = LemkeSettings {

@@ -254,7 +254,7 @@ fn check_facets(dim: usize, facets: usize) -> Result<()> {
              {facets}"
         )));
     }
-    if dim == 3 && (facets < 4 || facets % 2 != 0) {
+    if dim == 3 && (facets < 4 || !facets.is_multiple_of(2)) {
         return Err(CoulombError::InvalidParameter(format!(
             "facets must be even and at least 4 in 3D (tangent directions in +/- pairs), got \
              {facets}"

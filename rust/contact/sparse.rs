@@ -50,7 +50,7 @@ fn check_dims(dim: usize, n: usize) -> Result<usize> {
             "dim must be 2 (planar) or 3 (spatial), got {dim}"
         )));
     }
-    if n % dim != 0 {
+    if !n.is_multiple_of(dim) {
         return Err(CoulombError::Shape(format!(
             "W is {n} x {n}, which is not a whole number of {dim} x {dim} contact blocks"
         )));

@@ -47,6 +47,39 @@ const LEX_ROWS: usize = 64;
 /// etas folded together into the explicit inverse by one matrix product.
 const FOLD_BLOCK: usize = 16;
 
+/// `x += Σ_a t_a η̃_a` for the etas stored row after row in `etas`: the AVX-512 form where
+/// the CPU has it; else fused multiply-adds in two chains (a library call without FMA
+/// hardware, hence the plain form for the baseline).
+#[inline(always)]
+fn eta_pass<const M: usize>(isa: Isa, x: &mut [f64], etas: &[f64], t: &[f64; M]) {
+    let n = x.len();
+    #[cfg(target_arch = "x86_64")]
+    if isa == Isa::Avx512 {
+        // SAFETY: `kernel::detect` found AVX-512F on this CPU; `etas` holds M rows of n.
+        unsafe { super::simd512::eta_pass(x, &etas[..M * n], t) };
+        return;
+    }
+    let fused = isa != Isa::Baseline;
+    for (i, xi) in x.iter_mut().enumerate() {
+        let (mut even, mut odd) = (*xi, 0.0);
+        for a in 0..M {
+            let e = etas[a * n + i];
+            if fused {
+                if a % 2 == 0 {
+                    even = e.mul_add(t[a], even);
+                } else {
+                    odd = e.mul_add(t[a], odd);
+                }
+            } else if a % 2 == 0 {
+                even += e * t[a];
+            } else {
+                odd += e * t[a];
+            }
+        }
+        *xi = even + odd;
+    }
+}
+
 /// Storage of the product-form path, sized once for n and reused.
 pub(super) struct RevisedLemke {
     n: usize,
@@ -317,51 +350,36 @@ impl RevisedLemke {
                     }
                 }
                 let block = &self.etas[j * n..(j + ETA_BLOCK) * n];
-                let (e0, rest) = block.split_at(n);
-                let (e1, rest) = rest.split_at(n);
-                let (e2, rest) = rest.split_at(n);
-                let (e3, rest) = rest.split_at(n);
-                let (e4, rest) = rest.split_at(n);
-                let (e5, rest) = rest.split_at(n);
-                let (e6, e7) = rest.split_at(n);
-                // equal lengths let the compiler drop the bounds checks and vectorize
-                let len = x.len();
-                let (e0, e1, e2, e3) = (&e0[..len], &e1[..len], &e2[..len], &e3[..len]);
-                let (e4, e5, e6, e7) = (&e4[..len], &e5[..len], &e6[..len], &e7[..len]);
-                if self.isa == Isa::Baseline {
-                    for (i, xi) in x.iter_mut().enumerate() {
-                        *xi += t[0] * e0[i]
-                            + t[1] * e1[i]
-                            + t[2] * e2[i]
-                            + t[3] * e3[i]
-                            + t[4] * e4[i]
-                            + t[5] * e5[i]
-                            + t[6] * e6[i]
-                            + t[7] * e7[i];
-                    }
-                } else {
-                    // fused multiply-adds (a library call without FMA hardware, hence the
-                    // baseline branch) in two chains of four, so a lane waits on four
-                    // dependent operations, not eight
-                    for (i, xi) in x.iter_mut().enumerate() {
-                        let a = e0[i].mul_add(t[0], *xi);
-                        let a = e1[i].mul_add(t[1], a);
-                        let a = e2[i].mul_add(t[2], a);
-                        let a = e3[i].mul_add(t[3], a);
-                        let b = e4[i] * t[4];
-                        let b = e5[i].mul_add(t[5], b);
-                        let b = e6[i].mul_add(t[6], b);
-                        let b = e7[i].mul_add(t[7], b);
-                        *xi = a + b;
-                    }
-                }
+                eta_pass(self.isa, x, block, &t);
             }
             j += ETA_BLOCK;
         }
-        for k in j..p {
-            let t = x[self.eta_rows[k]];
-            if t != 0.0 {
-                axpy(x, t, &self.etas[k * n..(k + 1) * n]);
+        // the last, partial block: its multipliers by the recurrence itself
+        let m = p - j;
+        if m > 0 {
+            let mut t = [0.0f64; ETA_BLOCK];
+            for a in 0..m {
+                let r = self.eta_rows[j + a];
+                let mut v = x[r];
+                for (b, tb) in t.iter().enumerate().take(a) {
+                    v += tb * self.etas[(j + b) * n + r];
+                }
+                t[a] = v;
+            }
+            let block = &self.etas[j * n..p * n];
+            match m {
+                1 => eta_pass(self.isa, x, block, &[t[0]]),
+                2 => eta_pass(self.isa, x, block, &[t[0], t[1]]),
+                3 => eta_pass(self.isa, x, block, &[t[0], t[1], t[2]]),
+                4 => eta_pass(self.isa, x, block, &[t[0], t[1], t[2], t[3]]),
+                5 => eta_pass(self.isa, x, block, &[t[0], t[1], t[2], t[3], t[4]]),
+                6 => eta_pass(self.isa, x, block, &[t[0], t[1], t[2], t[3], t[4], t[5]]),
+                _ => eta_pass(
+                    self.isa,
+                    x,
+                    block,
+                    &[t[0], t[1], t[2], t[3], t[4], t[5], t[6]],
+                ),
             }
         }
     }
@@ -378,8 +396,8 @@ impl RevisedLemke {
             for a in c + 1..ETA_BLOCK {
                 let r = self.eta_rows[j + a];
                 let mut v = 0.0;
-                for b in c..a {
-                    v += self.etas[(j + b) * n + r] * col[b];
+                for (b, gb) in col.iter().enumerate().take(a).skip(c) {
+                    v += self.etas[(j + b) * n + r] * gb;
                 }
                 col[a] = v;
             }
@@ -447,7 +465,7 @@ impl RevisedLemke {
         eta[r] = inv - 1.0;
         self.eta_rows[j] = r;
         self.count += 1;
-        if self.count % ETA_BLOCK == 0 {
+        if self.count.is_multiple_of(ETA_BLOCK) {
             self.close_block(self.count - ETA_BLOCK);
         }
         let t = self.values[r];
@@ -586,5 +604,42 @@ impl RevisedLemke {
             }
         }
         basis.sort_unstable();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// every form of the eta pass (AVX-512 where the CPU has it, fused, plain) against the
+    /// definition `x + Σ_a t_a η̃_a`, for lengths with and without a partial vector
+    fn check_eta_pass<const M: usize>(t: [f64; M]) {
+        for n in [1usize, 5, 8, 13, 100] {
+            let etas: Vec<f64> = (0..M * n).map(|k| (k as f64 * 0.77).sin()).collect();
+            let x0: Vec<f64> = (0..n).map(|k| (k as f64 * 0.31).cos()).collect();
+            let want: Vec<f64> = (0..n)
+                .map(|i| x0[i] + (0..M).map(|a| t[a] * etas[a * n + i]).sum::<f64>())
+                .collect();
+            for isa in [kernel::detect(), Isa::Avx2, Isa::Baseline] {
+                if isa == Isa::Avx2 && kernel::detect() == Isa::Baseline {
+                    continue;
+                }
+                let mut x = x0.clone();
+                kernel::dispatch!(isa, (), || eta_pass(isa, &mut x, &etas, &t));
+                for i in 0..n {
+                    assert!((x[i] - want[i]).abs() <= 1e-14, "{isa:?} M={M} n={n} i={i}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn eta_pass_forms_agree_with_the_definition() {
+        check_eta_pass([0.5]);
+        check_eta_pass([0.5, -1.25]);
+        check_eta_pass([0.5, -1.25, 2.0]);
+        check_eta_pass([0.5, -1.25, 2.0, 0.0, 3.5]);
+        check_eta_pass([0.5, -1.25, 2.0, 0.0, 3.5, -0.75, 1.0]);
+        check_eta_pass([0.5, -1.25, 2.0, 0.0, 3.5, -0.75, 1.0, 4.0]);
     }
 }
