@@ -105,7 +105,7 @@ pub fn axpy(y: &mut [f64], a: f64, x: &[f64]) {
 /// passes: fused into one loop, the shared product defeats the vectorizer (it emits scalar
 /// multiplies), and the second pass reads data the first left in L1.
 #[inline(always)]
-pub fn dot_and_abs(a: &[f64], b: &[f64]) -> (f64, f64) {
+pub fn dot_and_abs_portable(a: &[f64], b: &[f64]) -> (f64, f64) {
     let n = a.len().min(b.len());
     let (a, b) = (&a[..n], &b[..n]);
     let mut dot = [0.0f64; 8];
@@ -131,9 +131,9 @@ pub fn dot_and_abs(a: &[f64], b: &[f64]) -> (f64, f64) {
     (d, s)
 }
 
-/// `Σ_j a_j b_j` with eight partial sums (see [`dot_and_abs`]).
+/// `Σ_j a_j b_j` with eight partial sums (see [`dot_and_abs_portable`]).
 #[inline(always)]
-pub fn dot(a: &[f64], b: &[f64]) -> f64 {
+pub fn dot_portable(a: &[f64], b: &[f64]) -> f64 {
     let n = a.len().min(b.len());
     let (a, b) = (&a[..n], &b[..n]);
     let mut acc = [0.0f64; 8];
@@ -277,6 +277,132 @@ pub fn find_ties_portable(
     (split..n).find(|&i| (f[i] > piv_tol) & (b[i] <= bound * f[i]) && visit(i))
 }
 
+/// [`dot_and_abs_portable`] with the AVX-512 form (one pass) on CPUs that have it.
+#[inline(always)]
+pub fn dot_and_abs(isa: Isa, a: &[f64], b: &[f64]) -> (f64, f64) {
+    #[cfg(target_arch = "x86_64")]
+    if isa == Isa::Avx512 {
+        let n = a.len().min(b.len());
+        // SAFETY: `detect` found AVX-512F on this CPU; both slices hold n entries.
+        return unsafe { super::simd512::dot_and_abs(a, b, n) };
+    }
+    let _ = isa;
+    dot_and_abs_portable(a, b)
+}
+
+/// `out_i = Σ_j m_ij z_j` and `abs_i = Σ_j |m_ij z_j|` for every row of the row-major matrix
+/// `m` (rows of length `z.len()`): four rows at a time where the CPU has AVX-512.
+#[inline(always)]
+pub fn matvec_and_abs(isa: Isa, m: &[f64], z: &[f64], out: &mut [f64], abs: &mut [f64]) {
+    let n = z.len();
+    let rows = out.len().min(abs.len()).min(m.len() / n.max(1));
+    let mut i = 0;
+    #[cfg(target_arch = "x86_64")]
+    if isa == Isa::Avx512 {
+        while i + 4 <= rows {
+            // SAFETY: `detect` found AVX-512F on this CPU; rows i..i+4 lie inside m.
+            let (d, s) = unsafe { super::simd512::dot_and_abs4(&m[i * n..(i + 4) * n], z, n) };
+            out[i..i + 4].copy_from_slice(&d);
+            abs[i..i + 4].copy_from_slice(&s);
+            i += 4;
+        }
+    }
+    while i < rows {
+        let (d, s) = dot_and_abs(isa, &m[i * n..(i + 1) * n], z);
+        out[i] = d;
+        abs[i] = s;
+        i += 1;
+    }
+}
+
+/// `out_i = Σ_j m_ij z_j` for every row of the row-major matrix `m` (see
+/// [`matvec_and_abs`]).
+#[inline(always)]
+pub fn matvec(isa: Isa, m: &[f64], z: &[f64], out: &mut [f64]) {
+    let n = z.len();
+    let rows = out.len().min(m.len() / n.max(1));
+    let mut i = 0;
+    #[cfg(target_arch = "x86_64")]
+    if isa == Isa::Avx512 {
+        while i + 4 <= rows {
+            // SAFETY: as in `matvec_and_abs`.
+            let d = unsafe { super::simd512::dot4(&m[i * n..(i + 4) * n], z, n) };
+            out[i..i + 4].copy_from_slice(&d);
+            i += 4;
+        }
+    }
+    while i < rows {
+        out[i] = dot(isa, &m[i * n..(i + 1) * n], z);
+        i += 1;
+    }
+}
+
+/// [`dot_portable`] with the AVX-512 form on CPUs that have it.
+#[inline(always)]
+pub fn dot(isa: Isa, a: &[f64], b: &[f64]) -> f64 {
+    #[cfg(target_arch = "x86_64")]
+    if isa == Isa::Avx512 {
+        let n = a.len().min(b.len());
+        // SAFETY: as in `dot_and_abs`.
+        return unsafe { super::simd512::dot(a, b, n) };
+    }
+    let _ = isa;
+    dot_portable(a, b)
+}
+
+/// One row of a Ruiz sweep: `max_j |x_j s_j|`, raising `colmax_j` to `|x_j r|` on the way
+/// (one pass over the row where the CPU has AVX-512, two otherwise).
+#[inline(always)]
+pub fn ruiz_row(isa: Isa, x: &[f64], s: &[f64], r: f64, colmax: &mut [f64]) -> f64 {
+    #[cfg(target_arch = "x86_64")]
+    if isa == Isa::Avx512 {
+        let n = x.len().min(s.len()).min(colmax.len());
+        // SAFETY: as in `dot_and_abs`; the three slices hold n entries.
+        return unsafe { super::simd512::ruiz_row(x, s, r, colmax, n) };
+    }
+    let _ = isa;
+    for (cm, v) in colmax.iter_mut().zip(x) {
+        let a = (v * r).abs();
+        *cm = if a > *cm { a } else { *cm };
+    }
+    max_abs_scaled(x, s)
+}
+
+/// One Ruiz sweep over the row-major matrix `m` (rows of length `col.len()`) with factors R
+/// (`row`) and C (`col`): `rowmax_i = r_i max_j |m_ij c_j|` and `colmax_j = max_i |m_ij r_i|`
+/// (colmax is overwritten). Four rows at a time where the CPU has AVX-512.
+#[inline(always)]
+pub fn ruiz_sweep(
+    isa: Isa,
+    m: &[f64],
+    row: &[f64],
+    col: &[f64],
+    rowmax: &mut [f64],
+    colmax: &mut [f64],
+) {
+    let n = col.len();
+    let rows = row.len().min(rowmax.len()).min(m.len() / n.max(1));
+    colmax.iter_mut().for_each(|c| *c = 0.0);
+    let mut i = 0;
+    #[cfg(target_arch = "x86_64")]
+    if isa == Isa::Avx512 && colmax.len() >= n {
+        while i + 4 <= rows {
+            let r = [row[i], row[i + 1], row[i + 2], row[i + 3]];
+            // SAFETY: `detect` found AVX-512F on this CPU; rows i..i+4 lie inside m.
+            let mx =
+                unsafe { super::simd512::ruiz_row4(&m[i * n..(i + 4) * n], col, r, colmax, n) };
+            for q in 0..4 {
+                rowmax[i + q] = r[q] * mx[q];
+            }
+            i += 4;
+        }
+    }
+    while i < rows {
+        rowmax[i] = row[i] * ruiz_row(isa, &m[i * n..(i + 1) * n], col, row[i], colmax);
+        i += 1;
+    }
+}
+
 /// [`max_abs_pair_portable`] with the AVX-512 form on CPUs that have it.
 #[inline(always)]
 pub fn max_abs_pair(isa: Isa, a: &[f64], b: &[f64]) -> (f64, f64) {
@@ -343,12 +469,48 @@ mod tests {
             .map(|(a, b)| (a * b).abs())
             .fold(0.0, f64::max);
         assert_eq!(m, want);
-        let (d, s_abs) = dispatch!(detect(), (f64, f64), || dot_and_abs(&x, &s));
-        let d1 = dispatch!(detect(), f64, || dot(&x, &s));
         let want_d: f64 = x.iter().zip(&s).map(|(a, b)| a * b).sum();
         let want_s: f64 = x.iter().zip(&s).map(|(a, b)| (a * b).abs()).sum();
-        assert!((d - want_d).abs() < 1e-13 && (s_abs - want_s).abs() < 1e-13);
-        assert_eq!(d, d1);
+        for isa in [detect(), Isa::Baseline] {
+            let (d, s_abs) = dispatch!(isa, (f64, f64), || dot_and_abs(isa, &x, &s));
+            let d1 = dispatch!(isa, f64, || dot(isa, &x, &s));
+            assert!((d - want_d).abs() < 1e-13 && (s_abs - want_s).abs() < 1e-13);
+            assert_eq!(d, d1);
+            let m: Vec<f64> = (0..37 * 9).map(|k| (k as f64 * 0.13).cos()).collect();
+            let (mut out, mut abs, mut out2) = (vec![0.0; 9], vec![0.0; 9], vec![0.0; 9]);
+            dispatch!(isa, (), || matvec_and_abs(isa, &m, &x, &mut out, &mut abs));
+            dispatch!(isa, (), || matvec(isa, &m, &x, &mut out2));
+            for i in 0..9 {
+                let row = &m[i * 37..(i + 1) * 37];
+                let want: f64 = row.iter().zip(&x).map(|(a, b)| a * b).sum();
+                let want_abs: f64 = row.iter().zip(&x).map(|(a, b)| (a * b).abs()).sum();
+                assert!((out[i] - want).abs() < 1e-13 && (abs[i] - want_abs).abs() < 1e-13);
+                assert_eq!(out[i], out2[i]);
+            }
+            let row9: Vec<f64> = (0..9).map(|i| 0.5 + i as f64).collect();
+            let (mut rmx, mut cmx) = (vec![0.0; 9], vec![7.0; 37]);
+            dispatch!(isa, (), || ruiz_sweep(
+                isa, &m, &row9, &x, &mut rmx, &mut cmx
+            ));
+            for i in 0..9 {
+                let want = (0..37)
+                    .map(|j| (m[i * 37 + j] * x[j]).abs())
+                    .fold(0.0, f64::max);
+                assert_eq!(rmx[i], row9[i] * want);
+            }
+            for j in 0..37 {
+                let want = (0..9)
+                    .map(|i| (m[i * 37 + j] * row9[i]).abs())
+                    .fold(0.0, f64::max);
+                assert_eq!(cmx[j], want);
+            }
+            let mut colmax = vec![0.1; 37];
+            let m = dispatch!(isa, f64, || ruiz_row(isa, &x, &s, -2.0, &mut colmax));
+            assert_eq!(m, max_abs_scaled(&x, &s));
+            for k in 0..37 {
+                assert_eq!(colmax[k], (2.0 * x[k].abs()).max(0.1));
+            }
+        }
         let (pa, ps) = dispatch!(detect(), (f64, f64), || max_abs_pair(detect(), &x, &s));
         assert_eq!(pa, x.iter().fold(0.0, |m: f64, v| m.max(v.abs())));
         assert_eq!(ps, s.iter().fold(0.0, |m: f64, v| m.max(v.abs())));

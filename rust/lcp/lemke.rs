@@ -497,11 +497,11 @@ impl LemkeWorkspace {
         }
         // the pending updates enter as (T + U^T V) s = T s + U^T (V s): no flush needed
         for p in 0..self.pending {
-            self.spare[p] = kernel::dot(&self.pending_v[p * w..(p + 1) * w], &self.row);
+            self.spare[p] = kernel::dot(self.isa, &self.pending_v[p * w..(p + 1) * w], &self.row);
         }
         for &j in &self.ties {
             if let Loc::Row(i) = self.loc[n + j] {
-                let mut d = kernel::dot(&self.tableau[i * w..(i + 1) * w], &self.row);
+                let mut d = kernel::dot(self.isa, &self.tableau[i * w..(i + 1) * w], &self.row);
                 for p in 0..self.pending {
                     d += self.pending_u[p * n + i] * self.spare[p];
                 }

@@ -222,31 +222,37 @@ impl<'a> LcpRef<'a> {
     /// instructions.
     fn evaluate_parts(&self, z: &[f64], scaling: &scaling::Equilibration) -> (Vec<f64>, Vec<f64>) {
         let isa = kernel::detect();
-        kernel::dispatch!(isa, (Vec<f64>, Vec<f64>), || self.evaluate_body(z, scaling))
+        kernel::dispatch!(isa, (Vec<f64>, Vec<f64>), || self
+            .evaluate_body(isa, z, scaling))
     }
 
     #[inline(always)]
-    fn evaluate_body(&self, z: &[f64], scaling: &scaling::Equilibration) -> (Vec<f64>, Vec<f64>) {
+    fn evaluate_body(
+        &self,
+        isa: kernel::Isa,
+        z: &[f64],
+        scaling: &scaling::Equilibration,
+    ) -> (Vec<f64>, Vec<f64>) {
         let n = self.n;
         // max_k |z_k / c_k|: the size of z in the equilibrated column units
         let zsize = z
             .iter()
             .zip(&scaling.col)
             .fold(0.0f64, |m, (v, c)| m.max((v / c).abs()));
-        let mut w = Vec::with_capacity(n);
-        let mut scale = Vec::with_capacity(n);
-        for ((mrow, qi), reach) in self
-            .m
-            .chunks_exact(n.max(1))
+        let mut w = vec![0.0; n];
+        let mut scale = vec![0.0; n];
+        kernel::matvec_and_abs(isa, self.m, z, &mut w, &mut scale);
+        for (((wi, si), qi), reach) in w
+            .iter_mut()
+            .zip(scale.iter_mut())
             .zip(self.q)
             .zip(&scaling.row_reach)
         {
-            let (dot, abs) = kernel::dot_and_abs(mrow, z);
-            w.push(dot + qi);
+            *wi += qi;
             // the terms of w_i, floored by what row i produces from a z of this size, so a
             // row whose terms all cancel to rounding is judged at the scale of the answer
             let floor = reach * zsize;
-            scale.push((abs + qi.abs()).max(floor));
+            *si = (*si + qi.abs()).max(floor);
         }
         (w, scale)
     }

@@ -217,7 +217,7 @@ impl RevisedLemke {
                 }
             } else {
                 for (o, brow) in out.iter_mut().zip(self.base.chunks_exact(n)) {
-                    *o = -kernel::dot(brow, &self.acol);
+                    *o = -kernel::dot(self.isa, brow, &self.acol);
                 }
             }
         } else if var < n {
@@ -241,7 +241,7 @@ impl RevisedLemke {
         y[i] = 1.0;
         for j in (0..self.count).rev() {
             let r = self.eta_rows[j];
-            y[r] += kernel::dot(&y, &self.etas[j * n..(j + 1) * n]);
+            y[r] += kernel::dot(self.isa, &y, &self.etas[j * n..(j + 1) * n]);
         }
         if self.has_base {
             // y^T B_0^{-1}: the base's rows weighted by y, summed in the second scratch vector
@@ -563,9 +563,9 @@ impl RevisedLemke {
         for (k, v) in zb.iter_mut().enumerate() {
             *v *= eq.col[k];
         }
-        for (i, mrow) in lcp.m.chunks_exact(n).enumerate() {
-            let mz = eq.row[i] * kernel::dot(mrow, &zb);
-            res[i] = eq.row[i] * lcp.q[i] / eq.sigma + mz + self.cover[i] * z0;
+        kernel::matvec(self.isa, lcp.m, &zb, &mut res);
+        for (((ri, r), qi), di) in res.iter_mut().zip(&eq.row).zip(lcp.q).zip(&self.cover) {
+            *ri = r * qi / eq.sigma + r * *ri + di * z0;
         }
         for i in 0..n {
             let var = self.basic[i];
@@ -576,7 +576,7 @@ impl RevisedLemke {
         let mut delta = std::mem::take(&mut self.column);
         if self.has_base {
             for (o, brow) in delta.iter_mut().zip(self.base.chunks_exact(n)) {
-                *o = kernel::dot(brow, &res);
+                *o = kernel::dot(self.isa, brow, &res);
             }
         } else {
             delta.copy_from_slice(&res);

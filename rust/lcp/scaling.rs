@@ -49,28 +49,20 @@ impl Equilibration {
     /// computes R, C and sigma for the row-major n x n matrix `m` and vector `q`.
     pub fn compute(n: usize, m: &[f64], q: &[f64]) -> Self {
         let isa = kernel::detect();
-        kernel::dispatch!(isa, Equilibration, || Self::compute_body(n, m, q))
+        kernel::dispatch!(isa, Equilibration, || Self::compute_body(isa, n, m, q))
     }
 
     /// Ruiz's simultaneous form: both factors of a sweep come from the same scaled matrix,
     /// so a sweep is one pass over M.
     #[inline(always)]
-    fn compute_body(n: usize, m: &[f64], q: &[f64]) -> Self {
+    fn compute_body(isa: kernel::Isa, n: usize, m: &[f64], q: &[f64]) -> Self {
         let mut row = vec![1.0; n];
         let mut col = vec![1.0; n];
         let mut rowmax = vec![0.0f64; n];
         let mut colmax = vec![0.0f64; n];
         let mut settled = false;
         for _ in 0..RUIZ_SWEEPS {
-            colmax.iter_mut().for_each(|c| *c = 0.0);
-            for (i, mrow) in m.chunks_exact(n.max(1)).enumerate() {
-                let r = row[i];
-                rowmax[i] = r * kernel::max_abs_scaled(mrow, &col);
-                for (cm, v) in colmax.iter_mut().zip(mrow) {
-                    let a = (v * r).abs();
-                    *cm = if a > *cm { a } else { *cm };
-                }
-            }
+            kernel::ruiz_sweep(isa, m, &row, &col, &mut rowmax, &mut colmax);
             settled = true;
             // only rows and columns off by more than a factor 4 are rescaled: equilibration is
             // for badly scaled data, and fine-tuning well-scaled data only costs sweeps

@@ -8,6 +8,26 @@
 
 use std::arch::x86_64::*;
 
+/// Runs `$body` for each group of eight rows `i..i + 8` below `$n` with `$k` the group's lanes:
+/// all eight (a constant, so masked loads become plain ones) for the full groups, then the
+/// tail's lanes for a last partial group. The body appears twice in the expansion.
+macro_rules! for_lanes {
+    ($n:expr, |$i:ident, $k:ident| $body:block) => {{
+        let rows: usize = $n;
+        let full = rows / 8 * 8;
+        let mut $i = 0usize;
+        while $i < full {
+            let $k: __mmask8 = 0xff;
+            $body
+            $i += 8;
+        }
+        if $i < rows {
+            let $k = lanes(rows - $i);
+            $body
+        }
+    }};
+}
+
 /// the lanes of the next eight rows when `left` rows remain: all eight, or the tail's.
 #[inline(always)]
 fn lanes(left: usize) -> __mmask8 {
@@ -31,9 +51,7 @@ pub(super) unsafe fn max_abs_pair(a: &[f64], b: &[f64], n: usize) -> (f64, f64) 
     let magnitude = _mm512_set1_epi64(i64::MAX);
     let (mut ma, mut mb) = (_mm512_setzero_si512(), _mm512_setzero_si512());
     let (pa, pb) = (a.as_ptr() as *const i64, b.as_ptr() as *const i64);
-    let mut i = 0;
-    while i < n {
-        let k = lanes(n - i);
+    for_lanes!(n, |i, k| {
         // SAFETY: only the lanes of k (entries below n) are read.
         let (va, vb) = unsafe {
             (
@@ -43,8 +61,7 @@ pub(super) unsafe fn max_abs_pair(a: &[f64], b: &[f64], n: usize) -> (f64, f64) 
         };
         ma = _mm512_max_epi64(ma, _mm512_and_si512(va, magnitude));
         mb = _mm512_max_epi64(mb, _mm512_and_si512(vb, magnitude));
-        i += 8;
-    }
+    });
     (
         f64::from_bits(_mm512_reduce_max_epi64(ma) as u64),
         f64::from_bits(_mm512_reduce_max_epi64(mb) as u64),
@@ -65,9 +82,7 @@ pub(super) unsafe fn min_ratio(f: &[f64], b: &mut [f64], n: usize, piv_tol: f64,
     let mut num = _mm512_set1_pd(f64::INFINITY);
     let mut den = _mm512_set1_pd(1.0);
     let (pf, pb) = (f.as_ptr(), b.as_mut_ptr());
-    let mut i = 0;
-    while i < n {
-        let k = lanes(n - i);
+    for_lanes!(n, |i, k| {
         // SAFETY: only the lanes of k (rows below n) are read and written; the others read
         // as f = 0, which does not block.
         let (vf, vb) = unsafe {
@@ -89,8 +104,7 @@ pub(super) unsafe fn min_ratio(f: &[f64], b: &mut [f64], n: usize, piv_tol: f64,
         );
         num = _mm512_mask_mov_pd(num, better, v);
         den = _mm512_mask_mov_pd(den, better, vf);
-        i += 8;
-    }
+    });
     _mm512_reduce_min_pd(_mm512_div_pd(num, den))
 }
 
@@ -113,9 +127,7 @@ pub(super) unsafe fn find_ties(
     let tol = _mm512_set1_pd(piv_tol);
     let bound = _mm512_set1_pd(bound);
     let (pf, pb) = (f.as_ptr(), b.as_ptr());
-    let mut i = 0;
-    while i < n {
-        let k = lanes(n - i);
+    for_lanes!(n, |i, k| {
         // SAFETY: only the lanes of k (rows below n) are read.
         let (vf, vb) = unsafe {
             (
@@ -133,8 +145,7 @@ pub(super) unsafe fn find_ties(
             }
             tied &= tied - 1;
         }
-        i += 8;
-    }
+    });
     None
 }
 
@@ -154,9 +165,7 @@ pub(super) unsafe fn eta_pass<const M: usize>(x: &mut [f64], etas: &[f64], t: &[
         *v = _mm512_set1_pd(*ta);
     }
     let (px, pe) = (x.as_mut_ptr(), etas.as_ptr());
-    let mut i = 0;
-    while i < n {
-        let k = lanes(n - i);
+    for_lanes!(n, |i, k| {
         // SAFETY: only the lanes of k (rows below n) of x and of each eta row are touched.
         unsafe {
             // two chains of multiply-adds, so a lane waits on M/2 dependent operations
@@ -176,6 +185,188 @@ pub(super) unsafe fn eta_pass<const M: usize>(x: &mut [f64], etas: &[f64], t: &[
             }
             _mm512_mask_storeu_pd(px.add(i), k, _mm512_add_pd(even, odd));
         }
-        i += 8;
-    }
+    });
+}
+
+/// `(Σ_j a_j b_j, Σ_j |a_j b_j|)` over the first `n` entries, in one pass (the product is
+/// formed once for both sums; no fused multiply-add, so the dot agrees with [`dot`]).
+///
+/// # Safety
+/// The CPU must support AVX-512F, and `a` and `b` must hold at least `n` entries.
+#[target_feature(enable = "avx512f,avx512vl,avx2,fma")]
+#[inline]
+pub(super) unsafe fn dot_and_abs(a: &[f64], b: &[f64], n: usize) -> (f64, f64) {
+    debug_assert!(a.len() >= n && b.len() >= n);
+    let (mut d, mut s) = (_mm512_setzero_pd(), _mm512_setzero_pd());
+    let (pa, pb) = (a.as_ptr(), b.as_ptr());
+    for_lanes!(n, |i, k| {
+        // SAFETY: only the lanes of k (entries below n) are read.
+        let p = unsafe {
+            _mm512_mul_pd(
+                _mm512_maskz_loadu_pd(k, pa.add(i)),
+                _mm512_maskz_loadu_pd(k, pb.add(i)),
+            )
+        };
+        d = _mm512_add_pd(d, p);
+        s = _mm512_add_pd(s, _mm512_abs_pd(p));
+    });
+    (_mm512_reduce_add_pd(d), _mm512_reduce_add_pd(s))
+}
+
+/// `Σ_j a_j b_j` over the first `n` entries (the same arithmetic as [`dot_and_abs`]).
+///
+/// # Safety
+/// The CPU must support AVX-512F, and `a` and `b` must hold at least `n` entries.
+#[target_feature(enable = "avx512f,avx512vl,avx2,fma")]
+#[inline]
+pub(super) unsafe fn dot(a: &[f64], b: &[f64], n: usize) -> f64 {
+    debug_assert!(a.len() >= n && b.len() >= n);
+    let mut d = _mm512_setzero_pd();
+    let (pa, pb) = (a.as_ptr(), b.as_ptr());
+    for_lanes!(n, |i, k| {
+        // SAFETY: only the lanes of k (entries below n) are read.
+        let p = unsafe {
+            _mm512_mul_pd(
+                _mm512_maskz_loadu_pd(k, pa.add(i)),
+                _mm512_maskz_loadu_pd(k, pb.add(i)),
+            )
+        };
+        d = _mm512_add_pd(d, p);
+    });
+    _mm512_reduce_add_pd(d)
+}
+
+/// One row of a Ruiz sweep over the first `n` entries: returns `max_j |x_j s_j|` and raises
+/// `colmax_j` to `|x_j r|`.
+///
+/// # Safety
+/// The CPU must support AVX-512F; `x`, `s` and `colmax` must hold at least `n` entries.
+#[target_feature(enable = "avx512f,avx512vl,avx2,fma")]
+#[inline]
+pub(super) unsafe fn ruiz_row(x: &[f64], s: &[f64], r: f64, colmax: &mut [f64], n: usize) -> f64 {
+    debug_assert!(x.len() >= n && s.len() >= n && colmax.len() >= n);
+    let rv = _mm512_set1_pd(r);
+    let mut m = _mm512_setzero_pd();
+    let (px, ps, pc) = (x.as_ptr(), s.as_ptr(), colmax.as_mut_ptr());
+    for_lanes!(n, |i, k| {
+        // SAFETY: only the lanes of k (entries below n) are read and written.
+        unsafe {
+            let v = _mm512_maskz_loadu_pd(k, px.add(i));
+            let scaled = _mm512_abs_pd(_mm512_mul_pd(v, _mm512_maskz_loadu_pd(k, ps.add(i))));
+            m = _mm512_max_pd(m, scaled);
+            let c = _mm512_maskz_loadu_pd(k, pc.add(i));
+            let a = _mm512_abs_pd(_mm512_mul_pd(v, rv));
+            _mm512_mask_storeu_pd(pc.add(i), k, _mm512_max_pd(c, a));
+        }
+    });
+    _mm512_reduce_max_pd(m)
+}
+
+/// [`dot_and_abs`] of four consecutive rows of a row-major matrix with row length `n` (the
+/// rows start at `rows`) against `z`: four independent chains of additions instead of one
+/// (one row's chain is latency-bound: an addition waits for the previous one), and each
+/// vector of z is loaded once for the four rows.
+///
+/// # Safety
+/// The CPU must support AVX-512F; `rows` must hold at least `4 n` entries and `z` at least n.
+#[target_feature(enable = "avx512f,avx512vl,avx2,fma")]
+#[inline]
+pub(super) unsafe fn dot_and_abs4(rows: &[f64], z: &[f64], n: usize) -> ([f64; 4], [f64; 4]) {
+    debug_assert!(rows.len() >= 4 * n && z.len() >= n);
+    let mut d = [_mm512_setzero_pd(); 4];
+    let mut s = [_mm512_setzero_pd(); 4];
+    let (pm, pz) = (rows.as_ptr(), z.as_ptr());
+    for_lanes!(n, |i, k| {
+        // SAFETY: only the lanes of k (columns below n) of the four rows and of z are read.
+        unsafe {
+            let zv = _mm512_maskz_loadu_pd(k, pz.add(i));
+            for r in 0..4 {
+                let p = _mm512_mul_pd(_mm512_maskz_loadu_pd(k, pm.add(r * n + i)), zv);
+                d[r] = _mm512_add_pd(d[r], p);
+                s[r] = _mm512_add_pd(s[r], _mm512_abs_pd(p));
+            }
+        }
+    });
+    (
+        [
+            _mm512_reduce_add_pd(d[0]),
+            _mm512_reduce_add_pd(d[1]),
+            _mm512_reduce_add_pd(d[2]),
+            _mm512_reduce_add_pd(d[3]),
+        ],
+        [
+            _mm512_reduce_add_pd(s[0]),
+            _mm512_reduce_add_pd(s[1]),
+            _mm512_reduce_add_pd(s[2]),
+            _mm512_reduce_add_pd(s[3]),
+        ],
+    )
+}
+
+/// [`dot`] of four consecutive rows against `z` (see [`dot_and_abs4`]).
+///
+/// # Safety
+/// As for [`dot_and_abs4`].
+#[target_feature(enable = "avx512f,avx512vl,avx2,fma")]
+#[inline]
+pub(super) unsafe fn dot4(rows: &[f64], z: &[f64], n: usize) -> [f64; 4] {
+    debug_assert!(rows.len() >= 4 * n && z.len() >= n);
+    let mut d = [_mm512_setzero_pd(); 4];
+    let (pm, pz) = (rows.as_ptr(), z.as_ptr());
+    for_lanes!(n, |i, k| {
+        // SAFETY: as in `dot_and_abs4`.
+        unsafe {
+            let zv = _mm512_maskz_loadu_pd(k, pz.add(i));
+            for (r, dr) in d.iter_mut().enumerate() {
+                let p = _mm512_mul_pd(_mm512_maskz_loadu_pd(k, pm.add(r * n + i)), zv);
+                *dr = _mm512_add_pd(*dr, p);
+            }
+        }
+    });
+    [
+        _mm512_reduce_add_pd(d[0]),
+        _mm512_reduce_add_pd(d[1]),
+        _mm512_reduce_add_pd(d[2]),
+        _mm512_reduce_add_pd(d[3]),
+    ]
+}
+
+/// [`ruiz_row`] for four consecutive rows (row length `n`, starting at `rows`) with row
+/// factors `r`: four independent maxima, and colmax loaded and stored once per four rows.
+///
+/// # Safety
+/// The CPU must support AVX-512F; `rows` must hold at least `4 n` entries, `s` and `colmax`
+/// at least n.
+#[target_feature(enable = "avx512f,avx512vl,avx2,fma")]
+#[inline]
+pub(super) unsafe fn ruiz_row4(
+    rows: &[f64],
+    s: &[f64],
+    r: [f64; 4],
+    colmax: &mut [f64],
+    n: usize,
+) -> [f64; 4] {
+    debug_assert!(rows.len() >= 4 * n && s.len() >= n && colmax.len() >= n);
+    let rv = r.map(|v| _mm512_set1_pd(v));
+    let mut m = [_mm512_setzero_pd(); 4];
+    let (px, ps, pc) = (rows.as_ptr(), s.as_ptr(), colmax.as_mut_ptr());
+    for_lanes!(n, |i, k| {
+        // SAFETY: only the lanes of k (columns below n) are read and written.
+        unsafe {
+            let sv = _mm512_maskz_loadu_pd(k, ps.add(i));
+            let mut c = _mm512_maskz_loadu_pd(k, pc.add(i));
+            for q in 0..4 {
+                let v = _mm512_maskz_loadu_pd(k, px.add(q * n + i));
+                m[q] = _mm512_max_pd(m[q], _mm512_abs_pd(_mm512_mul_pd(v, sv)));
+                c = _mm512_max_pd(c, _mm512_abs_pd(_mm512_mul_pd(v, rv[q])));
+            }
+            _mm512_mask_storeu_pd(pc.add(i), k, c);
+        }
+    });
+    [
+        _mm512_reduce_max_pd(m[0]),
+        _mm512_reduce_max_pd(m[1]),
+        _mm512_reduce_max_pd(m[2]),
+        _mm512_reduce_max_pd(m[3]),
+    ]
 }
