@@ -29,10 +29,16 @@ from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import numpy as np
+# Timings are single-threaded: numpy's BLAS worker threads (left polling after the problem
+# generators' matrix products) would otherwise compete for the machine's cores with whichever
+# solver is being timed. Set before numpy is imported; applies to every solver alike.
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
+import numpy as np  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-import lcp_problems as lp
+import lcp_problems as lp  # noqa: E402
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 BEGIN_MARKER = "<!-- lcp-peers:begin -->"
@@ -574,6 +580,9 @@ def method_text(policy: TimingPolicy) -> str:
         "per case is excluded; then the solve is repeated until at least "
         f"{policy.min_runs} runs and {policy.min_time:g} s (or {policy.max_time:g} s in "
         "total) and the median `time.perf_counter` wall time is reported. "
+        "BLAS and OpenMP thread pools are limited to one thread "
+        f"(`OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS')}`), so no idle "
+        "worker competes with the solver being timed. "
         "`error = ||min(z, M z + q)||_2 / max(1, ||q||_2)` is recomputed here from the "
         "original `M, q` for every solver; `success` is the solver's own claim. "
         "`coulomb speed-up` = peer median / coulomb median (>1 means coulomb is faster); "

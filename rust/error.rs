@@ -30,6 +30,9 @@ pub type Result<T> = std::result::Result<T, CoulombError>;
 
 /// checks that every entry of `values` is finite, naming the array in the error.
 pub(crate) fn check_finite(name: &str, values: &[f64]) -> Result<()> {
+    if crate::lcp::kernel::all_finite(values) {
+        return Ok(());
+    }
     match values.iter().position(|v| !v.is_finite()) {
         None => Ok(()),
         Some(k) => Err(CoulombError::NonFinite(format!(

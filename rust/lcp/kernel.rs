@@ -403,6 +403,21 @@ pub fn ruiz_sweep(
     }
 }
 
+/// Whether every entry is finite, as one maximum over the magnitudes' bit patterns (with the
+/// sign bit cleared, infinity and NaN are above every finite number): a reduction the
+/// compiler vectorizes, where a search for the first non-finite entry runs one entry per
+/// step.
+pub fn all_finite(values: &[f64]) -> bool {
+    #[inline(always)]
+    fn body(values: &[f64]) -> bool {
+        let top = values
+            .iter()
+            .fold(0u64, |m, v| m.max(v.to_bits() & 0x7fff_ffff_ffff_ffff));
+        top < 0x7ff0_0000_0000_0000
+    }
+    dispatch!(detect(), bool, || body(values))
+}
+
 /// [`max_abs_pair_portable`] with the AVX-512 form on CPUs that have it.
 #[inline(always)]
 pub fn max_abs_pair(isa: Isa, a: &[f64], b: &[f64]) -> (f64, f64) {
@@ -503,6 +518,12 @@ mod tests {
                     .map(|i| (m[i * 37 + j] * row9[i]).abs())
                     .fold(0.0, f64::max);
                 assert_eq!(cmx[j], want);
+            }
+            assert!(all_finite(&m) && all_finite(&[]));
+            let mut bad_m = m.clone();
+            for v in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+                bad_m[200] = v;
+                assert!(!all_finite(&bad_m));
             }
             let mut colmax = vec![0.1; 37];
             let m = dispatch!(isa, f64, || ruiz_row(isa, &x, &s, -2.0, &mut colmax));

@@ -17,7 +17,7 @@
 //! literature reports (`||min(z, w)||_2 / max(1, ||q||_2)`), so figures compare with peers.
 
 pub mod enumerate;
-mod kernel;
+pub(crate) mod kernel;
 pub mod lemke;
 pub mod pgs;
 mod revised;
@@ -287,24 +287,32 @@ impl<'a> LcpRef<'a> {
     ) -> LcpMeasures {
         let n = self.n;
         let qnorm = norm2(self.q);
+        // z in the equilibrated column units, u_i = z_i / (c_i σ): c_i and σ are powers of
+        // two, so one exact reciprocal per entry replaces two divisions in each loop below
+        let inv_sigma = 1.0 / scaling.sigma;
+        let u: Vec<f64> = z
+            .iter()
+            .zip(&scaling.col)
+            .map(|(zi, c)| zi * (inv_sigma / c))
+            .collect();
         let mut sq = 0.0;
         let mut min_z = f64::INFINITY;
         let mut min_w = f64::INFINITY;
         let mut comp: f64 = 0.0;
         let mut zscale: f64 = 1.0;
-        for i in 0..n {
-            let m = z[i].min(w[i]);
+        for ((zi, wi), ui) in z.iter().zip(w).zip(&u) {
+            let m = zi.min(*wi);
             sq += m * m;
-            min_z = min_z.min(z[i]);
-            min_w = min_w.min(w[i]);
-            comp = comp.max((z[i] * w[i]).abs());
-            zscale = zscale.max((z[i] / (scaling.col[i] * scaling.sigma)).abs());
+            min_z = min_z.min(*zi);
+            min_w = min_w.min(*wi);
+            comp = comp.max((zi * wi).abs());
+            zscale = zscale.max(ui.abs());
         }
+        let inv_zscale = 1.0 / zscale;
         let mut scaled: f64 = 0.0;
-        for i in 0..n {
-            let wi = if terms[i] > 0.0 { w[i] / terms[i] } else { 0.0 };
-            let zi = z[i] / (scaling.col[i] * scaling.sigma) / zscale;
-            scaled = scaled.max(zi.min(wi).abs());
+        for ((wi, ti), ui) in w.iter().zip(terms).zip(&u) {
+            let wu = if *ti > 0.0 { wi / ti } else { 0.0 };
+            scaled = scaled.max((ui * inv_zscale).min(wu).abs());
         }
         if n == 0 {
             min_z = 0.0;

@@ -593,17 +593,17 @@ impl RevisedLemke {
     /// z in original units from the current basis (z0 ignored), and the basic z indices.
     pub(super) fn extract(&self, eq: &Equilibration, z: &mut [f64], basis: &mut Vec<usize>) {
         let n = self.n;
-        z.iter_mut().for_each(|v| *v = 0.0);
         basis.clear();
-        for i in 0..n {
-            let var = self.basic[i];
-            if var >= n && var < 2 * n {
-                let k = var - n;
-                z[k] = eq.sigma * eq.col[k] * self.values[i].max(0.0);
-                basis.push(k);
-            }
+        // by variable, through row_of, so the basis comes out in increasing order unsorted
+        for (k, (zk, row)) in z.iter_mut().zip(&self.row_of[n..2 * n]).enumerate() {
+            *zk = match self.values.get(*row) {
+                Some(v) => {
+                    basis.push(k);
+                    eq.sigma * eq.col[k] * v.max(0.0)
+                }
+                None => 0.0,
+            };
         }
-        basis.sort_unstable();
     }
 }
 
