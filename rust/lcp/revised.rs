@@ -92,6 +92,10 @@ pub(super) struct RevisedLemke {
     /// per complete block of ETA_BLOCK etas, the 8 x 8 matrix G (column-major) that gives
     /// the block's multipliers from the entries it reads, `t = G x_R` (see `apply_etas`).
     block_maps: Vec<f64>,
+    /// the columns of -M' stored contiguously (`columns[k n + i] = -r_i M_ik c_k`), built by
+    /// `load` where the CPU has AVX-512 (n^2 entries; empty elsewhere).
+    columns: Vec<f64>,
+    has_columns: bool,
     /// explicit `B_0^{-1}` (row-major n x n) once the file has been folded; empty before.
     base: Vec<f64>,
     has_base: bool,
@@ -118,8 +122,8 @@ pub(super) struct RevisedLemke {
 }
 
 impl RevisedLemke {
-    /// storage for problems of size n: at most max(n, 16) etas of length n, M' once (n^2),
-    /// and O(n) vectors; the explicit inverse (another n^2) only if a path is long enough to
+    /// storage for problems of size n: at most max(n, 16) etas of length n, the columns of
+    /// -M' (n^2, on CPUs with AVX-512) and O(n) vectors; the explicit inverse (another n^2) only if a path is long enough to
     /// need folding.
     pub(super) fn new(n: usize) -> Self {
         let cap = n.max(16);
@@ -130,6 +134,12 @@ impl RevisedLemke {
             eta_rows: vec![0; cap],
             count: 0,
             block_maps: vec![0.0; cap.div_ceil(ETA_BLOCK) * ETA_BLOCK * ETA_BLOCK],
+            columns: if kernel::detect() == Isa::Avx512 {
+                vec![0.0; n * n]
+            } else {
+                Vec::new()
+            },
+            has_columns: false,
             base: Vec::new(),
             has_base: false,
             fold_rows: Vec::new(),
@@ -156,7 +166,11 @@ impl RevisedLemke {
 
     /// bytes held (for the workspace's memory report).
     pub(super) fn bytes(&self) -> usize {
-        (self.etas.len() + self.base.len() + self.fold_rows.len() + self.lex_rows.len())
+        (self.etas.len()
+            + self.columns.len()
+            + self.base.len()
+            + self.fold_rows.len()
+            + self.lex_rows.len())
             * std::mem::size_of::<f64>()
     }
 
@@ -189,6 +203,22 @@ impl RevisedLemke {
         }
         self.count = 0;
         self.has_base = false;
+        self.has_columns = false;
+        #[cfg(target_arch = "x86_64")]
+        if self.isa == Isa::Avx512 && self.columns.len() == n * n {
+            // SAFETY: `kernel::detect` found AVX-512F on this CPU; M and the copy hold n^2
+            // entries, the factors n.
+            unsafe {
+                super::simd512::negated_scaled_transpose(
+                    lcp.m,
+                    &eq.row,
+                    &eq.col,
+                    &mut self.columns,
+                    n,
+                )
+            };
+            self.has_columns = true;
+        }
     }
 
     /// `out = B^{-1} a_var` for the original column of variable `var`.
@@ -196,9 +226,24 @@ impl RevisedLemke {
     fn column_of(&mut self, lcp: &LcpRef<'_>, eq: &Equilibration, var: usize) {
         let n = self.n;
         let mut out = std::mem::take(&mut self.column);
+        if var > n && var < 2 * n && self.has_columns {
+            // the original column -M'[:, k], stored contiguously by `load`
+            let k = var - n;
+            let a = &self.columns[k * n..(k + 1) * n];
+            if self.has_base {
+                for (o, brow) in out.iter_mut().zip(self.base.chunks_exact(n)) {
+                    *o = kernel::dot(self.isa, brow, a);
+                }
+            } else {
+                out.copy_from_slice(a);
+            }
+            self.apply_etas(&mut out);
+            self.column = out;
+            return;
+        }
         if var >= n {
-            // the original column, -M'[:, k] = -R M[:, k] c_k (read down M's rows: a
-            // strided pass of n entries, cheaper than keeping a transposed copy), or -d'
+            // the original column, -M'[:, k] = -R M[:, k] c_k (read down M's rows: a strided
+            // pass of n entries), or -d'
             if var == 2 * n {
                 self.acol.copy_from_slice(&self.cover);
             } else {
@@ -628,6 +673,33 @@ mod tests {
                 kernel::dispatch!(isa, (), || eta_pass(isa, &mut x, &etas, &t));
                 for i in 0..n {
                     assert!((x[i] - want[i]).abs() <= 1e-14, "{isa:?} M={M} n={n} i={i}");
+                }
+            }
+        }
+    }
+
+    /// the contiguous columns of -M' equal `-r_i M_ik c_k` entry for entry (the factors are
+    /// powers of two, so the products are exact in any order), edge tiles included
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn transposed_columns_equal_the_definition() {
+        if kernel::detect() != Isa::Avx512 {
+            return;
+        }
+        for n in [1usize, 3, 8, 9, 17, 100] {
+            let m: Vec<f64> = (0..n * n).map(|k| (k as f64 * 0.37).sin()).collect();
+            let r: Vec<f64> = (0..n).map(|i| 2f64.powi(i as i32 % 5 - 2)).collect();
+            let c: Vec<f64> = (0..n).map(|k| 2f64.powi(k as i32 % 3 - 1)).collect();
+            let mut out = vec![f64::NAN; n * n];
+            // SAFETY: the CPU has AVX-512F (checked above); every slice is long enough.
+            unsafe { crate::lcp::simd512::negated_scaled_transpose(&m, &r, &c, &mut out, n) };
+            for i in 0..n {
+                for k in 0..n {
+                    assert_eq!(
+                        out[k * n + i],
+                        -(r[i] * m[i * n + k] * c[k]),
+                        "n={n} {i},{k}"
+                    );
                 }
             }
         }

@@ -370,3 +370,79 @@ pub(super) unsafe fn ruiz_row4(
         _mm512_reduce_max_pd(m[3]),
     ]
 }
+
+/// `out[k n + i] = -r_i m_ik c_k` for the row-major n x n matrix m: the columns of the
+/// equilibrated `-M' = -R M C`, each stored contiguously, so that Lemke's entering column is
+/// read as one run of n entries instead of n entries a row apart (a cache line each). Eight
+/// by eight tiles are transposed in registers (two rounds of 128-bit lane shuffles after the
+/// pairwise unpacks); edge tiles are masked.
+///
+/// # Safety
+/// The CPU must support AVX-512F; `m` and `out` must hold at least n^2 entries, `r` and `c`
+/// at least n.
+#[target_feature(enable = "avx512f,avx512vl,avx2,fma")]
+#[inline]
+pub(super) unsafe fn negated_scaled_transpose(
+    m: &[f64],
+    r: &[f64],
+    c: &[f64],
+    out: &mut [f64],
+    n: usize,
+) {
+    debug_assert!(m.len() >= n * n && out.len() >= n * n && r.len() >= n && c.len() >= n);
+    let (pm, pr, pc, po) = (m.as_ptr(), r.as_ptr(), c.as_ptr(), out.as_mut_ptr());
+    let mut i0 = 0;
+    while i0 < n {
+        let rows = lanes(n - i0);
+        let count_i = (n - i0).min(8);
+        // SAFETY: the lanes of `rows` are rows below n.
+        let neg_r =
+            unsafe { _mm512_sub_pd(_mm512_setzero_pd(), _mm512_maskz_loadu_pd(rows, pr.add(i0))) };
+        let mut j0 = 0;
+        while j0 < n {
+            let cols = lanes(n - j0);
+            let count_j = (n - j0).min(8);
+            let mut v = [_mm512_setzero_pd(); 8];
+            for (a, va) in v.iter_mut().enumerate().take(count_i) {
+                // SAFETY: row i0 + a < n, columns j0.. masked to below n.
+                *va = unsafe { _mm512_maskz_loadu_pd(cols, pm.add((i0 + a) * n + j0)) };
+            }
+            let t0 = _mm512_unpacklo_pd(v[0], v[1]);
+            let t1 = _mm512_unpackhi_pd(v[0], v[1]);
+            let t2 = _mm512_unpacklo_pd(v[2], v[3]);
+            let t3 = _mm512_unpackhi_pd(v[2], v[3]);
+            let t4 = _mm512_unpacklo_pd(v[4], v[5]);
+            let t5 = _mm512_unpackhi_pd(v[4], v[5]);
+            let t6 = _mm512_unpacklo_pd(v[6], v[7]);
+            let t7 = _mm512_unpackhi_pd(v[6], v[7]);
+            let u0 = _mm512_shuffle_f64x2::<0x88>(t0, t2);
+            let u1 = _mm512_shuffle_f64x2::<0x88>(t1, t3);
+            let u2 = _mm512_shuffle_f64x2::<0xdd>(t0, t2);
+            let u3 = _mm512_shuffle_f64x2::<0xdd>(t1, t3);
+            let u4 = _mm512_shuffle_f64x2::<0x88>(t4, t6);
+            let u5 = _mm512_shuffle_f64x2::<0x88>(t5, t7);
+            let u6 = _mm512_shuffle_f64x2::<0xdd>(t4, t6);
+            let u7 = _mm512_shuffle_f64x2::<0xdd>(t5, t7);
+            let columns = [
+                _mm512_shuffle_f64x2::<0x88>(u0, u4),
+                _mm512_shuffle_f64x2::<0x88>(u1, u5),
+                _mm512_shuffle_f64x2::<0x88>(u2, u6),
+                _mm512_shuffle_f64x2::<0x88>(u3, u7),
+                _mm512_shuffle_f64x2::<0xdd>(u0, u4),
+                _mm512_shuffle_f64x2::<0xdd>(u1, u5),
+                _mm512_shuffle_f64x2::<0xdd>(u2, u6),
+                _mm512_shuffle_f64x2::<0xdd>(u3, u7),
+            ];
+            for (b, col) in columns.iter().enumerate().take(count_j) {
+                let k = j0 + b;
+                // SAFETY: column k < n; rows masked to below n.
+                unsafe {
+                    let scale = _mm512_mul_pd(neg_r, _mm512_set1_pd(*pc.add(k)));
+                    _mm512_mask_storeu_pd(po.add(k * n + i0), rows, _mm512_mul_pd(*col, scale));
+                }
+            }
+            j0 += 8;
+        }
+        i0 += 8;
+    }
+}
