@@ -92,10 +92,11 @@ pub(super) struct RevisedLemke {
     /// per complete block of ETA_BLOCK etas, the 8 x 8 matrix G (column-major) that gives
     /// the block's multipliers from the entries it reads, `t = G x_R` (see `apply_etas`).
     block_maps: Vec<f64>,
-    /// the columns of -M' stored contiguously (`columns[k n + i] = -r_i M_ik c_k`), built by
-    /// `load` where the CPU has AVX-512 (n^2 entries; empty elsewhere).
+    /// the columns of -M' stored contiguously (`columns[k n + i] = -r_i M_ik c_k`) where the
+    /// CPU has AVX-512 (n^2 entries; empty elsewhere), filled eight columns at a time when
+    /// the path first asks for one of them: `column_blocks[k / 8]` says block k / 8 is there.
     columns: Vec<f64>,
-    has_columns: bool,
+    column_blocks: Vec<bool>,
     /// explicit `B_0^{-1}` (row-major n x n) once the file has been folded; empty before.
     base: Vec<f64>,
     has_base: bool,
@@ -139,7 +140,7 @@ impl RevisedLemke {
             } else {
                 Vec::new()
             },
-            has_columns: false,
+            column_blocks: vec![false; n.div_ceil(8)],
             base: Vec::new(),
             has_base: false,
             fold_rows: Vec::new(),
@@ -203,22 +204,8 @@ impl RevisedLemke {
         }
         self.count = 0;
         self.has_base = false;
-        self.has_columns = false;
-        #[cfg(target_arch = "x86_64")]
-        if self.isa == Isa::Avx512 && self.columns.len() == n * n {
-            // SAFETY: `kernel::detect` found AVX-512F on this CPU; M and the copy hold n^2
-            // entries, the factors n.
-            unsafe {
-                super::simd512::negated_scaled_transpose(
-                    lcp.m,
-                    &eq.row,
-                    &eq.col,
-                    &mut self.columns,
-                    n,
-                )
-            };
-            self.has_columns = true;
-        }
+        // the columns of -M' are transposed block by block as the path first asks for them
+        self.column_blocks.iter_mut().for_each(|b| *b = false);
     }
 
     /// `out = B^{-1} a_var` for the original column of variable `var`.
@@ -226,9 +213,25 @@ impl RevisedLemke {
     fn column_of(&mut self, lcp: &LcpRef<'_>, eq: &Equilibration, var: usize) {
         let n = self.n;
         let mut out = std::mem::take(&mut self.column);
-        if var > n && var < 2 * n && self.has_columns {
-            // the original column -M'[:, k], stored contiguously by `load`
+        #[cfg(target_arch = "x86_64")]
+        if var >= n && var < 2 * n && self.columns.len() == n * n {
+            // the original column -M'[:, k], contiguous
             let k = var - n;
+            if !self.column_blocks[k / 8] {
+                // SAFETY: `columns` is allocated only when `kernel::detect` found AVX-512F;
+                // M and the copy hold n^2 entries, the factors n; k / 8 * 8 <= k < n.
+                unsafe {
+                    super::simd512::negated_scaled_columns(
+                        lcp.m,
+                        &eq.row,
+                        &eq.col,
+                        &mut self.columns,
+                        n,
+                        k / 8 * 8,
+                    )
+                };
+                self.column_blocks[k / 8] = true;
+            }
             let a = &self.columns[k * n..(k + 1) * n];
             if self.has_base {
                 for (o, brow) in out.iter_mut().zip(self.base.chunks_exact(n)) {
@@ -679,7 +682,7 @@ mod tests {
     }
 
     /// the contiguous columns of -M' equal `-r_i M_ik c_k` entry for entry (the factors are
-    /// powers of two, so the products are exact in any order), edge tiles included
+    /// powers of two, so the products are exact in any order), edge blocks included
     #[cfg(target_arch = "x86_64")]
     #[test]
     fn transposed_columns_equal_the_definition() {
@@ -692,7 +695,9 @@ mod tests {
             let c: Vec<f64> = (0..n).map(|k| 2f64.powi(k as i32 % 3 - 1)).collect();
             let mut out = vec![f64::NAN; n * n];
             // SAFETY: the CPU has AVX-512F (checked above); every slice is long enough.
-            unsafe { crate::lcp::simd512::negated_scaled_transpose(&m, &r, &c, &mut out, n) };
+            for j0 in (0..n).step_by(8) {
+                unsafe { crate::lcp::simd512::negated_scaled_columns(&m, &r, &c, &mut out, n, j0) };
+            }
             for i in 0..n {
                 for k in 0..n {
                     assert_eq!(

@@ -371,37 +371,41 @@ pub(super) unsafe fn ruiz_row4(
     ]
 }
 
-/// `out[k n + i] = -r_i m_ik c_k` for the row-major n x n matrix m: the columns of the
-/// equilibrated `-M' = -R M C`, each stored contiguously, so that Lemke's entering column is
-/// read as one run of n entries instead of n entries a row apart (a cache line each). Eight
-/// by eight tiles are transposed in registers (two rounds of 128-bit lane shuffles after the
-/// pairwise unpacks); edge tiles are masked.
+/// `out[k n + i] = -r_i m_ik c_k` for the columns k of block `j0..j0 + 8` (those below n) of
+/// the row-major n x n matrix m: columns of the equilibrated `-M' = -R M C`, each stored
+/// contiguously, so that Lemke's entering column is read as one run of n entries instead of n
+/// entries a row apart (a cache line each). Eight by eight tiles are transposed in registers
+/// (two rounds of 128-bit lane shuffles after the pairwise unpacks); edge tiles are masked.
+/// A block costs about what one strided column costs (it reads the same cache lines), and
+/// makes the block's other seven columns free.
 ///
 /// # Safety
 /// The CPU must support AVX-512F; `m` and `out` must hold at least n^2 entries, `r` and `c`
-/// at least n.
+/// at least n; `j0 < n`.
 #[target_feature(enable = "avx512f,avx512vl,avx2,fma")]
 #[inline]
-pub(super) unsafe fn negated_scaled_transpose(
+pub(super) unsafe fn negated_scaled_columns(
     m: &[f64],
     r: &[f64],
     c: &[f64],
     out: &mut [f64],
     n: usize,
+    j0: usize,
 ) {
     debug_assert!(m.len() >= n * n && out.len() >= n * n && r.len() >= n && c.len() >= n);
+    debug_assert!(j0 < n);
     let (pm, pr, pc, po) = (m.as_ptr(), r.as_ptr(), c.as_ptr(), out.as_mut_ptr());
-    let mut i0 = 0;
-    while i0 < n {
-        let rows = lanes(n - i0);
-        let count_i = (n - i0).min(8);
-        // SAFETY: the lanes of `rows` are rows below n.
-        let neg_r =
-            unsafe { _mm512_sub_pd(_mm512_setzero_pd(), _mm512_maskz_loadu_pd(rows, pr.add(i0))) };
-        let mut j0 = 0;
-        while j0 < n {
-            let cols = lanes(n - j0);
-            let count_j = (n - j0).min(8);
+    {
+        let cols = lanes(n - j0);
+        let count_j = (n - j0).min(8);
+        let mut i0 = 0;
+        while i0 < n {
+            let rows = lanes(n - i0);
+            let count_i = (n - i0).min(8);
+            // SAFETY: the lanes of `rows` are rows below n.
+            let neg_r = unsafe {
+                _mm512_sub_pd(_mm512_setzero_pd(), _mm512_maskz_loadu_pd(rows, pr.add(i0)))
+            };
             let mut v = [_mm512_setzero_pd(); 8];
             for (a, va) in v.iter_mut().enumerate().take(count_i) {
                 // SAFETY: row i0 + a < n, columns j0.. masked to below n.
@@ -441,8 +445,7 @@ pub(super) unsafe fn negated_scaled_transpose(
                     _mm512_mask_storeu_pd(po.add(k * n + i0), rows, _mm512_mul_pd(*col, scale));
                 }
             }
-            j0 += 8;
+            i0 += 8;
         }
-        i0 += 8;
     }
 }
