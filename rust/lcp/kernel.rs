@@ -418,6 +418,43 @@ pub fn all_finite(values: &[f64]) -> bool {
     dispatch!(detect(), bool, || body(values))
 }
 
+/// the largest magnitude as a bit-pattern maximum (see [`all_finite`]): not finite exactly
+/// when some entry is not.
+#[inline(always)]
+fn max_magnitude_portable(x: &[f64]) -> f64 {
+    f64::from_bits(
+        x.iter()
+            .fold(0u64, |m, v| m.max(v.to_bits() & 0x7fff_ffff_ffff_ffff)),
+    )
+}
+
+/// `max_i |x_i|`, not finite exactly when some entry is not.
+#[inline(always)]
+pub fn max_abs(isa: Isa, x: &[f64]) -> f64 {
+    #[cfg(target_arch = "x86_64")]
+    if isa == Isa::Avx512 {
+        // SAFETY: `detect` found AVX-512F on this CPU; x holds x.len() entries.
+        return unsafe { super::simd512::max_abs(x, x.len()) };
+    }
+    let _ = isa;
+    max_magnitude_portable(x)
+}
+
+/// `y += a x`, returning `max_i |y_i|` of the result (not finite exactly when some entry is
+/// not): the pivot's update of the basic values hands the next ratio test their size.
+#[inline(always)]
+pub fn axpy_max(isa: Isa, y: &mut [f64], a: f64, x: &[f64]) -> f64 {
+    #[cfg(target_arch = "x86_64")]
+    if isa == Isa::Avx512 {
+        let n = y.len().min(x.len());
+        // SAFETY: as in `max_abs`; both slices hold n entries.
+        return unsafe { super::simd512::axpy_max(y, a, x, n) };
+    }
+    let _ = isa;
+    axpy(y, a, x);
+    max_magnitude_portable(y)
+}
+
 /// [`max_abs_pair_portable`] with the AVX-512 form on CPUs that have it.
 #[inline(always)]
 pub fn max_abs_pair(isa: Isa, a: &[f64], b: &[f64]) -> (f64, f64) {
@@ -520,6 +557,14 @@ mod tests {
                 assert_eq!(cmx[j], want);
             }
             assert!(all_finite(&m) && all_finite(&[]));
+            let want_max = x.iter().fold(0.0, |a: f64, v| a.max(v.abs()));
+            assert_eq!(dispatch!(isa, f64, || max_abs(isa, &x)), want_max);
+            let mut y = s.clone();
+            let ymax = dispatch!(isa, f64, || axpy_max(isa, &mut y, -0.75, &x));
+            for k in 0..37 {
+                assert!((y[k] - (s[k] - 0.75 * x[k])).abs() < 1e-15);
+            }
+            assert_eq!(ymax, y.iter().fold(0.0, |a: f64, v| a.max(v.abs())));
             let mut bad_m = m.clone();
             for v in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
                 bad_m[200] = v;

@@ -49,15 +49,14 @@ const FOLD_BLOCK: usize = 16;
 
 /// `x += Σ_a t_a η̃_a` for the etas stored row after row in `etas`: the AVX-512 form where
 /// the CPU has it; else fused multiply-adds in two chains (a library call without FMA
-/// hardware, hence the plain form for the baseline).
+/// hardware, hence the plain form for the baseline). Returns `max_i |x_i|` of the result.
 #[inline(always)]
-fn eta_pass<const M: usize>(isa: Isa, x: &mut [f64], etas: &[f64], t: &[f64; M]) {
+fn eta_pass<const M: usize>(isa: Isa, x: &mut [f64], etas: &[f64], t: &[f64; M]) -> f64 {
     let n = x.len();
     #[cfg(target_arch = "x86_64")]
     if isa == Isa::Avx512 {
         // SAFETY: `kernel::detect` found AVX-512F on this CPU; `etas` holds M rows of n.
-        unsafe { super::simd512::eta_pass(x, &etas[..M * n], t) };
-        return;
+        return unsafe { super::simd512::eta_pass(x, &etas[..M * n], t) };
     }
     let fused = isa != Isa::Baseline;
     for (i, xi) in x.iter_mut().enumerate() {
@@ -78,6 +77,7 @@ fn eta_pass<const M: usize>(isa: Isa, x: &mut [f64], etas: &[f64], t: &[f64; M])
         }
         *xi = even + odd;
     }
+    kernel::max_abs(isa, x)
 }
 
 /// Storage of the product-form path, sized once for n and reused.
@@ -109,6 +109,11 @@ pub(super) struct RevisedLemke {
     column: Vec<f64>,
     values: Vec<f64>,
     spare: Vec<f64>,
+    /// `max_i |f_i|` and `max_i |x_B,i|`, left by the passes that wrote the entering column
+    /// and the basic values, so the ratio test does not read them again to size them (each
+    /// not finite when its vector has a non-finite entry).
+    column_max: f64,
+    values_max: f64,
     scratch: Vec<f64>,
     /// `basic[i]`: the variable basic in row i (w_k = k, z_k = n + k, z0 = 2n).
     basic: Vec<usize>,
@@ -149,6 +154,8 @@ impl RevisedLemke {
             column: vec![0.0; n],
             values: vec![0.0; n],
             spare: vec![0.0; n],
+            column_max: 0.0,
+            values_max: 0.0,
             scratch: vec![0.0; n],
             basic: vec![0; n],
             row_of: vec![usize::MAX; 2 * n + 1],
@@ -197,6 +204,7 @@ impl RevisedLemke {
             self.values[i] = eq.row[i] * lcp.q[i] / eq.sigma;
             self.basic[i] = i;
         }
+        self.values_max = kernel::max_abs(self.isa, &self.values);
         self.cover.copy_from_slice(cover);
         self.row_of.iter_mut().for_each(|v| *v = usize::MAX);
         for i in 0..n {
@@ -240,7 +248,9 @@ impl RevisedLemke {
             } else {
                 out.copy_from_slice(a);
             }
-            self.apply_etas(&mut out);
+            self.column_max = self
+                .apply_etas(&mut out)
+                .unwrap_or_else(|| kernel::max_abs(self.isa, &out));
             self.column = out;
             return;
         }
@@ -276,7 +286,9 @@ impl RevisedLemke {
                 *o = -v;
             }
         }
-        self.apply_etas(&mut out);
+        self.column_max = self
+            .apply_etas(&mut out)
+            .unwrap_or_else(|| kernel::max_abs(self.isa, &out));
         self.column = out;
     }
 
@@ -338,10 +350,12 @@ impl RevisedLemke {
     #[inline(always)]
     fn ratio_test(&mut self) -> Result<Option<usize>, ()> {
         let z0 = self.z0();
-        match ties::blocking_rows(
+        match ties::blocking_rows_sized(
             self.isa,
             &self.column,
             &mut self.values,
+            self.column_max,
+            self.values_max,
             &self.basic,
             z0,
             &mut self.ties,
@@ -377,10 +391,14 @@ impl RevisedLemke {
     /// complete (`close_block`), so the multipliers are a small matrix-vector product with no
     /// chain of dependent loads; then one pass over x adds `Σ_a t_a η̃_a`, reading and writing
     /// x once per block instead of once per eta.
+    ///
+    /// Returns `max_i |x_i|` of the result when a pass over x produced it (None when no eta
+    /// touched x).
     #[inline(always)]
-    fn apply_etas(&self, x: &mut [f64]) {
+    fn apply_etas(&self, x: &mut [f64]) -> Option<f64> {
         let n = self.n;
         let p = self.count;
+        let mut size = None;
         let mut j = 0;
         while j + ETA_BLOCK <= p {
             let mut xr = [0.0f64; ETA_BLOCK];
@@ -398,7 +416,7 @@ impl RevisedLemke {
                     }
                 }
                 let block = &self.etas[j * n..(j + ETA_BLOCK) * n];
-                eta_pass(self.isa, x, block, &t);
+                size = Some(eta_pass(self.isa, x, block, &t));
             }
             j += ETA_BLOCK;
         }
@@ -415,7 +433,7 @@ impl RevisedLemke {
                 t[a] = v;
             }
             let block = &self.etas[j * n..p * n];
-            match m {
+            size = Some(match m {
                 1 => eta_pass(self.isa, x, block, &[t[0]]),
                 2 => eta_pass(self.isa, x, block, &[t[0], t[1]]),
                 3 => eta_pass(self.isa, x, block, &[t[0], t[1], t[2]]),
@@ -428,8 +446,9 @@ impl RevisedLemke {
                     block,
                     &[t[0], t[1], t[2], t[3], t[4], t[5], t[6]],
                 ),
-            }
+            });
         }
+        size
     }
 
     /// forms G = (I - L)^{-1} for the block of etas starting at j, `L_ab = η̃_b[r_a]` (b < a),
@@ -517,7 +536,12 @@ impl RevisedLemke {
             self.close_block(self.count - ETA_BLOCK);
         }
         let t = self.values[r];
-        axpy(&mut self.values, t, &self.etas[j * n..(j + 1) * n]);
+        self.values_max = kernel::axpy_max(
+            self.isa,
+            &mut self.values,
+            t,
+            &self.etas[j * n..(j + 1) * n],
+        );
         let leaving = self.basic[r];
         self.basic[r] = entering;
         self.row_of[entering] = r;
@@ -673,10 +697,11 @@ mod tests {
                     continue;
                 }
                 let mut x = x0.clone();
-                kernel::dispatch!(isa, (), || eta_pass(isa, &mut x, &etas, &t));
+                let size = kernel::dispatch!(isa, f64, || eta_pass(isa, &mut x, &etas, &t));
                 for i in 0..n {
                     assert!((x[i] - want[i]).abs() <= 1e-14, "{isa:?} M={M} n={n} i={i}");
                 }
+                assert_eq!(size, x.iter().fold(0.0, |m: f64, v| m.max(v.abs())));
             }
         }
     }

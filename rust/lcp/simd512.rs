@@ -152,12 +152,14 @@ pub(super) unsafe fn find_ties(
 /// `x += Σ_{a<M} t_a η̃_a` for the M etas stored row after row from `etas` (each of length
 /// `n = x.len()`): one pass over x, the last partial vector of rows masked instead of a
 /// scalar loop (which for n = 100 would cost a third as much again as the vector part).
+/// Returns `max_i |x_i|` of the result (not finite when an entry is not; see
+/// [`max_abs_pair`]), which the ratio test would otherwise read x again for.
 ///
 /// # Safety
 /// The CPU must support AVX-512F, and `etas` must hold at least `M * x.len()` entries.
 #[target_feature(enable = "avx512f,avx512vl,avx2,fma")]
 #[inline]
-pub(super) unsafe fn eta_pass<const M: usize>(x: &mut [f64], etas: &[f64], t: &[f64; M]) {
+pub(super) unsafe fn eta_pass<const M: usize>(x: &mut [f64], etas: &[f64], t: &[f64; M]) -> f64 {
     let n = x.len();
     debug_assert!(etas.len() >= M * n);
     let mut tv = [_mm512_setzero_pd(); M];
@@ -165,6 +167,8 @@ pub(super) unsafe fn eta_pass<const M: usize>(x: &mut [f64], etas: &[f64], t: &[
         *v = _mm512_set1_pd(*ta);
     }
     let (px, pe) = (x.as_mut_ptr(), etas.as_ptr());
+    let magnitude = _mm512_set1_epi64(i64::MAX);
+    let mut top = _mm512_setzero_si512();
     for_lanes!(n, |i, k| {
         // SAFETY: only the lanes of k (rows below n) of x and of each eta row are touched.
         unsafe {
@@ -183,9 +187,13 @@ pub(super) unsafe fn eta_pass<const M: usize>(x: &mut [f64], etas: &[f64], t: &[
                 let e0 = _mm512_maskz_loadu_pd(k, pe.add(a * n + i));
                 even = _mm512_fmadd_pd(e0, tv[a], even);
             }
-            _mm512_mask_storeu_pd(px.add(i), k, _mm512_add_pd(even, odd));
+            let v = _mm512_add_pd(even, odd);
+            _mm512_mask_storeu_pd(px.add(i), k, v);
+            // masked-off lanes hold zeros (their loads were zero-masked)
+            top = _mm512_max_epi64(top, _mm512_and_si512(_mm512_castpd_si512(v), magnitude));
         }
     });
+    f64::from_bits(_mm512_reduce_max_epi64(top) as u64)
 }
 
 /// `(Σ_j a_j b_j, Σ_j |a_j b_j|)` over the first `n` entries, in one pass (the product is
@@ -448,4 +456,52 @@ pub(super) unsafe fn negated_scaled_columns(
             i0 += 8;
         }
     }
+}
+
+/// `max_i |x_i|` over the first `n` entries (not finite when an entry is not; see
+/// [`max_abs_pair`]).
+///
+/// # Safety
+/// The CPU must support AVX-512F, and `x` must hold at least `n` entries.
+#[target_feature(enable = "avx512f,avx512vl,avx2,fma")]
+#[inline]
+pub(super) unsafe fn max_abs(x: &[f64], n: usize) -> f64 {
+    debug_assert!(x.len() >= n);
+    let magnitude = _mm512_set1_epi64(i64::MAX);
+    let mut top = _mm512_setzero_si512();
+    let px = x.as_ptr() as *const i64;
+    for_lanes!(n, |i, k| {
+        // SAFETY: only the lanes of k (entries below n) are read.
+        let v = unsafe { _mm512_maskz_loadu_epi64(k, px.add(i)) };
+        top = _mm512_max_epi64(top, _mm512_and_si512(v, magnitude));
+    });
+    f64::from_bits(_mm512_reduce_max_epi64(top) as u64)
+}
+
+/// `y += a x` over the first `n` entries, returning `max_i |y_i|` of the result (not finite
+/// when an entry is not).
+///
+/// # Safety
+/// The CPU must support AVX-512F; `y` and `x` must hold at least `n` entries.
+#[target_feature(enable = "avx512f,avx512vl,avx2,fma")]
+#[inline]
+pub(super) unsafe fn axpy_max(y: &mut [f64], a: f64, x: &[f64], n: usize) -> f64 {
+    debug_assert!(y.len() >= n && x.len() >= n);
+    let av = _mm512_set1_pd(a);
+    let magnitude = _mm512_set1_epi64(i64::MAX);
+    let mut top = _mm512_setzero_si512();
+    let (py, px) = (y.as_mut_ptr(), x.as_ptr());
+    for_lanes!(n, |i, k| {
+        // SAFETY: only the lanes of k (entries below n) are read and written.
+        unsafe {
+            let v = _mm512_fmadd_pd(
+                _mm512_maskz_loadu_pd(k, px.add(i)),
+                av,
+                _mm512_maskz_loadu_pd(k, py.add(i)),
+            );
+            _mm512_mask_storeu_pd(py.add(i), k, v);
+            top = _mm512_max_epi64(top, _mm512_and_si512(_mm512_castpd_si512(v), magnitude));
+        }
+    });
+    f64::from_bits(_mm512_reduce_max_epi64(top) as u64)
 }

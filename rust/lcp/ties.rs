@@ -39,6 +39,23 @@ pub(super) fn blocking_rows(
     ties: &mut Vec<usize>,
 ) -> Blocking {
     let (colmax, rhsmax) = kernel::max_abs_pair(isa, column, values);
+    blocking_rows_sized(isa, column, values, colmax, rhsmax, basic, z0, ties)
+}
+
+/// [`blocking_rows`] for a caller that already knows `colmax = ||f||_inf` and `rhsmax =
+/// ||b||_inf` (each not finite when its vector has a non-finite entry).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub(super) fn blocking_rows_sized(
+    isa: Isa,
+    column: &[f64],
+    values: &mut [f64],
+    colmax: f64,
+    rhsmax: f64,
+    basic: &[usize],
+    z0: usize,
+    ties: &mut Vec<usize>,
+) -> Blocking {
     if !(colmax.is_finite() && rhsmax.is_finite()) {
         return Blocking::NonFinite;
     }
