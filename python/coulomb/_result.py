@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import inspect
 from typing import Any
 
 import numpy as np
@@ -17,12 +18,33 @@ def _short(value: Any) -> str:
     return repr(value)
 
 
+def _item_property(name: str) -> property:
+    """A read-only property returning item ``name`` (AttributeError when it is absent)."""
+
+    def get(self: dict[str, Any]) -> Any:
+        try:
+            return self[name]
+        except KeyError:
+            raise AttributeError(name) from None
+
+    return property(get, doc=f"The ``{name!r}`` item.")
+
+
 class Result(dict):
     """A dict whose keys are also attributes, with a readable ``repr``.
 
     Every result has ``success`` (the answer passed the tolerance on the original data),
     ``status`` (a short string) and ``message`` (one line for a person).
     """
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        # Each annotated field of a subclass reads its item through a property: found by the
+        # type lookup, so `result.z` costs a call instead of a failed lookup, an exception
+        # and `__getattr__` (about 0.45 µs per access, several µs per small solve).
+        super().__init_subclass__(**kwargs)
+        for name in inspect.get_annotations(cls):
+            if name not in cls.__dict__:
+                setattr(cls, name, _item_property(name))
 
     def __getattr__(self, name: str) -> Any:
         try:
