@@ -315,28 +315,6 @@ pub fn matvec_and_abs(isa: Isa, m: &[f64], z: &[f64], out: &mut [f64], abs: &mut
     }
 }
 
-/// `out_i = Σ_j m_ij z_j` for every row of the row-major matrix `m` (see
-/// [`matvec_and_abs`]).
-#[inline(always)]
-pub fn matvec(isa: Isa, m: &[f64], z: &[f64], out: &mut [f64]) {
-    let n = z.len();
-    let rows = out.len().min(m.len() / n.max(1));
-    let mut i = 0;
-    #[cfg(target_arch = "x86_64")]
-    if isa == Isa::Avx512 {
-        while i + 4 <= rows {
-            // SAFETY: as in `matvec_and_abs`.
-            let d = unsafe { super::simd512::dot4(&m[i * n..(i + 4) * n], z, n) };
-            out[i..i + 4].copy_from_slice(&d);
-            i += 4;
-        }
-    }
-    while i < rows {
-        out[i] = dot(isa, &m[i * n..(i + 1) * n], z);
-        i += 1;
-    }
-}
-
 /// [`dot_portable`] with the AVX-512 form on CPUs that have it.
 #[inline(always)]
 pub fn dot(isa: Isa, a: &[f64], b: &[f64]) -> f64 {
@@ -529,15 +507,14 @@ mod tests {
             assert!((d - want_d).abs() < 1e-13 && (s_abs - want_s).abs() < 1e-13);
             assert_eq!(d, d1);
             let m: Vec<f64> = (0..37 * 9).map(|k| (k as f64 * 0.13).cos()).collect();
-            let (mut out, mut abs, mut out2) = (vec![0.0; 9], vec![0.0; 9], vec![0.0; 9]);
+            let (mut out, mut abs) = (vec![0.0; 9], vec![0.0; 9]);
             dispatch!(isa, (), || matvec_and_abs(isa, &m, &x, &mut out, &mut abs));
-            dispatch!(isa, (), || matvec(isa, &m, &x, &mut out2));
             for i in 0..9 {
                 let row = &m[i * 37..(i + 1) * 37];
                 let want: f64 = row.iter().zip(&x).map(|(a, b)| a * b).sum();
                 let want_abs: f64 = row.iter().zip(&x).map(|(a, b)| (a * b).abs()).sum();
                 assert!((out[i] - want).abs() < 1e-13 && (abs[i] - want_abs).abs() < 1e-13);
-                assert_eq!(out[i], out2[i]);
+                assert_eq!(out[i], dot(isa, row, &x));
             }
             let row9: Vec<f64> = (0..9).map(|i| 0.5 + i as f64).collect();
             let (mut rmx, mut cmx) = (vec![0.0; 9], vec![7.0; 37]);

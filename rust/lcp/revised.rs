@@ -89,9 +89,6 @@ pub(super) struct RevisedLemke {
     etas: Vec<f64>,
     eta_rows: Vec<usize>,
     count: usize,
-    /// per complete block of ETA_BLOCK etas, the 8 x 8 matrix G (column-major) that gives
-    /// the block's multipliers from the entries it reads, `t = G x_R` (see `apply_etas`).
-    block_maps: Vec<f64>,
     /// the columns of -M' stored contiguously (`columns[k n + i] = -r_i M_ik c_k`) where the
     /// CPU has AVX-512 (n^2 entries; empty elsewhere), filled eight columns at a time when
     /// the path first asks for one of them: `column_blocks[k / 8]` says block k / 8 is there.
@@ -139,7 +136,6 @@ impl RevisedLemke {
             etas: vec![0.0; cap * n],
             eta_rows: vec![0; cap],
             count: 0,
-            block_maps: vec![0.0; cap.div_ceil(ETA_BLOCK) * ETA_BLOCK * ETA_BLOCK],
             columns: if kernel::detect() == Isa::Avx512 {
                 vec![0.0; n * n]
             } else {
@@ -384,13 +380,12 @@ impl RevisedLemke {
     /// `t_a = x[r_a]` as updated by the block's earlier etas,
     ///
     /// ```text
-    ///     t_a = x[r_a] + Σ_{b<a} η̃_b[r_a] t_b,   i.e.   (I - L) t = x_R,   t = G x_R,
+    ///     t_a = x[r_a] + Σ_{b<a} η̃_b[r_a] t_b,
     /// ```
     ///
-    /// with L strictly lower triangular. G = (I - L)^{-1} is formed once when the block is
-    /// complete (`close_block`), so the multipliers are a small matrix-vector product with no
-    /// chain of dependent loads; then one pass over x adds `Σ_a t_a η̃_a`, reading and writing
-    /// x once per block instead of once per eta.
+    /// a tiny triangular recurrence; then one pass over x adds `Σ_a t_a η̃_a`, reading and
+    /// writing x once per block instead of once per eta. A full block whose multipliers are all
+    /// zero leaves x as it is and is skipped.
     ///
     /// Returns `max_i |x_i|` of the result when a pass over x produced it (None when no eta
     /// touched x).
@@ -400,30 +395,10 @@ impl RevisedLemke {
         let p = self.count;
         let mut size = None;
         let mut j = 0;
-        while j + ETA_BLOCK <= p {
-            let mut xr = [0.0f64; ETA_BLOCK];
-            let mut any = false;
-            for (a, v) in xr.iter_mut().enumerate() {
-                *v = x[self.eta_rows[j + a]];
-                any |= *v != 0.0;
-            }
-            if any {
-                let g = &self.block_maps[j * ETA_BLOCK..(j + ETA_BLOCK) * ETA_BLOCK];
-                let mut t = [0.0f64; ETA_BLOCK];
-                for (b, gcol) in g.chunks_exact(ETA_BLOCK).enumerate() {
-                    for a in 0..ETA_BLOCK {
-                        t[a] += gcol[a] * xr[b];
-                    }
-                }
-                let block = &self.etas[j * n..(j + ETA_BLOCK) * n];
-                size = Some(eta_pass(self.isa, x, block, &t));
-            }
-            j += ETA_BLOCK;
-        }
-        // the last, partial block: its multipliers by the recurrence itself
-        let m = p - j;
-        if m > 0 {
+        while j < p {
+            let m = ETA_BLOCK.min(p - j);
             let mut t = [0.0f64; ETA_BLOCK];
+            let mut any = false;
             for a in 0..m {
                 let r = self.eta_rows[j + a];
                 let mut v = x[r];
@@ -431,44 +406,29 @@ impl RevisedLemke {
                     v += tb * self.etas[(j + b) * n + r];
                 }
                 t[a] = v;
+                any |= v != 0.0;
             }
-            let block = &self.etas[j * n..p * n];
-            size = Some(match m {
-                1 => eta_pass(self.isa, x, block, &[t[0]]),
-                2 => eta_pass(self.isa, x, block, &[t[0], t[1]]),
-                3 => eta_pass(self.isa, x, block, &[t[0], t[1], t[2]]),
-                4 => eta_pass(self.isa, x, block, &[t[0], t[1], t[2], t[3]]),
-                5 => eta_pass(self.isa, x, block, &[t[0], t[1], t[2], t[3], t[4]]),
-                6 => eta_pass(self.isa, x, block, &[t[0], t[1], t[2], t[3], t[4], t[5]]),
-                _ => eta_pass(
-                    self.isa,
-                    x,
-                    block,
-                    &[t[0], t[1], t[2], t[3], t[4], t[5], t[6]],
-                ),
-            });
+            if any {
+                let block = &self.etas[j * n..(j + m) * n];
+                size = Some(match m {
+                    1 => eta_pass(self.isa, x, block, &[t[0]]),
+                    2 => eta_pass(self.isa, x, block, &[t[0], t[1]]),
+                    3 => eta_pass(self.isa, x, block, &[t[0], t[1], t[2]]),
+                    4 => eta_pass(self.isa, x, block, &[t[0], t[1], t[2], t[3]]),
+                    5 => eta_pass(self.isa, x, block, &[t[0], t[1], t[2], t[3], t[4]]),
+                    6 => eta_pass(self.isa, x, block, &[t[0], t[1], t[2], t[3], t[4], t[5]]),
+                    7 => eta_pass(
+                        self.isa,
+                        x,
+                        block,
+                        &[t[0], t[1], t[2], t[3], t[4], t[5], t[6]],
+                    ),
+                    _ => eta_pass(self.isa, x, block, &t),
+                });
+            }
+            j += m;
         }
         size
-    }
-
-    /// forms G = (I - L)^{-1} for the block of etas starting at j, `L_ab = η̃_b[r_a]` (b < a),
-    /// column by column: `g_a = δ_ac + Σ_{b<a} L_ab g_b` for column c.
-    fn close_block(&mut self, j: usize) {
-        let n = self.n;
-        let g = &mut self.block_maps[j * ETA_BLOCK..(j + ETA_BLOCK) * ETA_BLOCK];
-        for c in 0..ETA_BLOCK {
-            let col = &mut g[c * ETA_BLOCK..(c + 1) * ETA_BLOCK];
-            col.iter_mut().for_each(|v| *v = 0.0);
-            col[c] = 1.0;
-            for a in c + 1..ETA_BLOCK {
-                let r = self.eta_rows[j + a];
-                let mut v = 0.0;
-                for (b, gb) in col.iter().enumerate().take(a).skip(c) {
-                    v += self.etas[(j + b) * n + r] * gb;
-                }
-                col[a] = v;
-            }
-        }
     }
 
     /// folds the eta file into the explicit inverse, `B_0^{-1} <- E_p ⋯ E_1 B_0^{-1}`: per
@@ -532,9 +492,6 @@ impl RevisedLemke {
         eta[r] = inv - 1.0;
         self.eta_rows[j] = r;
         self.count += 1;
-        if self.count.is_multiple_of(ETA_BLOCK) {
-            self.close_block(self.count - ETA_BLOCK);
-        }
         let t = self.values[r];
         self.values_max = kernel::axpy_max(
             self.isa,
@@ -635,7 +592,8 @@ impl RevisedLemke {
         for (k, v) in zb.iter_mut().enumerate() {
             *v *= eq.col[k];
         }
-        kernel::matvec(self.isa, lcp.m, &zb, &mut res);
+        // (the term sums land in the spare vector, unused here)
+        kernel::matvec_and_abs(self.isa, lcp.m, &zb, &mut res, &mut self.spare);
         for (((ri, r), qi), di) in res.iter_mut().zip(&eq.row).zip(lcp.q).zip(&self.cover) {
             *ri = r * qi / eq.sigma + r * *ri + di * z0;
         }

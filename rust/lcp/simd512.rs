@@ -311,34 +311,6 @@ pub(super) unsafe fn dot_and_abs4(rows: &[f64], z: &[f64], n: usize) -> ([f64; 4
     )
 }
 
-/// [`dot`] of four consecutive rows against `z` (see [`dot_and_abs4`]).
-///
-/// # Safety
-/// As for [`dot_and_abs4`].
-#[target_feature(enable = "avx512f,avx512vl,avx2,fma")]
-#[inline]
-pub(super) unsafe fn dot4(rows: &[f64], z: &[f64], n: usize) -> [f64; 4] {
-    debug_assert!(rows.len() >= 4 * n && z.len() >= n);
-    let mut d = [_mm512_setzero_pd(); 4];
-    let (pm, pz) = (rows.as_ptr(), z.as_ptr());
-    for_lanes!(n, |i, k| {
-        // SAFETY: as in `dot_and_abs4`.
-        unsafe {
-            let zv = _mm512_maskz_loadu_pd(k, pz.add(i));
-            for (r, dr) in d.iter_mut().enumerate() {
-                let p = _mm512_mul_pd(_mm512_maskz_loadu_pd(k, pm.add(r * n + i)), zv);
-                *dr = _mm512_add_pd(*dr, p);
-            }
-        }
-    });
-    [
-        _mm512_reduce_add_pd(d[0]),
-        _mm512_reduce_add_pd(d[1]),
-        _mm512_reduce_add_pd(d[2]),
-        _mm512_reduce_add_pd(d[3]),
-    ]
-}
-
 /// [`ruiz_row`] for four consecutive rows (row length `n`, starting at `rows`) with row
 /// factors `r`: four independent maxima, and colmax loaded and stored once per four rows.
 ///
