@@ -680,10 +680,11 @@ class Model:
             active = []
             for i, (g, rows) in enumerate(frames):
                 vn_k, vn_free = float(rows[0] @ v), float(rows[0] @ v_free)
-                if g > gap_tolerance + 2 * h * max(0.0, -vn_k, -vn_free):
+                # a contact owed the rebound of the impact the last step stopped stays active
+                if g > gap_tolerance + 2 * h * max(0.0, -vn_k, -vn_free) and not landed[i]:
                     approach[i], landed[i], warm[i] = 0.0, False, 0.0
                     continue
-                active.append((i, g, rows, vn_k, g <= gap_tolerance))
+                active.append((i, g, rows, vn_k, g <= gap_tolerance or bool(landed[i])))
             resumed = used_fallback = False
             v_next = v_free.copy()
             gp = np.zeros(q.size)
@@ -731,11 +732,10 @@ class Model:
                 for a, (i, g, rows, vn_k, closed) in enumerate(active):
                     p = r[a * dim:(a + 1) * dim]
                     warm[i] = p
-                    if closed:
-                        approach[i], landed[i] = 0.0, False
-                    elif p[0] > 0.0:
-                        approach[i] = min(approach[i], vn_k)
-                        landed[i] = True
+                    # the impact record: made by an open contact that pushed, consumed by
+                    # the next step, never replayed
+                    landed[i] = not closed and p[0] > 0.0
+                    approach[i] = min(vn_k, 0.0) if landed[i] else 0.0
                     rec["contact_step"].append(k)
                     rec["contact_id"].append(i)
                     rec["contact_impulse"].append(p.copy())

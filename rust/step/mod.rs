@@ -18,9 +18,13 @@
 //! - an *imminently closing* contact (`g > gap_tolerance`, but the free motion would close it
 //!   within the step) gets the gap term `0 <= P_n ⊥ J_n v_{k+1} + g / h >= 0`: the contact may
 //!   close during the step but not pass through, and nothing is applied unless it would. When
-//!   such a step does push (`P_n > 0`), its approach velocity `J_n v_k` is remembered, and the
-//!   next step, with the contact closed, applies restitution with it: the rebound is then
-//!   `-e v_n^-` wherever in the step the impact fell;
+//!   such a step does push (`P_n > 0`), an impact happened inside it: its approach velocity
+//!   `J_n v_k` is recorded for that contact (module `impact`), and the next step applies the
+//!   impact law with it whatever the gap left (O(h^2) for a rotating body or a turning
+//!   normal): the rebound is then `-e v_n^-`, the record consumed, wherever in the step the
+//!   impact fell. With no force acting during the step this is exact; under gravity the
+//!   approach is the velocity at the start of the landing step, so with e = 1 each bounce
+//!   loses `m g y_k` (y_k the height at that start, at most `m g h |v_n^-|`: first order);
 //! - a contact that is far (neither of the above) carries no unknowns (seed: "A contact
 //!   search must first identify closed or imminently closing contacts").
 //!
@@ -52,6 +56,7 @@
 //! projection onto `g >= 0`.
 
 pub mod broad;
+mod impact;
 mod stepper;
 
 pub use stepper::{simulate, ContactRecord, StepRecord, Stepper, Trajectory};

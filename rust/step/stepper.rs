@@ -4,6 +4,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::broad::BroadPhase;
+use super::impact::ImpactMemory;
 use super::{det3, BodyKind, Drift, Pair, Restitution, Scene, StepSettings, StepSolver};
 use crate::contact::polyhedral::PolyhedralLcp;
 use crate::contact::{
@@ -67,7 +68,8 @@ pub struct ContactRecord {
     pub approach: f64,
     /// the gap at `q_k` (m).
     pub gap: f64,
-    /// whether the contact was closed (`gap <= gap_tolerance`) rather than imminent.
+    /// whether the contact got the impact law (it was closed, `gap <= gap_tolerance`, or owed
+    /// the rebound of an impact the previous step stopped) rather than the gap term.
     pub closed: bool,
 }
 
@@ -123,12 +125,8 @@ struct Candidate {
 struct CandState {
     /// the last impulse, `dim` used entries, for warm starts.
     warm: [f64; 3],
-    /// the approach velocity remembered when an open contact pushed (<= 0).
-    approach: f64,
-    /// whether the last step was open and pushed (it closed the contact).
-    landed: bool,
-    /// the normal impulse of those landing steps (Poisson's compression carried over).
-    landing: f64,
+    /// the impact the last step stopped with the gap term, owed its rebound by this step.
+    impact: ImpactMemory,
     /// the contact's variables in the last polyhedral LCP's final basis, for Lemke's warm
     /// start: bit 0 its normal impulse, bit 1 its λ, bit 2 + k its k-th β.
     basis: u64,
@@ -897,7 +895,9 @@ impl Stepper {
                 let [lin, ang] = self.speed_bounds[body];
                 reach += lin + ang * dot(r, r).sqrt();
             }
-            let far = geo.gap > tol_gap + 2.0 * h * reach;
+            // a contact owed a rebound stays active whatever its gap (module impact)
+            let pending = self.state[c].impact.pending;
+            let far = geo.gap > tol_gap + 2.0 * h * reach && !pending;
             let (vn_k, vn_free) = if far {
                 (0.0, 0.0)
             } else {
@@ -907,7 +907,7 @@ impl Stepper {
                 )
             };
             let closing = (-vn_k).max(-vn_free).max(0.0);
-            if far || geo.gap > tol_gap + 2.0 * h * closing {
+            if far || (geo.gap > tol_gap + 2.0 * h * closing && !pending) {
                 self.state[c] = CandState::default();
                 continue;
             }
@@ -915,7 +915,7 @@ impl Stepper {
             let mut act = Active {
                 cand: c,
                 gap: geo.gap,
-                closed: geo.gap <= tol_gap,
+                closed: geo.gap <= tol_gap || pending,
                 vn_k,
                 nsides: geo.nsides,
                 ..Active::default()
@@ -1089,15 +1089,13 @@ impl Stepper {
                 let st = &mut self.state[a.cand];
                 st.warm[..dim].copy_from_slice(p);
                 st.basis = sol.basis.get(i).copied().unwrap_or(0);
-                if a.closed {
-                    st.approach = 0.0;
-                    st.landed = false;
-                    st.landing = 0.0;
-                } else if p[0] > 0.0 {
-                    st.approach = st.approach.min(a.vn_k);
-                    st.landed = true;
-                    st.landing += p[0];
-                }
+                // a closed contact consumes its record; an open one that pushed records its
+                // impact; one that did not push has none
+                st.impact = if !a.closed && p[0] > 0.0 {
+                    ImpactMemory::landed(a.vn_k, p[0])
+                } else {
+                    ImpactMemory::default()
+                };
                 let mut impulse = [0.0; 3];
                 impulse[..dim].copy_from_slice(p);
                 let mut velocity = [0.0; 3];
@@ -1236,8 +1234,8 @@ impl Stepper {
             }
             let bound = if ai.closed {
                 // Newton: 0 <= P_n ⊥ J_n v_{k+1} + e v_n^- >= 0
-                let vminus = ai.vn_k.min(st.approach).min(0.0);
-                if st.landed {
+                let vminus = st.impact.approach_with(ai.vn_k);
+                if st.impact.pending {
                     record.resumed = true;
                 }
                 self.active[i].approach = vminus;
@@ -1248,8 +1246,8 @@ impl Stepper {
                 if poisson {
                     // the impact phase compresses on J_n v_k; what a landing step already
                     // pushed counts in the compression impulse
-                    self.active[i].carried = st.landing;
-                    self.poisson_impact |= ai.vn_k < 0.0 || st.landed;
+                    self.active[i].carried = st.impact.compression;
+                    self.poisson_impact |= ai.vn_k < 0.0 || st.impact.pending;
                     bias
                 } else {
                     cand.e * vminus + bias

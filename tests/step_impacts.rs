@@ -1,0 +1,412 @@
+//! Impacts over the class of bodies and shape pairs: Newton's law keyed to each contact's
+//! recorded impact (a rod end, box corners, spheres whose normal turns, declared or found by
+//! the broad phase), wherever in the step the impact falls, and the energy of a tumbling cube.
+
+use coulomb::step::{
+    simulate, Body, BodyKind, ContactRecord, HalfSpace, Pair, Scene, Shape, StepSettings,
+    Trajectory,
+};
+
+fn body(kind: BodyKind, mass: f64, inertia: Vec<f64>, q0: Vec<f64>, v0: Vec<f64>) -> Body {
+    let dim = if kind == BodyKind::Spatial || q0.len() == 3 && kind == BodyKind::Particle {
+        3
+    } else {
+        2
+    };
+    Body {
+        kind,
+        mass,
+        inertia,
+        q0,
+        v0,
+        force: vec![0.0; dim],
+    }
+}
+
+fn floor(dim: usize) -> HalfSpace {
+    let mut normal = vec![0.0; dim];
+    normal[dim - 1] = 1.0;
+    HalfSpace {
+        point: vec![0.0; dim],
+        normal,
+    }
+}
+
+/// one body with a shape of `points` (radius r) against the floor, no gravity.
+fn on_floor(dim: usize, b: Body, points: Vec<Vec<f64>>, r: f64, mu: f64, e: f64) -> Scene {
+    Scene {
+        dim,
+        gravity: vec![0.0; dim],
+        bodies: vec![b],
+        shapes: vec![Shape {
+            body: 0,
+            points,
+            radius: r,
+        }],
+        half_spaces: vec![floor(dim)],
+        pairs: vec![Pair::ShapeHalfSpace {
+            shape: 0,
+            half_space: 0,
+            mu,
+            e,
+        }],
+    }
+}
+
+/// a unit quaternion (w, x, y, z) of `angle` about the unit `axis`.
+fn quat(axis: [f64; 3], angle: f64) -> [f64; 4] {
+    let (s, c) = (0.5 * angle).sin_cos();
+    [c, s * axis[0], s * axis[1], s * axis[2]]
+}
+
+fn cube_corners(a: f64) -> Vec<Vec<f64>> {
+    let mut out = vec![];
+    for sx in [-a, a] {
+        for sy in [-a, a] {
+            for sz in [-a, a] {
+                out.push(vec![sx, sy, sz]);
+            }
+        }
+    }
+    out
+}
+
+/// The cases: (name, scene, lowest gap's time scale) with the first impact at a phase `frac`
+/// of a step of size h (the impact comes after 2 + frac steps at the approach speed 1 m/s,
+/// to first order: rotation shifts it by O(h)).
+fn cases(h: f64, frac: f64, e: f64, mu: f64) -> Vec<(&'static str, Scene)> {
+    let drop = (2.0 + frac) * h;
+    let mut out = vec![];
+    // particles, 2D and 3D
+    let p2 = body(
+        BodyKind::Particle,
+        0.5,
+        vec![],
+        vec![0.0, drop],
+        vec![0.3, -1.0],
+    );
+    out.push((
+        "particle 2D",
+        on_floor(2, p2, vec![vec![0.0; 2]], 0.0, mu, e),
+    ));
+    let p3 = body(
+        BodyKind::Particle,
+        0.5,
+        vec![],
+        vec![0.0, 0.0, drop],
+        vec![0.3, -0.2, -1.0],
+    );
+    out.push((
+        "particle 3D",
+        on_floor(3, p3, vec![vec![0.0; 3]], 0.0, mu, e),
+    ));
+    // a planar rod (l = 1) whose lower end strikes, rotating
+    let th = 30f64.to_radians();
+    let rod = body(
+        BodyKind::Planar,
+        1.0,
+        vec![1.0 / 12.0],
+        vec![0.0, 0.5 * th.sin() + drop, th],
+        vec![0.0, -1.0, 2.0],
+    );
+    out.push((
+        "planar rod end",
+        on_floor(2, rod, vec![vec![-0.5, 0.0], vec![0.5, 0.0]], 0.0, mu, e),
+    ));
+    // a planar box (polygon corners) tilted 20 degrees, spinning
+    let (a, b) = (0.2, 0.1);
+    let tb = 20f64.to_radians();
+    let low = a * tb.sin() + b * tb.cos();
+    let boxb = body(
+        BodyKind::Planar,
+        2.0,
+        vec![2.0 * (4.0 * a * a + 4.0 * b * b) / 12.0],
+        vec![0.0, low + drop, tb],
+        vec![0.1, -1.0, -3.0],
+    );
+    let corners = vec![vec![-a, -b], vec![a, -b], vec![a, b], vec![-a, b]];
+    out.push(("planar box corner", on_floor(2, boxb, corners, 0.0, mu, e)));
+    // a disk (radius) on a spinning planar body
+    let disk = body(
+        BodyKind::Planar,
+        1.0,
+        vec![0.005],
+        vec![0.0, 0.1 + drop, 0.0],
+        vec![0.5, -1.0, 10.0],
+    );
+    out.push((
+        "planar disk",
+        on_floor(2, disk, vec![vec![0.0; 2]], 0.1, mu, e),
+    ));
+    // a spatial cube standing on a corner (its diagonal vertical: 54.74 deg about
+    // (1, -1, 0)), tumbling
+    let ang = (1.0 / 3f64.sqrt()).acos();
+    let s2 = std::f64::consts::FRAC_1_SQRT_2;
+    let qc = quat([s2, -s2, 0.0], ang);
+    let ac = 0.1;
+    let ic = (2.0 * ac) * (2.0 * ac) / 6.0;
+    let zc = ac * 3f64.sqrt() + drop;
+    let cube = body(
+        BodyKind::Spatial,
+        1.0,
+        vec![ic, 0.0, 0.0, 0.0, ic, 0.0, 0.0, 0.0, ic],
+        vec![0.0, 0.0, zc, qc[0], qc[1], qc[2], qc[3]],
+        vec![0.1, 0.0, -1.0, 1.0, 2.0, -0.5],
+    );
+    out.push((
+        "spatial cube corner",
+        on_floor(3, cube, cube_corners(ac), 0.0, mu, e),
+    ));
+    // a spatial sphere, spinning
+    let sph = body(
+        BodyKind::Spatial,
+        1.0,
+        vec![0.004, 0.0, 0.0, 0.0, 0.004, 0.0, 0.0, 0.0, 0.004],
+        vec![0.0, 0.0, 0.1 + drop, 1.0, 0.0, 0.0, 0.0],
+        vec![0.2, 0.1, -1.0, 3.0, -2.0, 1.0],
+    );
+    out.push((
+        "spatial sphere",
+        on_floor(3, sph, vec![vec![0.0; 3]], 0.1, mu, e),
+    ));
+    // two spheres colliding obliquely (the normal turns during the step), declared or found
+    for (name, dim, auto) in [
+        ("spheres 3D declared", 3, false),
+        ("spheres 3D broad phase", 3, true),
+        ("disks 2D declared", 2, false),
+    ] {
+        out.push((name, two_spheres(dim, auto, drop, mu, e)));
+    }
+    out
+}
+
+/// two balls (r = 0.1, m = 1) meeting obliquely (offset 0.12 across), closing at 1 m/s along
+/// x, the gap `drop` along x at the start.
+fn two_spheres(dim: usize, auto: bool, drop: f64, mu: f64, e: f64) -> Scene {
+    let r: f64 = 0.1;
+    let off: f64 = 0.12;
+    let dx = ((2.0 * r) * (2.0 * r) - off * off).sqrt() + drop;
+    let (kind, inertia, pad_q, pad_v): (BodyKind, Vec<f64>, Vec<f64>, Vec<f64>) = if dim == 3 {
+        (
+            BodyKind::Spatial,
+            vec![0.004, 0.0, 0.0, 0.0, 0.004, 0.0, 0.0, 0.0, 0.004],
+            vec![1.0, 0.0, 0.0, 0.0],
+            vec![0.0; 3],
+        )
+    } else {
+        (BodyKind::Planar, vec![0.005], vec![0.0], vec![0.0])
+    };
+    let place = |x: f64, y: f64, vx: f64| {
+        let mut q = vec![x, y];
+        let mut v = vec![vx, 0.0];
+        if dim == 3 {
+            q.push(0.0);
+            v.push(0.0);
+        }
+        q.extend_from_slice(&pad_q);
+        v.extend_from_slice(&pad_v);
+        body(kind, 1.0, inertia.clone(), q, v)
+    };
+    let centre = vec![0.0; dim];
+    let mut scene = Scene {
+        dim,
+        gravity: vec![0.0; dim],
+        bodies: vec![place(0.0, 0.0, 0.5), place(dx, off, -0.5)],
+        shapes: vec![
+            Shape {
+                body: 0,
+                points: vec![centre.clone()],
+                radius: r,
+            },
+            Shape {
+                body: 1,
+                points: vec![centre],
+                radius: r,
+            },
+        ],
+        half_spaces: vec![],
+        pairs: vec![],
+    };
+    scene.pairs.push(if auto {
+        Pair::Spheres { mu, e }
+    } else {
+        Pair::SphereSphere { a: 0, b: 1, mu, e }
+    });
+    scene
+}
+
+fn run(scene: &Scene, h: f64, steps: usize) -> Trajectory {
+    let tr = simulate(scene, &StepSettings::new(h, steps)).expect("valid scene");
+    assert!(tr.stopped.is_none(), "{:?}", tr.stopped);
+    tr
+}
+
+/// the first record of the first contact that pushed, and the rebound record that followed
+/// it (the same contact, with the impact law).
+fn impact_pair(tr: &Trajectory) -> (ContactRecord, ContactRecord) {
+    let land = *tr
+        .contacts
+        .iter()
+        .find(|c| c.impulse[0] > 0.0)
+        .expect("an impact");
+    let rebound = *tr
+        .contacts
+        .iter()
+        .find(|c| c.id == land.id && c.step > land.step && c.closed)
+        .unwrap_or(&land);
+    (land, rebound)
+}
+
+fn total_energy(tr: &Trajectory, k: usize) -> f64 {
+    tr.kinetic_energy[k] + tr.potential_energy[k]
+}
+
+/// Newton's law `v_n^+ = -e v_n^-` for the first impact of every body kind and shape pair,
+/// wherever in the step it falls: the rebound is keyed to the contact's recorded impact (not
+/// to the gap left after the landing step, which is O(h^2) for a rotating body or a turning
+/// normal), exact in the contact's velocity, and the recorded approach is the approach speed
+/// (1 m/s here) to O(h).
+#[test]
+fn newton_rebound_follows_every_impact_for_every_body_and_shape_pair() {
+    let e = 0.6;
+    for h in [1e-3, 1e-4] {
+        for frac in [0.05, 0.5, 0.95] {
+            for (name, scene) in cases(h, frac, e, 0.0) {
+                let tr = run(&scene, h, 8);
+                let (land, rebound) = impact_pair(&tr);
+                let what = format!("{name} h {h} frac {frac}: {land:?} {rebound:?}");
+                assert!(rebound.closed && rebound.step > land.step, "{what}");
+                let vminus = rebound.approach;
+                assert!(
+                    (rebound.velocity[0] + e * vminus).abs() < 1e-9 * vminus.abs(),
+                    "{what}"
+                );
+                // the approach the rule used is the contact's approach when it was found
+                // (two or three steps before), to O(h) (rotation, turning normals)
+                let first = tr
+                    .contacts
+                    .iter()
+                    .find(|c| c.id == land.id)
+                    .expect("the contact was found");
+                assert!(
+                    (vminus - first.approach).abs() < 100.0 * h * first.approach.abs(),
+                    "{what}"
+                );
+            }
+        }
+    }
+}
+
+/// The reproduction of a rod end striking (e = 0.6, h = 1e-3): the end's normal velocity
+/// after the impact, at the final state, is 0.6 m/s to O(h) (it was 0.0018: the mid-step
+/// impact's rebound was dropped because the gap left, 8e-8 m, exceeded the gap tolerance).
+#[test]
+fn rod_end_rebounds_with_e_after_a_mid_step_impact() {
+    for h in [1e-3, 1e-4] {
+        let th = 30f64.to_radians();
+        let rod = body(
+            BodyKind::Planar,
+            1.0,
+            vec![1.0 / 12.0],
+            vec![0.0, 0.5 * th.sin() + 2.5 * h, th],
+            vec![0.0, -1.0, 0.0],
+        );
+        let scene = on_floor(2, rod, vec![vec![-0.5, 0.0]], 0.0, 0.0, 0.6);
+        let tr = run(&scene, h, 6);
+        let q = &tr.q[6 * 3..7 * 3];
+        let v = &tr.v[6 * 3..7 * 3];
+        let vn = v[1] - v[2] * 0.5 * q[2].cos();
+        assert!((vn - 0.6).abs() < 10.0 * h, "{h}: {vn}");
+    }
+}
+
+/// Elastic (e = 1), frictionless impacts keep the kinetic energy to O(h): spheres colliding
+/// obliquely (declared or found by the broad phase; they lost 47% of it when the turning
+/// normal left the contact 1e-6 m open after the landing step), the tumbling cube's corner,
+/// the rod end, the box corner.
+#[test]
+fn elastic_impacts_keep_the_energy_to_order_h() {
+    for h in [1e-3, 1e-4] {
+        for frac in [0.05, 0.5, 0.95] {
+            for (name, scene) in cases(h, frac, 1.0, 0.0) {
+                let tr = run(&scene, h, 10);
+                let n = tr.t.len() - 1;
+                let (e0, e1) = (total_energy(&tr, 0), total_energy(&tr, n));
+                assert!(tr.contacts.iter().any(|c| c.impulse[0] > 0.0), "{name}");
+                assert!(
+                    (e1 / e0 - 1.0).abs() < 20.0 * h,
+                    "{name} h {h} frac {frac}: {e0} -> {e1}"
+                );
+            }
+        }
+    }
+}
+
+/// a cube (a = 0.1 m, 1 kg) tilted onto a corner (35.26 deg about (1, -1, 0)) dropped from
+/// 0.5 m onto a frictionless floor under gravity.
+fn dropped_cube(e: f64, mu: f64) -> Scene {
+    let ang = 35.26f64.to_radians();
+    let s2 = std::f64::consts::FRAC_1_SQRT_2;
+    let qc = quat([s2, -s2, 0.0], ang);
+    let ac = 0.1;
+    let ic = (2.0 * ac) * (2.0 * ac) / 6.0;
+    let mut scene = on_floor(
+        3,
+        body(
+            BodyKind::Spatial,
+            1.0,
+            vec![ic, 0.0, 0.0, 0.0, ic, 0.0, 0.0, 0.0, ic],
+            vec![0.0, 0.0, 0.5, qc[0], qc[1], qc[2], qc[3]],
+            vec![0.0; 6],
+        ),
+        cube_corners(ac),
+        0.0,
+        mu,
+        e,
+    );
+    scene.gravity = vec![0.0, 0.0, -9.81];
+    scene
+}
+
+/// the largest energy gain of a step, a step that gives a recorded impact its rebound judged
+/// together with the landing step before it (the landing takes the energy the rebound gives
+/// back).
+fn largest_gain(tr: &Trajectory) -> f64 {
+    let mut worst = f64::NEG_INFINITY;
+    for k in 0..tr.steps.len() {
+        let from = if tr.steps[k].resumed { k - 1 } else { k };
+        if k + 1 < tr.steps.len() && tr.steps[k + 1].resumed {
+            continue;
+        }
+        worst = worst.max(total_energy(tr, k + 1) - total_energy(tr, from));
+    }
+    worst
+}
+
+/// The tumbling cube on a frictionless floor (1 s, several corner and edge impacts): with
+/// e = 1 it keeps its energy to O(h) (it kept 0.50 of it at h = 1e-3, as inelastic as e = 0
+/// when the corner's rebound was dropped), no step adds more than O(h) of it, and no stale
+/// approach velocity is replayed (a corner hovering open for a few steps used to get the
+/// rebound of its old impact when the face slapped down: +2.7 J in one step, 55% of the
+/// energy). With e = 0.5 and e = 0 it loses energy and no step gains beyond O(h).
+#[test]
+fn tumbling_cube_energy_with_every_restitution() {
+    for h in [1e-3, 1e-4] {
+        let steps = (1.0 / h) as usize;
+        for e in [1.0, 0.5, 0.0] {
+            let tr = run(&dropped_cube(e, 0.0), h, steps);
+            let e0 = total_energy(&tr, 0);
+            let n = tr.t.len() - 1;
+            let ratio = total_energy(&tr, n) / e0;
+            let gain = largest_gain(&tr) / e0;
+            // measured: e = 1, 1.033 (h = 1e-3) and 1.002 (1e-4), largest gain 0.024 and
+            // 0.0027 of E0
+            assert!(gain < 30.0 * h, "e {e} h {h}: gain {gain}");
+            if e == 1.0 {
+                assert!((ratio - 1.0).abs() < 40.0 * h, "h {h}: {ratio}");
+            } else {
+                assert!(ratio < 1.0, "e {e} h {h}: {ratio}");
+            }
+        }
+    }
+}
