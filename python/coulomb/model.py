@@ -474,10 +474,12 @@ class Scene:
         restitution : {"newton", "poisson"}
             The impact law at closed contacts, with each pair's ``e``: Newton's velocity-level
             condition ``J_n v_{k+1} + e v_n^- >= 0``, or Poisson's (an impact phase on ``v_k``:
-            the compression impulse with friction, then the normal restitution impulse
-            ``e P_comp``; friction is not re-solved during restitution). They agree on a
-            single frictionless impact; with friction Poisson's keeps more tangential speed
-            (m = 2, v = (1, -3), mu = 0.2, e = 0.5: v_t^+ = 0.4 against Newton's 0.1).
+            compression until the normal velocity stops, then the normal restitution impulse
+            ``e P_comp``, Coulomb friction acting in both phases: Routh's integration in
+            impulse space for one contact, which never gains energy, the two phases solved as
+            wholes for coupled contacts). They agree on a single frictionless impact. Newton's
+            law with friction can gain energy (a rod at 45 deg striking at v = (0.6, -1),
+            e = 1, sticking: +0.1125 J); Poisson's does not.
         """
         t_end = _positive("t_end", t_end)
         h = _positive("h", h)

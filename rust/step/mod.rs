@@ -29,7 +29,15 @@
 //!   search must first identify closed or imminently closing contacts").
 //!
 //! [`Restitution::Poisson`] replaces Newton's condition by an impact phase on `v_k`
-//! (compression, then the normal impulse `e P_comp`) followed by an inelastic smooth phase.
+//! (compression, then the normal impulse `e P_comp`, Coulomb friction active in both phases:
+//! Routh's method for one contact, module `poisson`) followed by an inelastic smooth phase.
+//!
+//! Energy: for `e <= 1` a step adds no energy beyond the integrator's O(h) (the landing step
+//! of a mid-step impact and its rebound step freeze W at configurations one step apart),
+//! except where Newton's law with friction is known to add it (Stewart 2000; Kane and
+//! Levinson's example): a rod at 45 degrees striking at `v = (0.6, -1)` with e = 1 and
+//! sticking gains 0.1125 J under Newton's law. Poisson's law with friction in both phases
+//! never gains energy for one frictional contact (Glocker, Multibody Syst. Dyn. 2013).
 //!
 //! The friction law is Coulomb's with the exact disk (NSGS, warm-started by contact identity,
 //! with a fallback when it misses its tolerance: see [`StepSettings::fallback`]) or the
@@ -57,6 +65,7 @@
 
 pub mod broad;
 mod impact;
+mod poisson;
 mod stepper;
 
 pub use stepper::{simulate, ContactRecord, StepRecord, Stepper, Trajectory};
@@ -401,11 +410,13 @@ pub enum Restitution {
     /// Newton's: `0 <= P_n ⊥ J_n v_{k+1} + e v_n^- >= 0` (the seed's velocity-level
     /// condition).
     Newton,
-    /// Poisson's: an impact phase on `v_k` alone, the compression impulse `P_comp` (the
-    /// contact problem with `e = 0` on the approach velocity `v_n^-`, friction included), then
-    /// the normal restitution impulse `P_rest = e P_comp` (each pair's `e` as `e_P`; friction is
-    /// not re-solved during restitution), after which the step's smooth phase is inelastic. For
-    /// a single frictionless impact it agrees with Newton's law (seed).
+    /// Poisson's: an impact phase on `v_k` alone, compression until the normal velocity
+    /// stops (`P_comp`), then the normal restitution impulse `P_rest = e P_comp` (each pair's
+    /// `e` as `e_P`), Coulomb friction active in both phases: Routh's integration in impulse
+    /// space when one contact impacts alone, the phases solved as wholes for coupled contacts
+    /// (see the module `poisson`); the step's smooth phase is then inelastic. For a single
+    /// frictionless impact it agrees with Newton's law (seed); for one frictional contact it
+    /// never gains energy (Glocker, Multibody Syst. Dyn. 2013).
     Poisson,
 }
 

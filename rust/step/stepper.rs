@@ -5,6 +5,7 @@
 
 use super::broad::BroadPhase;
 use super::impact::ImpactMemory;
+use super::poisson::{restitution_with_friction, routh};
 use super::{det3, BodyKind, Drift, Pair, Restitution, Scene, StepSettings, StepSolver};
 use crate::contact::polyhedral::PolyhedralLcp;
 use crate::contact::{
@@ -284,6 +285,8 @@ pub struct Stepper {
     initial: Vec<f64>,
     basis_guess: Vec<usize>,
     p_impact: Vec<f64>,
+    /// the active contacts' restitution coefficients (Poisson's impact phase).
+    restitution: Vec<f64>,
     solve: SolveBuffers,
     gp: Vec<f64>,
     v_next: Vec<f64>,
@@ -573,6 +576,7 @@ impl Stepper {
             initial: Vec::new(),
             basis_guess: Vec::new(),
             p_impact: Vec::new(),
+            restitution: Vec::new(),
             solve: SolveBuffers::default(),
             candidates,
         })
@@ -988,19 +992,23 @@ impl Stepper {
             p_impact.clear();
             if self.poisson_impact {
                 let problem = step_problem(dim, &self.w, w_sparse.as_ref(), &self.q1, &self.mu)?;
-                solve_step_problem(
-                    &self.settings,
-                    &problem,
-                    warm,
-                    &basis,
+                let mut restitution = std::mem::take(&mut self.restitution);
+                restitution.clear();
+                restitution.extend(self.active.iter().map(|a| self.candidates[a.cand].e));
+                poisson_phase(
+                    &PoissonInput {
+                        settings: &self.settings,
+                        problem: &problem,
+                        active: &self.active,
+                        e: &restitution,
+                        warm,
+                        guess: &basis,
+                    },
                     &mut record,
                     &mut self.solve,
+                    &mut p_impact,
                 )?;
-                p_impact.extend_from_slice(&self.solve.impulse);
-                for (i, a) in self.active.iter().enumerate() {
-                    let e = self.candidates[a.cand].e;
-                    p_impact[i * dim] = (1.0 + e) * p_impact[i * dim] + e * a.carried;
-                }
+                self.restitution = restitution;
                 // the smooth phase starts from v_free + M^{-1} G P_impact
                 let mut wp = std::mem::take(&mut self.solve.velocity);
                 wp.resize(n, 0.0);
@@ -1253,9 +1261,10 @@ impl Stepper {
                     cand.e * vminus + bias
                 }
             } else {
-                // imminent: 0 <= P_n ⊥ J_n v_{k+1} + g / h >= 0
+                // imminent: 0 <= P_n ⊥ J_n v_{k+1} + g / h >= 0; an open contact takes no
+                // impulse in Poisson's (instantaneous) impact phase
                 self.active[i].approach = ai.vn_k;
-                self.q1[i * dim] += ai.gap / h;
+                self.q1[i * dim] = self.q1[i * dim].max(0.0) + ai.gap / h;
                 ai.gap / h
             };
             self.qc[i * dim] += bound;
@@ -1689,6 +1698,100 @@ fn solve_step_problem(
         }
         StepSolver::Lemke(s) => solve_polyhedral_warm(problem, s, guess, ws),
     }
+}
+
+/// What Poisson's impact phase reads.
+struct PoissonInput<'a, 'b> {
+    settings: &'a StepSettings,
+    /// the contact problem on the approach velocities `G^T v_k` (open contacts separated).
+    problem: &'a ContactProblem<'b>,
+    active: &'a [Active],
+    /// each active contact's restitution coefficient.
+    e: &'a [f64],
+    warm: Option<&'a [f64]>,
+    guess: &'a [usize],
+}
+
+/// Poisson's impact phase (module `poisson`) into `p_impact`: Routh's integration when one
+/// closed contact impacts and no other closed contact shares its bodies; otherwise
+/// compression as a whole (the inelastic friction-contact problem on the approach
+/// velocities), then restitution of `e P_n^c` with friction.
+fn poisson_phase(
+    input: &PoissonInput<'_, '_>,
+    record: &mut StepRecord,
+    solve: &mut SolveBuffers,
+    p_impact: &mut Vec<f64>,
+) -> Result<()> {
+    let problem = input.problem;
+    let dim = problem.dim;
+    let nc = problem.nc;
+    let active = input.active;
+    p_impact.clear();
+    p_impact.resize(nc * dim, 0.0);
+    let impacting =
+        |i: usize| active[i].closed && (problem.q[i * dim] < 0.0 || active[i].carried > 0.0);
+    let mut hits = (0..nc).filter(|&i| impacting(i));
+    let (Some(first), second) = (hits.next(), hits.next()) else {
+        return Ok(());
+    };
+    let shares = |i: usize, j: usize| {
+        let (a, b) = (&active[i], &active[j]);
+        a.sides[..a.nsides]
+            .iter()
+            .any(|s| b.sides[..b.nsides].iter().any(|t| t.body == s.body))
+    };
+    let isolated =
+        second.is_none() && (0..nc).all(|j| j == first || !active[j].closed || !shares(first, j));
+    if isolated {
+        let i = first;
+        let mut u0 = [0.0; 3];
+        u0[..dim].copy_from_slice(&problem.q[i * dim..(i + 1) * dim]);
+        let p = routh(
+            dim,
+            &problem.w_block(i, i),
+            u0,
+            problem.mu[i],
+            input.e[i],
+            active[i].carried,
+        );
+        p_impact[i * dim..(i + 1) * dim].copy_from_slice(&p[..dim]);
+        return Ok(());
+    }
+    solve_step_problem(
+        input.settings,
+        problem,
+        input.warm,
+        input.guess,
+        record,
+        solve,
+    )?;
+    // restitution from the velocities after compression, u_c = q + W P_c
+    let mut uc = vec![0.0; nc * dim];
+    problem.mul_w(&solve.impulse, &mut uc);
+    for (u, q) in uc.iter_mut().zip(problem.q) {
+        *u += q;
+    }
+    let normal: Vec<f64> = (0..nc)
+        .map(|i| {
+            if active[i].closed {
+                input.e[i] * (solve.impulse[i * dim] + active[i].carried)
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let after = match problem.storage() {
+        crate::contact::Delassus::Dense(w) => ContactProblem::new(dim, w, &uc, problem.mu)?,
+        crate::contact::Delassus::BlockSparse(w) => {
+            ContactProblem::with_block_sparse(w, &uc, problem.mu)?
+        }
+    };
+    let mut rest = vec![0.0; nc * dim];
+    restitution_with_friction(&after, &normal, &mut rest);
+    for ((p, c), r) in p_impact.iter_mut().zip(&solve.impulse).zip(&rest) {
+        *p = c + r;
+    }
+    Ok(())
 }
 
 /// Runs `settings.steps` steps of the impulse time stepper on `scene` from its initial state.

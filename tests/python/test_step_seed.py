@@ -231,9 +231,10 @@ def test_poisson_restitution(frac):
                      gravity=(0.0, 0.0)).simulate(4 * h, h, restitution="poisson")
     assert tr.v[-1, 1] == pytest.approx(1.8, abs=1e-12)
     assert tr.contact_impulse[:, 0].sum() == pytest.approx(2.4, abs=1e-12)
-    # with friction (m = 2, v = (1, -3), mu = 0.2, e = 0.5) friction acts in compression only
+    # with friction (m = 2, v = (1, -3), mu = 0.2, e = 0.5) friction acts in compression and
+    # restitution: P_t = -0.2 (6 + 3), v_t^+ = 0.1 (it was 0.4 with friction off in restitution)
     sc = point_scene((0.0, 0.0), (1.0, -3.0), mu=0.2, e=0.5, mass=2.0, gravity=(0.0, 0.0))
-    assert sc.simulate(h, h, restitution="poisson").v[-1] == pytest.approx([0.4, 1.5], abs=1e-12)
+    assert sc.simulate(h, h, restitution="poisson").v[-1] == pytest.approx([0.1, 1.5], abs=1e-12)
     assert sc.simulate(h, h).v[-1] == pytest.approx([0.1, 1.5], abs=1e-12)
     with pytest.raises(coulomb.errors.InvalidParameterError):
         sc.simulate(h, h, restitution="stronge")
