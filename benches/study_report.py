@@ -73,7 +73,8 @@ What the fronts teach (orders measured below):
   {orders["painleve-h"]:.2f}). Halving h halves the error and doubles the cost; no other setting
   moves these figures, because the contact problem of each step is solved exactly. The impact
   law needs no small step at all: the floor impact rebounds at exactly e times its speed at
-  every h and wherever in the step the impact falls.
+  every h and wherever in the step the impact falls (no force acts during its step; under
+  gravity an elastic bounce loses `m g y_k`, first order in h).
 - **The solver second.** NSGS (exact friction disk) and the polyhedral Lemke give the same
   answers in planar scenes (the 2D cone is exact as an LCP); in 3D the polyhedral cone adds an
   error that falls as facets^{orders["facets"]:.2f}: 8 facets leave about 9% slip error on an

@@ -86,4 +86,5 @@ def step_simulate(
     drift: str = "none",
     drift_bias: float = 0.2,
     restitution: str = "newton",
+    locate_impacts: bool = False,
 ) -> dict[str, Any]: ...

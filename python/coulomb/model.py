@@ -24,8 +24,14 @@ Every step solves, with M and the Jacobians frozen at ``q_k``,
 for the record and its checks. A closed contact gets Newton's condition
 ``0 <= P_n ⊥ J_n v_{k+1} + e v_n^- >= 0`` (or Poisson's law, ``restitution="poisson"``); an
 imminently closing one the gap term ``J_n v_{k+1} + g / h >= 0`` (it may close within the step,
-not pass through), and the step after it closes gives back the rebound ``-e v_n^-`` of the
-approach velocity it remembered, so the rebound is exact wherever in the step the impact falls.
+not pass through), and when that step pushes, the contact records its approach velocity and
+the next step gives back the rebound ``-e v_n^-`` whatever gap is left (a rotating body or a
+turning normal leaves O(h^2)); the record is then consumed. The rebound is exact wherever in
+the step the impact falls when no force acts during the step; under a force such as gravity
+the approach is the velocity at the start of the landing step, so with ``e = 1`` each bounce
+loses ``m g y_k`` (``y_k`` the height there, at most ``m g h |v_n^-|``: first order in h).
+``locate_impacts=True`` finds the impact instant within the step for isolated impacts and
+removes that loss.
 
 :class:`Model` takes a user-defined model in generalized coordinates instead (``M(q)``,
 ``f(q, v, t)`` and :class:`GapContact` gap functions with Jacobians), stepped by a Python loop
@@ -436,6 +442,7 @@ class Scene:
         drift: Literal["none", "bias", "projection"] = "none",
         drift_bias: float = 0.2,
         restitution: Literal["newton", "poisson"] = "newton",
+        locate_impacts: bool = False,
     ) -> Trajectory:
         """Runs ``ceil(t_end / h)`` steps of the impulse time stepper from the initial state.
 
@@ -484,6 +491,13 @@ class Scene:
             wholes for coupled contacts). They agree on a single frictionless impact. Newton's
             law with friction can gain energy (a rod at 45 deg striking at v = (0.6, -1),
             e = 1, sticking: +0.1125 J); Poisson's does not.
+        locate_impacts : bool
+            Locate isolated impacts within the step (every active contact open, one reaching
+            zero gap first): the step follows its free path to the impact instant, applies the
+            impact law there and finishes the step from it. With ``e = 1`` under gravity the
+            apex energy is then kept bounce after bounce (the plain step loses ``m g y_k`` per
+            bounce, ``y_k`` the height at the start of the landing step). Other steps are
+            plain steps.
         """
         t_end = _positive("t_end", t_end)
         h = _positive("h", h)
@@ -519,7 +533,7 @@ class Scene:
             spec, h, steps, solver=solver, tol=tol, max_iter=max_iter, relaxation=relaxation,
             facets=facets, gap_tolerance=gap_tolerance, warm_start=warm_start,
             fallback=fallback, drift=drift, drift_bias=float(drift_bias),
-            restitution=restitution,
+            restitution=restitution, locate_impacts=bool(locate_impacts),
         )
         return Trajectory._from_core(raw, scene=self, h=h, solver=solver,
                                      gap_tolerance=gap_tolerance)

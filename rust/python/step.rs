@@ -139,7 +139,7 @@ fn matrix<'py, T: numpy::Element>(
 #[pyfunction]
 #[pyo3(signature = (scene, h, steps, solver="nsgs", tol=1e-12, max_iter=None, relaxation=1.0,
                     facets=None, gap_tolerance=1e-9, warm_start=true, fallback=true,
-                    drift="none", drift_bias=0.2, restitution="newton"))]
+                    drift="none", drift_bias=0.2, restitution="newton", locate_impacts=false))]
 #[allow(clippy::too_many_arguments)]
 pub(super) fn step_simulate<'py>(
     py: Python<'py>,
@@ -157,6 +157,7 @@ pub(super) fn step_simulate<'py>(
     drift: &str,
     drift_bias: f64,
     restitution: &str,
+    locate_impacts: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let scene = scene_from_dict(scene)?;
     let solver = match solver {
@@ -220,6 +221,7 @@ pub(super) fn step_simulate<'py>(
         fallback,
         drift,
         restitution,
+        locate_impacts,
     };
     let (tr, seconds) = guarded(py, usize::MAX, || {
         let start = std::time::Instant::now();

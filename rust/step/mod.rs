@@ -460,6 +460,12 @@ pub struct StepSettings {
     pub drift: Drift,
     /// the impact law at closed contacts.
     pub restitution: Restitution,
+    /// locate isolated impacts within the step: when every active contact is open and one
+    /// reaches zero gap first, the step follows the free path to that instant, applies the
+    /// impact law there and finishes the step from it (exact rebound timing; with e = 1
+    /// under gravity the apex energy is kept bounce after bounce, where the plain step loses
+    /// `m g y_k` per bounce). Steps whose impact is not isolated are plain steps.
+    pub locate_impacts: bool,
 }
 
 impl StepSettings {
@@ -477,6 +483,7 @@ impl StepSettings {
             fallback: true,
             drift: Drift::None,
             restitution: Restitution::Newton,
+            locate_impacts: false,
         }
     }
 

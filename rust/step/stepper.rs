@@ -5,6 +5,8 @@
 
 #[path = "drift.rs"]
 mod drift;
+#[path = "event.rs"]
+mod event;
 
 use super::broad::BroadPhase;
 use super::impact::ImpactMemory;
@@ -290,6 +292,9 @@ pub struct Stepper {
     solve: SolveBuffers,
     gp: Vec<f64>,
     v_next: Vec<f64>,
+    /// `(q_k, v_k)` while a located step follows its path (module `event`).
+    saved_q: Vec<f64>,
+    saved_v: Vec<f64>,
 }
 
 fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
@@ -545,6 +550,8 @@ impl Stepper {
             v_free: vec![0.0; off_v],
             gp: vec![0.0; off_v],
             v_next: vec![0.0; off_v],
+            saved_q: vec![0.0; off_q],
+            saved_v: vec![0.0; off_v],
             q,
             v,
             step_index: 0,
@@ -881,6 +888,23 @@ impl Stepper {
         }
     }
 
+    /// the record of a step with `active` contacts before its solve.
+    fn blank_record(active: usize) -> StepRecord {
+        StepRecord {
+            active,
+            status: None,
+            error: 0.0,
+            iterations: 0,
+            momentum_residual: 0.0,
+            min_normal_impulse: 0.0,
+            cone_violation: 0.0,
+            complementarity: 0.0,
+            resumed: false,
+            fallback: false,
+            projection: 0.0,
+        }
+    }
+
     /// The seed's "One impulse-based time step", from `(t_k, q_k, v_k)` to
     /// `(t_{k+1}, q_{k+1}, v_{k+1})`; appends the active contacts to `contacts` and returns the
     /// step's checks. Errors only for settings the contact solver refuses.
@@ -942,21 +966,15 @@ impl Stepper {
             self.active.push(act);
         }
 
+        if self.settings.locate_impacts {
+            if let Some(record) = self.located_step(contacts)? {
+                return Ok(record);
+            }
+        }
+
         let nc = self.active.len();
         let n = nc * dim;
-        let mut record = StepRecord {
-            active: nc,
-            status: None,
-            error: 0.0,
-            iterations: 0,
-            momentum_residual: 0.0,
-            min_normal_impulse: 0.0,
-            cone_violation: 0.0,
-            complementarity: 0.0,
-            resumed: false,
-            fallback: false,
-            projection: 0.0,
-        };
+        let mut record = Self::blank_record(nc);
         self.gp.fill(0.0);
         let mut v_next = std::mem::take(&mut self.v_next);
         v_next.copy_from_slice(&self.v_free);

@@ -1,0 +1,357 @@
+//! The event-located impact of [`StepSettings::locate_impacts`](super::super::StepSettings):
+//! for an isolated impact, the impact instant is found within the step, the impact law applied
+//! there, and the step finished from it.
+//!
+//! Between impacts the stepper's update `v_{k+1} = v_k + h a`, `q_{k+1} = q_k + h v_{k+1}` (a
+//! the step's free acceleration, `a = (v_free - v_k) / h`) puts its positions exactly on the
+//! parabola
+//!
+//! ```text
+//!     q(s) = q_k + s (v_k + a h / 2) + a s^2 / 2,     s in [0, h],
+//! ```
+//!
+//! whose velocity `q'(s)` is the state velocity shifted by `a h / 2` (for a rotation, the same
+//! in the rotation vector applied to `q_k`). A located step follows that path to the first
+//! instant `s*` where a contact's true gap vanishes (sampled, then bisected), applies the
+//! impact law there to `q'(s*)` with M and the Jacobians at `q(s*)` (Newton's law by the
+//! contact solver, or Poisson's by Routh's method), continues the parabola with the
+//! post-impact velocity to `t_{k+1}`, and takes the state velocity back by `-a h / 2`. The
+//! discrete trajectory after the impact is then exactly the one a flight from the impact would
+//! give: with e = 1 under gravity the apex energy of the parabola (the conserved
+//! `T + V + (h / 2) f . v` of the stepper's flight) is kept to rounding bounce after bounce,
+//! where the plain step loses `m g y_k` per bounce.
+//!
+//! Isolated means: every active contact of the step is open (none closed, none owed a
+//! rebound), a single contact reaches zero gap first, and at the end of the step no active
+//! contact penetrates beyond the gap tolerance (a second impact in the same step, or a
+//! contact that stays closed, as after an inelastic impact under gravity). Otherwise the step
+//! is the plain one.
+
+use super::{frame, rotate, BodyKind, ContactRecord, Restitution, StepRecord, Stepper};
+use crate::contact::{solve_nsgs, ContactProblem, NsgsSettings};
+use crate::error::Result;
+
+/// samples of the path per step before bisection.
+const SAMPLES: usize = 16;
+
+/// bisection steps on the impact instant (to rounding of h).
+const BISECTIONS: usize = 64;
+
+/// the impact of a located step: contact, instant, impulse and velocities.
+struct Hit {
+    /// index into the step's active contacts.
+    active: usize,
+    /// the impulse, contact frame.
+    impulse: [f64; 3],
+    /// the approach normal velocity.
+    approach: f64,
+    /// the contact velocity after the impact.
+    velocity: [f64; 3],
+    error: f64,
+    iterations: usize,
+    residual: f64,
+}
+
+impl Stepper {
+    /// the free acceleration of velocity component i over the step.
+    fn acceleration(&self, i: usize) -> f64 {
+        (self.v_free[i] - self.saved_v[i]) / self.settings.h
+    }
+
+    /// puts the positions at `q(s)` and the velocities at `q'(s)` on the step's free path
+    /// (module docs), bodies frozen there.
+    fn follow(&mut self, s: f64) {
+        let h = self.settings.h;
+        for bi in 0..self.bodies.len() {
+            let b = &self.bodies[bi];
+            let (oq, ov, nv, kind) = (b.off_q, b.off_v, b.nv, b.kind);
+            let mut d = [0.0; 6];
+            for k in 0..nv {
+                let a = self.acceleration(ov + k);
+                let v0 = self.saved_v[ov + k] + 0.5 * a * h;
+                d[k] = s * v0 + 0.5 * a * s * s;
+                self.v[ov + k] = v0 + a * s;
+            }
+            let q0 = &self.saved_q[oq..oq + kind.nq(self.dim)];
+            let q = &mut self.q[oq..oq + kind.nq(self.dim)];
+            q.copy_from_slice(q0);
+            match kind {
+                BodyKind::Particle | BodyKind::Planar => {
+                    for k in 0..nv {
+                        q[k] += d[k];
+                    }
+                }
+                BodyKind::Spatial => {
+                    for k in 0..3 {
+                        q[k] += d[k];
+                    }
+                    rotate(&mut q[3..7], [d[3], d[4], d[5]]);
+                }
+            }
+        }
+        self.freeze();
+    }
+
+    /// the smallest true gap over the step's active contacts at the current q, and which.
+    fn closest(&self) -> (f64, usize) {
+        let mut best = (f64::INFINITY, 0);
+        for (i, a) in self.active.iter().enumerate() {
+            let g = self.geometry(a.cand).gap;
+            if g < best.0 {
+                best = (g, i);
+            }
+        }
+        best
+    }
+
+    /// The located step (module docs): `Ok(None)`, with the state untouched, when the step's
+    /// impact is not isolated or there is none.
+    pub(super) fn located_step(
+        &mut self,
+        contacts: &mut Vec<ContactRecord>,
+    ) -> Result<Option<StepRecord>> {
+        let h = self.settings.h;
+        let tol_gap = self.settings.gap_tolerance;
+        if self.active.is_empty() || self.active.iter().any(|a| a.closed) {
+            return Ok(None);
+        }
+        self.saved_q.copy_from_slice(&self.q);
+        self.saved_v.copy_from_slice(&self.v);
+        let Some(s_star) = self.impact_instant() else {
+            self.restore();
+            return Ok(None);
+        };
+        self.follow(s_star);
+        let (_, which) = self.closest();
+        // isolated: every other active contact still open at the instant
+        let others_open = self
+            .active
+            .iter()
+            .enumerate()
+            .all(|(i, a)| i == which || self.geometry(a.cand).gap > tol_gap);
+        if !others_open {
+            self.restore();
+            return Ok(None);
+        }
+        let hit = self.impact_at(which)?;
+        // the rest of the step from the post-impact velocity
+        let rest = h - s_star;
+        for bi in 0..self.bodies.len() {
+            let b = &self.bodies[bi];
+            let (oq, ov, nv, kind) = (b.off_q, b.off_v, b.nv, b.kind);
+            let mut d = [0.0; 6];
+            for k in 0..nv {
+                let a = self.acceleration(ov + k);
+                d[k] = rest * self.v[ov + k] + 0.5 * a * rest * rest;
+                self.v[ov + k] += a * rest - 0.5 * a * h;
+            }
+            let q = &mut self.q[oq..oq + kind.nq(self.dim)];
+            match kind {
+                BodyKind::Particle | BodyKind::Planar => {
+                    for k in 0..nv {
+                        q[k] += d[k];
+                    }
+                }
+                BodyKind::Spatial => {
+                    for k in 0..3 {
+                        q[k] += d[k];
+                    }
+                    rotate(&mut q[3..7], [d[3], d[4], d[5]]);
+                }
+            }
+        }
+        self.freeze();
+        let penetrates = self.closest().0 < -tol_gap;
+        let finite = self.q.iter().chain(&self.v).all(|x| x.is_finite());
+        if penetrates || !finite {
+            self.restore();
+            return Ok(None);
+        }
+        Ok(Some(self.finish_located(hit, contacts)))
+    }
+
+    /// back to `(q_k, v_k)`, bodies frozen there.
+    fn restore(&mut self) {
+        self.q.copy_from_slice(&self.saved_q);
+        self.v.copy_from_slice(&self.saved_v);
+        self.freeze();
+    }
+
+    /// the first instant in `(0, h]` at which an active contact's true gap vanishes on the
+    /// free path, to rounding; `None` when no gap vanishes within the step.
+    fn impact_instant(&mut self) -> Option<f64> {
+        let h = self.settings.h;
+        let mut lo = 0.0;
+        let mut hi = None;
+        for j in 1..=SAMPLES {
+            let s = h * j as f64 / SAMPLES as f64;
+            self.follow(s);
+            if self.closest().0 <= 0.0 {
+                hi = Some(s);
+                break;
+            }
+            lo = s;
+        }
+        let mut hi = hi?;
+        for _ in 0..BISECTIONS {
+            let mid = 0.5 * (lo + hi);
+            if mid <= lo || mid >= hi {
+                break;
+            }
+            self.follow(mid);
+            if self.closest().0 <= 0.0 {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        Some(hi)
+    }
+
+    /// applies the impact law to active contact `which` at the current state (the path at
+    /// the impact instant): velocities updated, the impulse returned.
+    fn impact_at(&mut self, which: usize) -> Result<Hit> {
+        let dim = self.dim;
+        let cand = self.candidates[self.active[which].cand];
+        let geo = self.geometry(self.active[which].cand);
+        let fr = frame(dim, geo.normal);
+        // columns of G and M^{-1} G per side
+        let mut cols = [[[0.0; 6]; 3]; 2];
+        let mut bcols = [[[0.0; 6]; 3]; 2];
+        for s in 0..geo.nsides {
+            let (body, sign, r) = geo.sides[s];
+            let minv = &self.frozen[body].minv;
+            for (j, d) in fr.iter().enumerate().take(dim) {
+                let mut col = self.column(body, r, *d);
+                for x in &mut col {
+                    *x *= sign;
+                }
+                cols[s][j] = col;
+                bcols[s][j] =
+                    std::array::from_fn(|a| (0..6).map(|c| minv[a * 6 + c] * col[c]).sum());
+            }
+        }
+        let side_dot = |s: usize, x: &[f64; 6], v: &[f64]| -> f64 {
+            let b = &self.bodies[geo.sides[s].0];
+            (0..b.nv).map(|k| x[k] * v[b.off_v + k]).sum()
+        };
+        let mut w = [0.0; 9];
+        let mut u = [0.0; 3];
+        for s in 0..geo.nsides {
+            for a in 0..dim {
+                u[a] += side_dot(s, &cols[s][a], &self.v);
+                for c in 0..dim {
+                    w[a * dim + c] += (0..6).map(|k| cols[s][a][k] * bcols[s][c][k]).sum::<f64>();
+                }
+            }
+        }
+        let approach = u[0].min(0.0);
+        let (impulse, error, iterations) = match self.settings.restitution {
+            Restitution::Poisson => {
+                let mut w3 = [[0.0; 3]; 3];
+                for a in 0..dim {
+                    for c in 0..dim {
+                        w3[a][c] = w[a * dim + c];
+                    }
+                }
+                let p = super::routh(dim, &w3, u, cand.mu, cand.e, 0.0);
+                (p, 0.0, 0)
+            }
+            Restitution::Newton => {
+                let mut q = u;
+                q[0] += cand.e * approach;
+                let mu = [cand.mu];
+                let problem = ContactProblem::new(dim, &w[..dim * dim], &q[..dim], &mu)?;
+                let settings = NsgsSettings {
+                    tol: 1e-14,
+                    max_iter: 100,
+                    ..NsgsSettings::default()
+                };
+                let sol = solve_nsgs(&problem, &settings)?;
+                let mut p = [0.0; 3];
+                p[..dim].copy_from_slice(&sol.impulse);
+                (p, sol.measures.error, sol.iterations)
+            }
+        };
+        // v+ = q'(s*) + M^{-1} G P, and the momentum balance M dv = G P at q(s*)
+        let mut residual: f64 = 0.0;
+        let mut scale: f64 = 0.0;
+        for s in 0..geo.nsides {
+            let body = geo.sides[s].0;
+            let b = &self.bodies[body];
+            let mut dv = [0.0; 6];
+            let mut gp = [0.0; 6];
+            for k in 0..b.nv {
+                for j in 0..dim {
+                    dv[k] += bcols[s][j][k] * impulse[j];
+                    gp[k] += cols[s][j][k] * impulse[j];
+                }
+                self.v[b.off_v + k] += dv[k];
+            }
+            let m = &self.frozen[body].m;
+            for k in 0..b.nv {
+                let mdv: f64 = (0..b.nv).map(|c| m[k * 6 + c] * dv[c]).sum();
+                residual = residual.max((mdv - gp[k]).abs());
+                scale = scale.max(gp[k].abs());
+            }
+        }
+        let mut velocity = [0.0; 3];
+        for s in 0..geo.nsides {
+            for (a, va) in velocity.iter_mut().enumerate().take(dim) {
+                *va += side_dot(s, &cols[s][a], &self.v);
+            }
+        }
+        Ok(Hit {
+            active: which,
+            impulse,
+            approach,
+            velocity,
+            error,
+            iterations,
+            residual: if scale > 0.0 {
+                residual / scale
+            } else {
+                residual
+            },
+        })
+    }
+
+    /// the records of a located step, the contacts' states, and the clock.
+    fn finish_located(&mut self, hit: Hit, contacts: &mut Vec<ContactRecord>) -> StepRecord {
+        let dim = self.dim;
+        let a = self.active[hit.active];
+        let cand = self.candidates[a.cand];
+        for act in &self.active {
+            let st = &mut self.state[act.cand];
+            st.impact = Default::default();
+            st.warm = [0.0; 3];
+            st.basis = 0;
+        }
+        self.state[a.cand].warm[..dim].copy_from_slice(&hit.impulse[..dim]);
+        contacts.push(ContactRecord {
+            step: self.step_index,
+            id: cand.id,
+            impulse: hit.impulse,
+            velocity: hit.velocity,
+            approach: hit.approach,
+            gap: a.gap,
+            closed: true,
+        });
+        let pt = (hit.impulse[1] * hit.impulse[1] + hit.impulse[2] * hit.impulse[2]).sqrt();
+        let bound = match self.settings.restitution {
+            Restitution::Newton => hit.velocity[0] + cand.e * hit.approach,
+            Restitution::Poisson => 0.0,
+        };
+        let mut record = Self::blank_record(1);
+        record.status = Some(crate::contact::ContactStatus::Solved);
+        record.error = hit.error;
+        record.iterations = hit.iterations;
+        record.momentum_residual = hit.residual;
+        record.min_normal_impulse = hit.impulse[0];
+        record.cone_violation = (pt - cand.mu * hit.impulse[0]).max(0.0);
+        record.complementarity = (hit.impulse[0] * bound).abs();
+        self.step_index += 1;
+        self.t = self.step_index as f64 * self.settings.h;
+        record
+    }
+}
