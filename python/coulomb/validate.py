@@ -136,19 +136,27 @@ def run(data: Path | None = None, progress: Callable[[str], None] | None = None)
 
 
 def _fmt(v: float | str) -> str:
-    return f"{v:.6g}" if isinstance(v, float) else str(v)
+    """Six significant digits; exact zeros as ``0`` (a signed zero as ``0`` too)."""
+    if isinstance(v, float):
+        return "0" if v == 0.0 else f"{v:.6g}"
+    return str(v)
+
+
+def _fmt_tol(tol: float | None) -> str:
+    return "exact" if tol in (None, 0.0) else f"{tol:.0e}"
 
 
 def format_table(rows: list[Row]) -> str:
-    """A plain-text table of the rows."""
-    head = ("case", "quantity", "seed", "coulomb", "tolerance", "")
+    """A plain-text table of the rows: the expected value (from the literature, or the
+    closed form), coulomb's, the tolerance and whether it is met."""
+    head = ("case", "quantity", "expected", "coulomb", "tolerance", "result")
     body = [
         (
             r.case,
             r.quantity,
             _fmt(r.expected),
             _fmt(r.computed),
-            "exact" if r.tolerance in (None, 0.0) else f"{r.tolerance:.0e}",
+            _fmt_tol(r.tolerance),
             "ok" if r.passed else "FAIL",
         )
         for r in rows
