@@ -60,9 +60,9 @@ def siconos_lcp_dir() -> Path:
 
 
 def pytest_collection_finish(session: pytest.Session) -> None:
-    """A run that collects no test is an error, not a pass (pytest would exit with 5 anyway;
-    this says why in the output)."""
+    """A run with no test to run is an error, never a quiet pass: it says why."""
     if not session.items and not session.testsfailed and not session.config.option.collectonly:
         raise pytest.UsageError(
-            "no tests collected: run pytest from the repository root (testpaths = tests/python)"
+            "no test to run (none collected, or every one deselected by -k/-m): run pytest "
+            "from the repository root, where pyproject.toml sets testpaths = tests/python"
         )
