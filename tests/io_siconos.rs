@@ -2,8 +2,8 @@
 //!
 //! The LCP set and the friction-contact files of at most 200 kB ship in `tests/data/`: the
 //! tests over them always run. The tests over the whole friction-contact set (54 files, in
-//! `$COULOMB_DATA` or `../shared/data`) are `#[ignore]`d with the reason and fail loudly when
-//! run without it (`cargo test -- --include-ignored`, as CI does).
+//! `$COULOMB_DATA` or `../shared/data`) run when the build script found that data, and are
+//! otherwise `#[ignore]`d with the reason (they fail loudly if forced to run without it).
 
 mod common;
 
@@ -747,7 +747,10 @@ fn shipped_fc_files_read_with_the_documented_shapes() {
 }
 
 #[test]
-#[ignore = "needs the full benchmark data (../shared/data or $COULOMB_DATA); run with `cargo test -- --include-ignored`"]
+#[cfg_attr(
+    not(coulomb_full_data),
+    ignore = "needs the full benchmark data ($COULOMB_DATA or ../shared/data, found when the crate is built)"
+)]
 fn every_fc_file_reads_with_the_documented_shapes() {
     let (dir, rows) = full_fc();
     fc_files_read_with_the_documented_shapes(&dir, &rows);
@@ -801,7 +804,10 @@ fn fc_kind_is_decided_by_content_not_by_name() {
 }
 
 #[test]
-#[ignore = "needs the full benchmark data (../shared/data or $COULOMB_DATA); run with `cargo test -- --include-ignored`"]
+#[cfg_attr(
+    not(coulomb_full_data),
+    ignore = "needs the full benchmark data ($COULOMB_DATA or ../shared/data, found when the crate is built)"
+)]
 fn fc_kind_is_decided_by_content_not_by_name_on_the_full_set() {
     let (dir, rows) = full_fc();
     fc_kind_by_content(&dir, &rows);
@@ -860,7 +866,10 @@ fn local_delassus_matrices_are_symmetric() {
 }
 
 #[test]
-#[ignore = "needs the full benchmark data (../shared/data or $COULOMB_DATA); run with `cargo test -- --include-ignored`"]
+#[cfg_attr(
+    not(coulomb_full_data),
+    ignore = "needs the full benchmark data ($COULOMB_DATA or ../shared/data, found when the crate is built)"
+)]
 fn local_delassus_matrices_are_symmetric_on_the_full_set() {
     let (dir, rows) = full_fc();
     check_local_symmetry(&dir, &rows);
@@ -901,7 +910,10 @@ fn sparse_dump_delassus_matrices_are_symmetric_to_print_precision() {
 }
 
 #[test]
-#[ignore = "needs the full benchmark data (../shared/data or $COULOMB_DATA); run with `cargo test -- --include-ignored`"]
+#[cfg_attr(
+    not(coulomb_full_data),
+    ignore = "needs the full benchmark data ($COULOMB_DATA or ../shared/data, found when the crate is built)"
+)]
 fn sparse_dump_delassus_matrices_are_symmetric_to_print_precision_on_the_full_set() {
     let (dir, rows) = full_fc();
     check_sparse_dump_symmetry(&dir, &rows);
@@ -939,7 +951,10 @@ fn global_mass_matrices_are_symmetric() {
 }
 
 #[test]
-#[ignore = "needs the full benchmark data (../shared/data or $COULOMB_DATA); run with `cargo test -- --include-ignored`"]
+#[cfg_attr(
+    not(coulomb_full_data),
+    ignore = "needs the full benchmark data ($COULOMB_DATA or ../shared/data, found when the crate is built)"
+)]
 fn global_mass_matrices_are_symmetric_on_the_full_set() {
     let (dir, rows) = full_fc();
     check_global_mass_symmetry(&dir, &rows);

@@ -156,7 +156,10 @@ fn problems_where_nsgs_stalls_are_solved_at_1e_8() {
 /// is singular up to that rounding and indefinite (min eigenvalue -3.9e-3 against 1.7e4):
 /// Newton stalls at error_q ~3.5e-7 and the 2D LCP finish (Lemke on a working set) solves it.
 #[test]
-#[ignore = "needs the full benchmark data (../shared/data or $COULOMB_DATA); run with `cargo test -- --include-ignored`"]
+#[cfg_attr(
+    not(coulomb_full_data),
+    ignore = "needs the full benchmark data ($COULOMB_DATA or ../shared/data, found when the crate is built)"
+)]
 fn the_indefinite_2d_granular_flow_is_finished_by_its_lcp() {
     let name = "fc2d_granularflowonwall_02020_00213.dat";
     let (dim, w, q, mu) = local(&data::full_set_dir("siconos-fc").join(name), name);

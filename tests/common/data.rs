@@ -2,10 +2,10 @@
 //! sets in `$COULOMB_DATA` or `../shared/data` beside the checkout.
 //!
 //! A test never passes without its data. Tests that read shipped files always run and fail
-//! loudly if a file is missing. Tests that need a full set that does not ship are marked
-//! `#[ignore = "needs the full benchmark data ..."]` (so `cargo test` lists them as ignored,
-//! with the reason) and fail loudly when run (`cargo test -- --include-ignored`, as CI does)
-//! without the data.
+//! loudly if a file is missing. Tests that need a full set that does not ship run when the build
+//! script (`build.rs`) found that set when the crate was built (as in CI); otherwise they are
+//! compiled as `#[ignore]`d with the reason, so `cargo test` lists them as ignored, and they
+//! fail loudly if forced to run (`cargo test -- --include-ignored`) without the data.
 
 use std::path::{Path, PathBuf};
 
