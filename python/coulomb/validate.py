@@ -86,11 +86,15 @@ def _stepper_rows() -> Iterator[Row]:
 
 
 def default_data_dir() -> Path | None:
-    """``$COULOMB_DATA``, else ``../shared/data`` beside a source checkout, if present."""
+    """``$COULOMB_DATA``, else ``../shared/data`` beside a source checkout, else the sets
+    shipped in the checkout's ``tests/data``, if present."""
     env = os.environ.get("COULOMB_DATA")
     candidates = [Path(env)] if env else []
+    checkout = Path(__file__).resolve().parents[2]
     candidates.append(Path.cwd().parent / "shared" / "data")
-    candidates.append(Path(__file__).resolve().parents[3] / "shared" / "data")
+    candidates.append(checkout.parent / "shared" / "data")
+    candidates.append(Path.cwd() / "tests" / "data")
+    candidates.append(checkout / "tests" / "data")
     for c in candidates:
         if (c / "siconos-lcp").is_dir():
             return c
@@ -131,7 +135,9 @@ def run(data: Path | None = None, progress: Callable[[str], None] | None = None)
             progress(f"benchmark data: {data}")
         rows.extend(_data_rows(data))
     elif progress:
-        progress("benchmark data not found (set COULOMB_DATA): seed rows only")
+        progress(
+            "benchmark data not found (set COULOMB_DATA): the chapter's worked examples only"
+        )
     return rows
 
 
