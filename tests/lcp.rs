@@ -1,8 +1,9 @@
 //! Integration tests of the LCP solvers: the seed's figures, the Siconos set, oracles
 //! (enumeration, planted solutions, Murty's pivot count) and invariance under scaling.
 
-use std::path::PathBuf;
+mod common;
 
+use common::data;
 use coulomb::io::siconos::read_siconos_lcp;
 use coulomb::lcp::{
     solve_enumerate, solve_lemke, solve_pgs, EnumerateSettings, LcpRef, LcpSolution, LcpStatus,
@@ -10,18 +11,6 @@ use coulomb::lcp::{
 };
 use coulomb::testing::{dense_spd, max_rel_diff, murty, p_matrix, planted_psd, SplitMix64};
 use coulomb::DenseMatrix;
-
-fn data_dir() -> Option<PathBuf> {
-    let dir = std::env::var_os("COULOMB_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data"));
-    if dir.join("siconos-lcp").is_dir() {
-        Some(dir)
-    } else {
-        println!("skipped: ../shared/data not found (set COULOMB_DATA)");
-        None
-    }
-}
 
 fn lemke(m: &DenseMatrix, q: &[f64]) -> LcpSolution {
     let lcp = LcpRef::from_dense(m, q).expect("well-formed test problem");
@@ -55,8 +44,7 @@ fn seed_scalar_problems() {
 /// report success.
 #[test]
 fn siconos_lcp_set() {
-    let Some(dir) = data_dir() else { return };
-    let mut paths: Vec<_> = std::fs::read_dir(dir.join("siconos-lcp"))
+    let mut paths: Vec<_> = std::fs::read_dir(data::shipped_dir("siconos-lcp"))
         .expect("readable data folder")
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.extension().is_some_and(|x| x == "dat"))
@@ -94,8 +82,7 @@ fn siconos_lcp_set() {
 /// whatever covering vectors are tried, the result must never claim success falsely.
 #[test]
 fn cps3_reports_its_ray_honestly() {
-    let Some(dir) = data_dir() else { return };
-    let prob = read_siconos_lcp(&dir.join("siconos-lcp/lcp_CPS_3.dat")).expect("readable");
+    let prob = read_siconos_lcp(&data::file("siconos-lcp", "lcp_CPS_3.dat")).expect("readable");
     assert!(enumerate(&prob.m, &prob.q).success());
     let s = lemke(&prob.m, &prob.q);
     if s.success() {
@@ -123,18 +110,18 @@ fn murty_takes_two_to_the_n_pivots() {
         assert!(s.success(), "n = {n}: {}", s.message);
         assert_eq!(s.pivots, 1 << n, "n = {n}");
     }
-    if let Some(dir) = data_dir() {
-        let prob = read_siconos_lcp(&dir.join("siconos-lcp/lcp_exp_murty2.dat")).expect("readable");
-        let s = lemke_with(
-            &prob.m,
-            &prob.q,
-            &LemkeSettings {
-                covering_vector: Some(vec![1.0; 6]),
-                ..Default::default()
-            },
-        );
-        assert_eq!(s.pivots, 64);
-    }
+    // the same example as a Siconos file (n = 6)
+    let prob =
+        read_siconos_lcp(&data::file("siconos-lcp", "lcp_exp_murty2.dat")).expect("readable");
+    let s = lemke_with(
+        &prob.m,
+        &prob.q,
+        &LemkeSettings {
+            covering_vector: Some(vec![1.0; 6]),
+            ..Default::default()
+        },
+    );
+    assert_eq!(s.pivots, 64);
 }
 
 /// For P-matrices the solution is unique: Lemke's equals enumeration's.

@@ -3,8 +3,9 @@
 //! answers that pass on the original data, including the product form's fold of a long eta
 //! file into an explicit inverse and its refinement step.
 
-use std::path::PathBuf;
+mod common;
 
+use common::data;
 use coulomb::io::siconos::read_siconos_lcp;
 use coulomb::lcp::{solve_lemke, LcpRef, LcpSolution, LemkeEngine, LemkeSettings};
 use coulomb::testing::{dense_spd, max_rel_diff, murty, planted_psd};
@@ -82,23 +83,15 @@ fn auto_engine_solves_planted_degenerate_problems() {
 /// reports as a ray is not claimed solved.
 #[test]
 fn auto_engine_agrees_with_the_tableau_on_the_siconos_set() {
-    let dir = std::env::var_os("COULOMB_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data"));
-    let dir = dir.join("siconos-lcp");
-    let Ok(entries) = std::fs::read_dir(&dir) else {
-        println!("skipped: {} not found (set COULOMB_DATA)", dir.display());
-        return;
-    };
+    let dir = data::shipped_dir("siconos-lcp");
+    let entries = std::fs::read_dir(&dir).expect("readable data folder");
     let mut seen = 0;
     for entry in entries.flatten() {
         let path = entry.path();
         if path.extension().and_then(|e| e.to_str()) != Some("dat") {
             continue;
         }
-        let Ok(p) = read_siconos_lcp(&path) else {
-            continue;
-        };
+        let p = read_siconos_lcp(&path).unwrap_or_else(|e| panic!("{e}"));
         let t = run(&p.m, &p.q, LemkeEngine::Tableau);
         let a = run(&p.m, &p.q, LemkeEngine::Auto);
         assert_eq!(
@@ -119,5 +112,5 @@ fn auto_engine_agrees_with_the_tableau_on_the_siconos_set() {
         }
         seen += 1;
     }
-    assert!(seen >= 15, "only {seen} Siconos LCP files read");
+    assert!(seen == 20, "only {seen} Siconos LCP files read");
 }

@@ -4,13 +4,14 @@
 
 mod common;
 
+use common::data;
 use coulomb::contact::prox::{solve_prox, ProxSettings};
 use coulomb::contact::{
     measure, solve_nsgs, BlockCsr, ContactProblem, ContactStatus, NsgsSettings,
 };
 use coulomb::io::siconos::{read_siconos_fc, SiconosFcFile};
 use coulomb::testing::SplitMix64;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 fn settings(tol: f64) -> ProxSettings {
     ProxSettings {
@@ -97,24 +98,8 @@ fn random_rank_deficient_problems_are_solved() {
     }
 }
 
-fn data_root() -> Option<PathBuf> {
-    let root = match std::env::var_os("COULOMB_DATA") {
-        Some(dir) => PathBuf::from(dir),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data"),
-    };
-    if root.join("siconos-fc").is_dir() {
-        Some(root)
-    } else {
-        println!(
-            "skipped: ../shared/data/siconos-fc not found (set COULOMB_DATA); looked in {}",
-            root.display()
-        );
-        None
-    }
-}
-
-fn local(root: &Path, name: &str) -> (usize, Vec<f64>, Vec<f64>, Vec<f64>) {
-    match read_siconos_fc(&root.join("siconos-fc").join(name)) {
+fn local(path: &Path, name: &str) -> (usize, Vec<f64>, Vec<f64>, Vec<f64>) {
+    match read_siconos_fc(path) {
         Ok(SiconosFcFile::Local(p)) => (p.dim, p.w.to_dense().data, p.q, p.mu),
         Ok(SiconosFcFile::Global(_)) => panic!("{name} is a global problem"),
         Err(e) => panic!("{name}: {e}"),
@@ -123,13 +108,12 @@ fn local(root: &Path, name: &str) -> (usize, Vec<f64>, Vec<f64>, Vec<f64>) {
 
 #[test]
 fn problems_where_nsgs_stalls_are_solved_at_1e_8() {
-    let Some(root) = data_root() else { return };
     for name in [
         "BoxesStack1-i100000-32.hdf5.dat",
         "OneObject-i100000-316.hdf5.dat",
         "OneObject-i100000-499.hdf5.dat",
     ] {
-        let (dim, w, q, mu) = local(&root, name);
+        let (dim, w, q, mu) = local(&data::file("siconos-fc", name), name);
         let p = ContactProblem::new(dim, &w, &q, &mu).unwrap();
         let s = solve_prox(&p, &settings(1e-8)).unwrap();
         assert!(s.success(), "{name}: {}", s.message);
@@ -172,9 +156,13 @@ fn problems_where_nsgs_stalls_are_solved_at_1e_8() {
 /// is singular up to that rounding and indefinite (min eigenvalue -3.9e-3 against 1.7e4):
 /// Newton stalls at error_q ~3.5e-7 and the 2D LCP finish (Lemke on a working set) solves it.
 #[test]
+#[cfg_attr(
+    not(coulomb_full_data),
+    ignore = "needs the full benchmark data ($COULOMB_DATA or ../shared/data, found when the crate is built)"
+)]
 fn the_indefinite_2d_granular_flow_is_finished_by_its_lcp() {
-    let Some(root) = data_root() else { return };
-    let (dim, w, q, mu) = local(&root, "fc2d_granularflowonwall_02020_00213.dat");
+    let name = "fc2d_granularflowonwall_02020_00213.dat";
+    let (dim, w, q, mu) = local(&data::full_set_dir("siconos-fc").join(name), name);
     assert_eq!((dim, mu.len()), (2, 2020));
     let n = dim * mu.len();
     let blocks = BlockCsr::from_dense(dim, n, &w).unwrap();

@@ -9,6 +9,7 @@ from dataclasses import asdict
 from pathlib import Path
 
 from . import __version__
+from ._extras import MissingExtraError, require
 from .errors import CoulombError
 
 
@@ -44,6 +45,16 @@ def _study(args: argparse.Namespace) -> int:
     if args.name is None:
         print("coulomb study: give a study name (see --list)", file=sys.stderr)
         return 2
+    if args.name not in study.PRESETS:
+        print(
+            f"coulomb study: unknown study {args.name!r} (see --list: {', '.join(study.PRESETS)})",
+            file=sys.stderr,
+        )
+        return 2
+    # optional dependencies first: say what is missing before any work
+    study.require_preset(args.name)
+    if args.plot:
+        require("matplotlib", extra="plot", what="coulomb study --plot")
     executor = None
     if args.processes > 1:
         from concurrent.futures import ProcessPoolExecutor
@@ -106,7 +117,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         return int(args.func(args))
-    except (OSError, CoulombError) as exc:
+    except (OSError, CoulombError, MissingExtraError) as exc:
         print(f"coulomb {args.command}: error: {exc}", file=sys.stderr)
         return 2
 

@@ -26,6 +26,7 @@ import time
 
 import numpy as np
 
+from ._extras import require
 from ._result import Result
 from .errors import InvalidParameterError, NonFiniteError
 
@@ -110,7 +111,9 @@ def simulate_ramp(
 
     ``method`` is a :func:`scipy.integrate.solve_ivp` method; the stiff ones (``"Radau"``,
     ``"BDF"``, ``"LSODA"``) get the analytic Jacobian. ``t_eval`` defaults to 1001 points.
+    Needs scipy (the ``ode`` extra).
     """
+    require("scipy.integrate", extra="ode", what="coulomb.regularized.simulate_ramp")
     from scipy.integrate import solve_ivp
 
     theta = _check("theta", theta)

@@ -32,6 +32,7 @@ from typing import Any
 
 import numpy as np
 
+from ._extras import require
 from .errors import InvalidParameterError
 
 __all__ = [
@@ -215,7 +216,9 @@ class Study:
     def plot(
         self, x: str = "time", y: str = "error", ax: Any = None, path: str | Path | None = None
     ):
-        """Error against cost on log axes, the Pareto front joined (needs matplotlib)."""
+        """Error against cost on log axes, the Pareto front joined (needs matplotlib, the
+        ``plot`` extra)."""
+        require("matplotlib", extra="plot", what="Study.plot")
         import matplotlib
 
         if ax is None and path is not None:
@@ -572,8 +575,17 @@ PRESETS: dict[str, dict[str, Any]] = {
         "order": "eps",
         "order_where": {"method": "Radau"},
         "about": "tanh-smoothed friction on the seed's ramp: creep against eps, ODE cost",
+        # (module, extra): checked before the study starts
+        "needs": [("scipy.integrate", "ode")],
     },
 }
+
+
+def require_preset(name: str) -> None:
+    """Raises :class:`coulomb._extras.MissingExtraError` (an ImportError naming the extra) if
+    an optional dependency of the named study is not installed."""
+    for module, extra in PRESETS[name].get("needs", ()):
+        require(module, extra=extra, what=f"the study {name!r}")
 
 
 def run_preset(
@@ -582,6 +594,7 @@ def run_preset(
     """Runs the named study of :data:`PRESETS`."""
     if name not in PRESETS:
         raise InvalidParameterError(f"unknown study {name!r}: expected one of {sorted(PRESETS)}")
+    require_preset(name)
     p = PRESETS[name]
     return sweep(
         p["run"],

@@ -86,11 +86,15 @@ def _stepper_rows() -> Iterator[Row]:
 
 
 def default_data_dir() -> Path | None:
-    """``$COULOMB_DATA``, else ``../shared/data`` beside a source checkout, if present."""
+    """``$COULOMB_DATA``, else ``../shared/data`` beside a source checkout, else the sets
+    shipped in the checkout's ``tests/data``, if present."""
     env = os.environ.get("COULOMB_DATA")
     candidates = [Path(env)] if env else []
+    checkout = Path(__file__).resolve().parents[2]
     candidates.append(Path.cwd().parent / "shared" / "data")
-    candidates.append(Path(__file__).resolve().parents[3] / "shared" / "data")
+    candidates.append(checkout.parent / "shared" / "data")
+    candidates.append(Path.cwd() / "tests" / "data")
+    candidates.append(checkout / "tests" / "data")
     for c in candidates:
         if (c / "siconos-lcp").is_dir():
             return c
@@ -131,24 +135,34 @@ def run(data: Path | None = None, progress: Callable[[str], None] | None = None)
             progress(f"benchmark data: {data}")
         rows.extend(_data_rows(data))
     elif progress:
-        progress("benchmark data not found (set COULOMB_DATA): seed rows only")
+        progress(
+            "benchmark data not found (set COULOMB_DATA): the chapter's worked examples only"
+        )
     return rows
 
 
 def _fmt(v: float | str) -> str:
-    return f"{v:.6g}" if isinstance(v, float) else str(v)
+    """Six significant digits; exact zeros as ``0`` (a signed zero as ``0`` too)."""
+    if isinstance(v, float):
+        return "0" if v == 0.0 else f"{v:.6g}"
+    return str(v)
+
+
+def _fmt_tol(tol: float | None) -> str:
+    return "exact" if tol in (None, 0.0) else f"{tol:.0e}"
 
 
 def format_table(rows: list[Row]) -> str:
-    """A plain-text table of the rows."""
-    head = ("case", "quantity", "seed", "coulomb", "tolerance", "")
+    """A plain-text table of the rows: the expected value (from the literature, or the
+    closed form), coulomb's, the tolerance and whether it is met."""
+    head = ("case", "quantity", "expected", "coulomb", "tolerance", "result")
     body = [
         (
             r.case,
             r.quantity,
             _fmt(r.expected),
             _fmt(r.computed),
-            "exact" if r.tolerance in (None, 0.0) else f"{r.tolerance:.0e}",
+            _fmt_tol(r.tolerance),
             "ok" if r.passed else "FAIL",
         )
         for r in rows

@@ -1,6 +1,8 @@
-//! Helpers shared by the contact integration tests: a mechanism given by a diagonal mass
-//! matrix and contact Jacobians G, reduced to the contact problem over W.
+//! Helpers shared by the integration tests: where the data is ([`data`]), and a mechanism given
+//! by a diagonal mass matrix and contact Jacobians G, reduced to the contact problem over W.
 #![allow(dead_code)]
+
+pub mod data;
 
 /// `W = G^T M^{-1} G` and `q = G^T v_free` for diagonal M; G is ndof x ncols, row-major
 /// (column k is the generalized direction of contact component k).

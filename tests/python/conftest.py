@@ -1,13 +1,14 @@
-"""Shared fixtures: where the benchmark data lives."""
+"""Shared fixtures: where the benchmark data lives (see helpers.py: tests/data first, then
+``$COULOMB_DATA`` or ``../shared/data``)."""
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import pytest
+from helpers import SHIPPED, external_data_dir, full_set_dir, shipped_dir
 
-# The files of ../shared/data/siconos-lcp (see SOURCE.md there).
+# The files of tests/data/siconos-lcp (see SOURCE.md there).
 SICONOS_LCP_NAMES = (
     "lcp_CPS_1",
     "lcp_CPS_2",
@@ -33,22 +34,35 @@ SICONOS_LCP_NAMES = (
 
 
 def find_data_dir() -> Path:
-    """``$COULOMB_DATA`` if set, else ``<checkout>/../shared/data``."""
-    env = os.environ.get("COULOMB_DATA")
-    if env:
-        return Path(env)
-    return Path(__file__).resolve().parents[3] / "shared" / "data"
+    """``$COULOMB_DATA`` if set, else ``<checkout>/../shared/data`` (the full sets)."""
+    return external_data_dir()
+
+
+@pytest.fixture(scope="session")
+def shipped_data() -> Path:
+    """``tests/data``: a data folder with the whole Siconos LCP set and subsets of the others."""
+    shipped_dir("siconos-lcp")
+    return SHIPPED
 
 
 @pytest.fixture(scope="session")
 def data_dir() -> Path:
-    """The benchmark data folder; skips the test when it is absent."""
-    path = find_data_dir()
-    if not (path / "siconos-lcp").is_dir():
-        pytest.skip(f"benchmark data not found at {path}; set COULOMB_DATA")
-    return path
+    """The full benchmark data folder; skips the test when it is absent (fails in CI)."""
+    for name in ("siconos-lcp", "siconos-fc", "fclib"):
+        full_set_dir(name)
+    return external_data_dir()
 
 
 @pytest.fixture(scope="session")
-def siconos_lcp_dir(data_dir: Path) -> Path:
-    return data_dir / "siconos-lcp"
+def siconos_lcp_dir() -> Path:
+    """The Siconos LCP set: it ships whole in tests/data."""
+    return shipped_dir("siconos-lcp")
+
+
+def pytest_collection_finish(session: pytest.Session) -> None:
+    """A run with no test to run is an error, never a quiet pass: it says why."""
+    if not session.items and not session.testsfailed and not session.config.option.collectonly:
+        raise pytest.UsageError(
+            "no test to run (none collected, or every one deselected by -k/-m): run pytest "
+            "from the repository root, where pyproject.toml sets testpaths = tests/python"
+        )

@@ -1,11 +1,124 @@
-"""Problem generators and independent error measures for the tests (numpy only)."""
+"""Problem generators, independent error measures and the data lookup for the tests."""
 
 from __future__ import annotations
 
+import os
+from collections.abc import Callable, Iterator, Mapping
+from pathlib import Path
+from typing import Any
+
 import numpy as np
+import pytest
 from numpy.typing import NDArray
 
 Array = NDArray[np.float64]
+
+# ---- where the benchmark data is ------------------------------------------------------------
+#
+# The small sets ship in tests/data (the Siconos LCP set, the Siconos friction-contact files of
+# at most 200 kB, seven FCLib files); the full sets are in $COULOMB_DATA or ../shared/data
+# beside the checkout. A file is looked up in tests/data first. A test whose data is absent is
+# skipped with the reason, except when COULOMB_DATA or CI is set: then the data must be there
+# and its absence fails the test.
+
+#: tests/data: the data that ships with the repository.
+SHIPPED = Path(__file__).resolve().parents[1] / "data"
+
+
+def external_data_dir() -> Path:
+    """``$COULOMB_DATA`` if set, else ``<checkout>/../shared/data``."""
+    env = os.environ.get("COULOMB_DATA")
+    if env:
+        return Path(env)
+    return Path(__file__).resolve().parents[3] / "shared" / "data"
+
+
+def data_required() -> bool:
+    """True when the full data must be present: ``COULOMB_DATA`` or ``CI`` is set."""
+    ci = os.environ.get("CI", "").strip().lower()
+    return bool(os.environ.get("COULOMB_DATA")) or ci not in ("", "0", "false", "no")
+
+
+def missing_data(reason: str) -> None:
+    """Skips the test with the reason, or fails it when the data is required."""
+    if data_required():
+        pytest.fail(f"{reason} (COULOMB_DATA or CI is set, so the data must be there)")
+    pytest.skip(f"{reason}; set COULOMB_DATA to the benchmark data folder")
+
+
+def shipped_dir(set_name: str) -> Path:
+    """``tests/data/<set_name>``; fails if it is not there (it is part of the repository)."""
+    path = SHIPPED / set_name
+    if not path.is_dir():
+        pytest.fail(f"shipped test data missing: {path}")
+    return path
+
+
+def full_set_dir(set_name: str) -> Path:
+    """The full set in ``$COULOMB_DATA`` or ``../shared/data`` (skips or fails if absent)."""
+    path = external_data_dir() / set_name
+    if not path.is_dir():
+        missing_data(f"the full {set_name} set is not at {path}")
+    return path
+
+
+def has_full_set(set_name: str) -> bool:
+    return (external_data_dir() / set_name).is_dir()
+
+
+def data_file(set_name: str, name: str) -> Path:
+    """A file of a set (``name`` relative to the set's folder): the shipped copy if there is
+    one, else the full set's (skips or fails when neither exists)."""
+    shipped = SHIPPED / set_name / name
+    if shipped.is_file():
+        return shipped
+    path = external_data_dir() / set_name / name
+    if not path.is_file():
+        missing_data(f"{set_name}/{name} is not shipped in tests/data and not at {path}")
+    return path
+
+
+def available_dir(set_name: str) -> tuple[Path, bool]:
+    """The full set if present (or required), else the shipped subset; and whether it is the
+    full set."""
+    if has_full_set(set_name) or data_required():
+        return full_set_dir(set_name), True
+    return shipped_dir(set_name), False
+
+
+class ProblemSet(Mapping[str, Any]):
+    """Problems of a data set by name, read on first use: an item is looked up in tests/data
+    first (a missing one skips or fails the test that asks for it); iterating covers the full
+    set, so a test that goes through every problem needs it."""
+
+    def __init__(
+        self,
+        set_name: str,
+        reader: Callable[[Path], Any],
+        suffix: str = ".dat",
+        exclude: tuple[str, ...] = (),
+    ) -> None:
+        self.set_name, self.reader, self.suffix, self.exclude = set_name, reader, suffix, exclude
+        self._cache: dict[str, Any] = {}
+
+    def __getitem__(self, name: str) -> Any:
+        if name not in self._cache:
+            self._cache[name] = self.reader(data_file(self.set_name, name + self.suffix))
+        return self._cache[name]
+
+    def names(self) -> list[str]:
+        folder = full_set_dir(self.set_name)
+        return sorted(
+            f.name[: -len(self.suffix)]
+            for f in folder.glob("*" + self.suffix)
+            if f.name[: -len(self.suffix)] not in self.exclude
+        )
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self.names())
+
+    def __len__(self) -> int:
+        return len(self.names())
 
 
 def lcp_error(M: Array, q: Array, z: Array) -> float:

@@ -69,7 +69,9 @@ def test_validate_json(tmp_path):
         assert abs(step[case, "T^+ (J)"]["computed"] - 0.16) <= 1e-9
 
 
-def test_validate_with_data(tmp_path, data_dir):
+def test_validate_with_data(tmp_path, shipped_data):
+    # tests/data holds the whole Siconos LCP set, as the full data folder does
+    data_dir = shipped_data
     p = run(["validate", "--json"], tmp_path, data=data_dir)
     assert p.returncode == 0, p.stderr
     rows = json.loads(p.stdout)
@@ -90,8 +92,8 @@ def test_validate_with_data(tmp_path, data_dir):
     assert len(json.loads(d.stdout)) == len(rows)
 
 
-def test_solve_lcp_prints_the_result(tmp_path, data_dir):
-    path = data_dir / "siconos-lcp" / "lcp_deudeu.dat"
+def test_solve_lcp_prints_the_result(tmp_path, siconos_lcp_dir):
+    path = siconos_lcp_dir / "lcp_deudeu.dat"
     p = run(["solve-lcp", str(path)], tmp_path)
     assert p.returncode == 0, p.stderr
     assert "lcp_deudeu: n = 2" in p.stdout

@@ -1,6 +1,6 @@
-"""The Siconos friction-contact test set (../shared/data/siconos-fc, see SOURCE.md there):
-every file is read, and the small local problems are solved by NSGS and judged by an
-independent numpy residual."""
+"""The Siconos friction-contact test set (tests/data/siconos-fc ships 42 of its 54 files, the
+full set is in $COULOMB_DATA or ../shared/data; see SOURCE.md there): every file is read, and
+the small local problems are solved by NSGS and judged by an independent numpy residual."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ from coulomb.io import (
     GlobalFrictionContactProblem,
     read_siconos_fc,
 )
-from helpers import contact_error
+from helpers import ProblemSet, contact_error, data_file, full_set_dir
 
 TOL = 1e-6
 MAX_ITER = 5000
@@ -39,21 +39,16 @@ MUST_SOLVE = (
 
 
 @pytest.fixture(scope="session")
-def fc_dir(data_dir: Path) -> Path:
-    path = data_dir / "siconos-fc"
-    if not path.is_dir():
-        pytest.skip(f"siconos-fc data not found at {path}")
-    return path
+def fc_dir() -> Path:
+    """The full set (54 files): for the tests that go through every file."""
+    return full_set_dir("siconos-fc")
 
 
 @pytest.fixture(scope="session")
-def problems(fc_dir: Path):
-    """Every readable file, by name."""
-    out = {}
-    for f in sorted(fc_dir.glob("*.dat")):
-        if f.stem not in TOO_LARGE:
-            out[f.stem] = read_siconos_fc(f)
-    return out
+def problems() -> ProblemSet:
+    """Every readable file, by name: an item is read from tests/data when it ships there;
+    iterating needs the full set."""
+    return ProblemSet("siconos-fc", read_siconos_fc, exclude=TOO_LARGE)
 
 
 def test_every_file_is_read(fc_dir, problems):
@@ -81,9 +76,13 @@ def test_known_sizes(problems):
     p = problems["FC3D_Example1"]
     assert (p.dim, p.nc, p.name) == (3, 3, "FC3D_Example1")
     np.testing.assert_array_equal(p.mu, [0.1, 0.1, 0.1])
-    assert (problems["FrictionContactProblem00071"].dim, problems["RockPile_tob1"].nc) == (2, 463)
+    assert problems["FrictionContactProblem00071"].dim == 2
     g = problems["GFC3D_TwoRods1"]
     assert (g.dim, g.nc, g.M.shape, g.H.shape) == (3, 3, (54, 54), (54, 9))
+
+
+def test_known_size_of_the_largest_3d_file(problems):
+    assert problems["RockPile_tob1"].nc == 463
 
 
 def test_sparse_block_and_dense_storage_agree(problems):
@@ -103,9 +102,10 @@ def test_condensed_global_problem_is_the_reduced_one(problems):
     np.testing.assert_allclose(MinvH.T @ g.q + g.b, c.q, rtol=1e-12, atol=1e-14)
 
 
-def test_too_large_is_refused_clearly(fc_dir):
+def test_too_large_is_refused_clearly():
+    path = data_file("siconos-fc", f"{TOO_LARGE[0]}.dat")
     with pytest.raises(errors.ProblemTooLargeError, match="9000 x 9000"):
-        read_siconos_fc(fc_dir / f"{TOO_LARGE[0]}.dat")
+        read_siconos_fc(path)
 
 
 def test_missing_and_malformed_files(tmp_path):
@@ -144,6 +144,16 @@ def test_small_local_problems_are_solved_or_honestly_reported(problems):
             assert err > TOL, name
     missing = set(MUST_SOLVE) - solved
     assert not missing, missing
+
+
+@pytest.mark.parametrize("name", MUST_SOLVE)
+def test_problems_nsgs_must_solve_are_solved(problems, name):
+    # the same problems one by one (all of them ship in tests/data)
+    p = problems[name]
+    r = contact.solve(p.W, p.q, p.mu, p.dim, tol=TOL, max_iter=MAX_ITER)
+    assert r.success and r.status == "solved", (name, r.message)
+    err, _ = contact_error(p.W, p.q, p.mu, p.dim, r.impulse)
+    assert err <= TOL and r.error == pytest.approx(err, rel=1e-8, abs=1e-14), name
 
 
 def test_iteration_limit_on_a_real_problem(problems):

@@ -1,4 +1,5 @@
-"""The FCLib subset (../shared/data/fclib, see SOURCE.md there): every file is read by
+"""The FCLib subset (7 of its 14 files ship in tests/data/fclib, the others are in
+$COULOMB_DATA/fclib or ../shared/data/fclib; see SOURCE.md there): every file is read by
 ``coulomb.io.read_fclib`` or refused with a clear error, global problems are reduced to local
 ones (``W = H^T M^-1 H``, ``q = H^T M^-1 f + w``) and checked against a scipy oracle, and every
 3D problem except RockPile is solved by the robust mode (``method="prox"``) to
@@ -25,7 +26,7 @@ import numpy as np
 import pytest
 from coulomb import contact, errors
 from coulomb.io import FrictionContactProblem, read_fclib
-from helpers import contact_error
+from helpers import ProblemSet, contact_error, data_file, full_set_dir, shipped_dir
 
 h5py = pytest.importorskip("h5py", reason="h5py (the extra coulomb[hdf5]) is not installed")
 sp = pytest.importorskip("scipy.sparse")
@@ -38,34 +39,47 @@ ROLLING = "Chute-ndof-768-nc-4-3"
 
 
 @pytest.fixture(scope="module")
-def fclib_dir(data_dir: Path) -> Path:
-    path = data_dir / "fclib"
-    if not path.is_dir():
-        pytest.skip(f"fclib data not found at {path}")
-    return path
-
-
-@pytest.fixture(scope="module")
-def manifest(fclib_dir: Path) -> dict[str, dict]:
-    entries = json.loads((fclib_dir / "manifest.json").read_text())
+def manifest() -> dict[str, dict]:
+    """The manifest of the 14-file subset (it ships in tests/data/fclib with 7 of the files)."""
+    entries = json.loads((shipped_dir("fclib") / "manifest.json").read_text())
     return {Path(e["path"]).stem: e for e in entries}
 
 
+def fclib_path(manifest: dict[str, dict], name: str) -> Path:
+    """A file of the subset: tests/data/fclib first, then the full set (else skip or fail)."""
+    return data_file("fclib", manifest[name]["path"])
+
+
+class FclibProblems(ProblemSet):
+    """The problems by name, read on first use from tests/data/fclib or the full set."""
+
+    def __init__(self, manifest: dict[str, dict]) -> None:
+        super().__init__("fclib", read_fclib, suffix="")
+        self.manifest = manifest
+
+    def __getitem__(self, name: str) -> FrictionContactProblem:
+        if name not in self._cache:
+            self._cache[name] = read_fclib(fclib_path(self.manifest, name))
+        return self._cache[name]
+
+    def names(self) -> list[str]:
+        return [n for n in self.manifest if n != ROLLING]
+
+
 @pytest.fixture(scope="module")
-def problems(fclib_dir: Path, manifest) -> dict[str, FrictionContactProblem]:
-    return {
-        name: read_fclib(fclib_dir / e["path"]) for name, e in manifest.items() if name != ROLLING
-    }
+def problems(manifest) -> FclibProblems:
+    return FclibProblems(manifest)
 
 
-def test_every_file_is_read_or_refused(fclib_dir, manifest, problems):
+def test_every_file_is_read_or_refused(manifest, problems):
+    fclib_dir = full_set_dir("fclib")
     assert len(manifest) == 14
     for name, e in manifest.items():
         if name == ROLLING:
             with pytest.raises(errors.ProblemFormatError, match="rolling"):
                 read_fclib(fclib_dir / e["path"])
             continue
-        p = problems[name]
+        p = read_fclib(fclib_dir / e["path"])
         assert p.name == name
         assert p.dim == e["spacedim"] and p.nc == e["nc"]
         n = p.dim * p.nc
@@ -78,10 +92,29 @@ def test_every_file_is_read_or_refused(fclib_dir, manifest, problems):
             assert np.allclose(np.unique(p.mu), e["mu"])
 
 
-def test_local_matrix_storage_kinds_agree_with_an_independent_read(fclib_dir, manifest, problems):
+def test_shipped_files_are_the_manifests(manifest):
+    """Every FCLib file in tests/data is byte for byte the one the manifest describes."""
+    import hashlib
+
+    folder = shipped_dir("fclib")
+    shipped = sorted(folder.rglob("*.hdf5"))
+    assert len(shipped) == 7
+    by_path = {e["path"]: e for e in manifest.values()}
+    for f in shipped:
+        e = by_path[f.relative_to(folder).as_posix()]
+        assert f.stat().st_size == e["bytes"], f
+        assert hashlib.sha256(f.read_bytes()).hexdigest() == e["sha256"], f
+
+
+def test_rolling_problem_is_refused(manifest):
+    with pytest.raises(errors.ProblemFormatError, match="rolling"):
+        read_fclib(fclib_path(manifest, ROLLING))
+
+
+def test_local_matrix_storage_kinds_agree_with_an_independent_read(manifest, problems):
     """CSR (PerioBox) and CSC (converted files) decoded by hand here give the reader's W."""
     for name in ("LMGC_100_PR_PerioBox-i00361-60-03000", "OneObject-i100000-499"):
-        with h5py.File(fclib_dir / manifest[name]["path"], "r") as f:
+        with h5py.File(fclib_path(manifest, name), "r") as f:
             g = f["fclib_local/W"]
             nz, m = int(g["nz"][0]), int(g["m"][0])
             p, i, x = g["p"][:], g["i"][:], g["x"][:]
@@ -96,39 +129,36 @@ def test_local_matrix_storage_kinds_agree_with_an_independent_read(fclib_dir, ma
         assert np.array_equal(problems[name].W.toarray(), dense)
 
 
-def test_global_problems_are_reduced_as_the_scipy_oracle(fclib_dir, manifest, problems):
-    for name in (
-        "Box_Stacks-i0122-82-5",
-        "Spheres-i099-356-679",
-        "LMGC_GlobalFrictionContactProblem00046",
-    ):
-        with h5py.File(fclib_dir / manifest[name]["path"], "r") as f:
-            g = f["fclib_global"]
+@pytest.mark.parametrize(
+    "name",
+    ["Box_Stacks-i0122-82-5", "Spheres-i099-356-679", "LMGC_GlobalFrictionContactProblem00046"],
+)
+def test_global_problems_are_reduced_as_the_scipy_oracle(manifest, problems, name):
+    with h5py.File(fclib_path(manifest, name), "r") as f:
+        g = f["fclib_global"]
 
-            def triplets(key, g=g):
-                h = g[key]
-                nz, m, n = int(h["nz"][0]), int(h["m"][0]), int(h["n"][0])
-                assert nz >= 0  # Siconos and LMGC90 write M and H as triplets
-                return sp.coo_matrix(
-                    (h["x"][:nz], (h["i"][:nz], h["p"][:nz])), shape=(m, n)
-                ).tocsc()
+        def triplets(key, g=g):
+            h = g[key]
+            nz, m, n = int(h["nz"][0]), int(h["m"][0]), int(h["n"][0])
+            assert nz >= 0  # Siconos and LMGC90 write M and H as triplets
+            return sp.coo_matrix((h["x"][:nz], (h["i"][:nz], h["p"][:nz])), shape=(m, n)).tocsc()
 
-            M, H = triplets("M"), triplets("H")
-            f_, w = g["vectors/f"][:], g["vectors/w"][:]
-        if name.startswith("LMGC"):
-            # LMGC90 stores the symmetric M by its upper triangle
-            assert sp.tril(M, -1).nnz == 0 and sp.triu(M, 1).nnz > 0
-            M = (M + sp.triu(M, 1).T).tocsc()
-        else:
-            assert (M - sp.diags(M.diagonal())).nnz == 0  # diagonal mass matrices
-        MiH = spl.spsolve(M, H.tocsc())
-        MiH = MiH.toarray() if sp.issparse(MiH) else MiH
-        W = H.T @ MiH
-        q = H.T @ spl.spsolve(M, f_) + w
-        p = problems[name]
-        scale = np.abs(W).max()
-        assert np.abs(p.W.toarray() - W).max() <= 1e-12 * scale, name
-        assert np.abs(p.q - q).max() <= 1e-12 * max(np.abs(q).max(), 1.0), name
+        M, H = triplets("M"), triplets("H")
+        f_, w = g["vectors/f"][:], g["vectors/w"][:]
+    if name.startswith("LMGC"):
+        # LMGC90 stores the symmetric M by its upper triangle
+        assert sp.tril(M, -1).nnz == 0 and sp.triu(M, 1).nnz > 0
+        M = (M + sp.triu(M, 1).T).tocsc()
+    else:
+        assert (M - sp.diags(M.diagonal())).nnz == 0  # diagonal mass matrices
+    MiH = spl.spsolve(M, H.tocsc())
+    MiH = MiH.toarray() if sp.issparse(MiH) else MiH
+    W = H.T @ MiH
+    q = H.T @ spl.spsolve(M, f_) + w
+    p = problems[name]
+    scale = np.abs(W).max()
+    assert np.abs(p.W.toarray() - W).max() <= 1e-12 * scale, name
+    assert np.abs(p.q - q).max() <= 1e-12 * max(np.abs(q).max(), 1.0), name
 
 
 SOLVED = (
@@ -202,7 +232,7 @@ def test_the_2d_file_is_indefinite_and_solved_by_the_lcp_finish(problems):
     assert r.cone_violation <= 1e-12 * rn.max()
 
 
-def test_reader_errors(tmp_path, fclib_dir, manifest):
+def test_reader_errors(tmp_path):
     with pytest.raises(FileNotFoundError):
         read_fclib(tmp_path / "missing.hdf5")
     bad = tmp_path / "not.hdf5"
@@ -226,7 +256,8 @@ def test_reader_errors(tmp_path, fclib_dir, manifest):
         read_fclib(broken)
 
 
-def test_missing_h5py_names_the_extra(monkeypatch, fclib_dir, manifest):
+def test_missing_h5py_names_the_extra(monkeypatch, manifest):
+    path = fclib_path(manifest, "NESpheres_10_1")
     import builtins
 
     real_import = builtins.__import__
@@ -238,4 +269,4 @@ def test_missing_h5py_names_the_extra(monkeypatch, fclib_dir, manifest):
 
     monkeypatch.setattr(builtins, "__import__", fake_import)
     with pytest.raises(ImportError, match=r"coulomb\[hdf5\]"):
-        read_fclib(fclib_dir / manifest["NESpheres_10_1"]["path"])
+        read_fclib(path)
