@@ -1,0 +1,163 @@
+//! Contact persistence: what each contact carries from step to step under its identity (the
+//! last impulse for warm starts, its variables in the last polyhedral LCP's basis, and its
+//! impact record, module `impact`), and the broad phase's sphere pairs, which take over the
+//! state of the same pair of the previous step by key.
+
+use super::super::impact::ImpactMemory;
+use super::bodies::norm3;
+use super::narrow::Candidate;
+use super::{dot_v, ContactRecord, PolyhedralSettings, StepSolver, Stepper};
+
+/// What a candidate carries from one step to the next (reset when it is far).
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct CandState {
+    /// the last impulse, `dim` used entries, for warm starts.
+    pub(super) warm: [f64; 3],
+    /// the impact the last step stopped with the gap term, owed its rebound by this step.
+    pub(super) impact: ImpactMemory,
+    /// the contact's variables in the last polyhedral LCP's final basis, for Lemke's warm
+    /// start: bit 0 its normal impulse, bit 1 its λ, bit 2 + k its k-th β.
+    pub(super) basis: u64,
+}
+
+impl Stepper {
+    /// After a solve: each active contact keeps its impulse (warm start), its variables in
+    /// Lemke's basis and its impact record by identity (a closed contact consumes its
+    /// record, an open one that pushed records its impact, one that did not push has none),
+    /// and its record of the step is appended to `contacts`.
+    pub(super) fn remember(&mut self, v_next: &[f64], contacts: &mut Vec<ContactRecord>) {
+        let dim = self.dim;
+        let sol = &self.solve;
+        for (i, a) in self.active.iter().enumerate() {
+            let p = &sol.impulse[i * dim..(i + 1) * dim];
+            let st = &mut self.state[a.cand];
+            st.warm[..dim].copy_from_slice(p);
+            st.basis = sol.basis.get(i).copied().unwrap_or(0);
+            st.impact = if !a.closed && p[0] > 0.0 {
+                ImpactMemory::landed(a.vn_k, p[0])
+            } else {
+                ImpactMemory::default()
+            };
+            let mut impulse = [0.0; 3];
+            impulse[..dim].copy_from_slice(p);
+            let mut velocity = [0.0; 3];
+            for s in &a.sides[..a.nsides] {
+                let b = &self.bodies[s.body];
+                for (j, vj) in velocity.iter_mut().enumerate().take(dim) {
+                    *vj += dot_v(&s.g[j], v_next, b.off_v, b.nv);
+                }
+            }
+            contacts.push(ContactRecord {
+                step: self.step_index,
+                id: self.candidates[a.cand].id,
+                impulse,
+                velocity,
+                approach: a.approach,
+                gap: a.gap,
+                closed: a.closed,
+            });
+        }
+    }
+
+    /// Rebuilds the sphere pairs of [`Pair::Spheres`] (candidates `n_static..`): every pair of
+    /// balls whose distance is at most the sum of their radii grown by what the step can
+    /// close, `r + gap_tolerance / 2 + 2 h (speed bound)`, so the pairs it leaves out are
+    /// exactly ones the contact search would call far. Each kept pair takes over its state
+    /// (warm start, remembered approach) from the previous step by its key.
+    pub(super) fn broad_phase(&mut self) {
+        let Some((mu, e)) = self.auto else { return };
+        let h = self.settings.h;
+        let half_tol = 0.5 * self.settings.gap_tolerance;
+        let nb = self.balls.len();
+        self.ball_centres.clear();
+        self.ball_radii.clear();
+        for k in 0..nb {
+            let (body, p, r) = self.balls[k];
+            let (_, c) = self.world_point(body, p);
+            let [lin, ang] = self.speed_bounds[body];
+            let reach = lin + ang * (norm3(p) + r);
+            let size = c.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            // a hair of slack: rounding must never drop a pair the exact test keeps
+            let grown = (r + half_tol + 2.0 * h * reach) * (1.0 + 1e-9) + 4.0 * f64::EPSILON * size;
+            self.ball_centres.push(c);
+            self.ball_radii.push(grown);
+        }
+        self.broad
+            .pairs(&self.ball_centres, &self.ball_radii, &mut self.ball_pairs);
+        self.ball_pairs.sort_unstable();
+        // carry the state of the previous step's pairs over by key (both lists sorted)
+        std::mem::swap(&mut self.auto_keys, &mut self.old_keys);
+        self.old_state.clear();
+        self.old_state
+            .extend_from_slice(&self.state[self.n_static..]);
+        self.state.truncate(self.n_static);
+        self.candidates.truncate(self.n_static);
+        self.auto_keys.clear();
+        let mut old = 0;
+        for &(i, j) in &self.ball_pairs {
+            let (bi, bj) = (self.balls[i as usize], self.balls[j as usize]);
+            if bi.0 == bj.0 || self.declared_balls.binary_search(&(i, j)).is_ok() {
+                continue;
+            }
+            let key = (u64::from(i) << 32) | u64::from(j);
+            while old < self.old_keys.len() && self.old_keys[old] < key {
+                old += 1;
+            }
+            let st = if old < self.old_keys.len() && self.old_keys[old] == key {
+                self.old_state[old]
+            } else {
+                CandState::default()
+            };
+            self.auto_keys.push(key);
+            self.state.push(st);
+            self.candidates.push(Candidate {
+                a: bi,
+                b: Some(bj),
+                plane: ([0.0; 3], [0.0; 3]),
+                mu,
+                e,
+                id: self.n_static + i as usize * nb + j as usize,
+            });
+        }
+    }
+
+    /// The polyhedral LCP's guessed basis from the active contacts' last bases (see
+    /// [`CandState::basis`]), in the layout of [`PolyhedralLcp`]: normals `0..nc`, then each
+    /// frictional contact's `facets` β, then their λ.
+    pub(super) fn basis_of_active(&self, out: &mut Vec<usize>) {
+        out.clear();
+        let facets = match &self.settings.solver {
+            StepSolver::Lemke(s) => s.facets,
+            StepSolver::Nsgs(_) => PolyhedralSettings::for_dim(self.dim).facets,
+        };
+        if facets + 2 > 64 || !self.settings.warm_start {
+            return;
+        }
+        let nc = self.active.len();
+        let nf = self
+            .active
+            .iter()
+            .filter(|a| self.candidates[a.cand].mu > 0.0)
+            .count();
+        let mut beta = nc;
+        let mut lambda = nc + nf * facets;
+        for (i, a) in self.active.iter().enumerate() {
+            let bits = self.state[a.cand].basis;
+            if bits & 1 != 0 {
+                out.push(i);
+            }
+            if self.candidates[a.cand].mu > 0.0 {
+                for k in 0..facets {
+                    if bits & (1 << (2 + k)) != 0 {
+                        out.push(beta + k);
+                    }
+                }
+                if bits & 2 != 0 {
+                    out.push(lambda);
+                }
+                beta += facets;
+                lambda += 1;
+            }
+        }
+    }
+}
