@@ -104,8 +104,13 @@ impl Stepper {
     /// found from each body's list of contacts (O(Σ_b k_b^2), not O(nc^2)); each pair of
     /// contacts is computed once and mirrored (W is symmetric).
     pub(super) fn assemble(&mut self, record: &mut StepRecord) {
+        self.assemble_w();
+        self.contact_terms(record);
+    }
+
+    /// W over the active contacts (see [`Stepper::assemble`]).
+    fn assemble_w(&mut self) {
         let dim = self.dim;
-        let h = self.settings.h;
         let nc = self.active.len();
         let n = nc * dim;
         let sparse = nc >= SPARSE_FROM;
@@ -162,6 +167,15 @@ impl Stepper {
                 }
             }
         }
+    }
+
+    /// `q_c = G^T v_free` plus each contact's restitution, bias or gap term, `q_1 = G^T v_k`
+    /// (open contacts separated) for Poisson's impact phase, and mu.
+    fn contact_terms(&mut self, record: &mut StepRecord) {
+        let dim = self.dim;
+        let h = self.settings.h;
+        let nc = self.active.len();
+        let n = nc * dim;
         self.qc.clear();
         self.qc.resize(n, 0.0);
         self.q1.clear();

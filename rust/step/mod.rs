@@ -226,61 +226,7 @@ impl Scene {
         }
         check_len("gravity", &self.gravity, dim)?;
         for (i, b) in self.bodies.iter().enumerate() {
-            match (b.kind, dim) {
-                (BodyKind::Planar, 3) => {
-                    return Err(bad(format!("body {i}: a planar rigid body needs dim = 2")))
-                }
-                (BodyKind::Spatial, 2) => {
-                    return Err(bad(format!("body {i}: a spatial rigid body needs dim = 3")))
-                }
-                _ => {}
-            }
-            if !(b.mass.is_finite() && b.mass > 0.0) {
-                return Err(bad(format!(
-                    "body {i}: mass must be finite and > 0, got {}",
-                    b.mass
-                )));
-            }
-            check_len(&format!("body {i} q0"), &b.q0, b.kind.nq(dim))?;
-            check_len(&format!("body {i} v0"), &b.v0, b.kind.nv(dim))?;
-            check_len(&format!("body {i} force"), &b.force, dim)?;
-            match b.kind {
-                BodyKind::Particle => {}
-                BodyKind::Planar => {
-                    check_len(&format!("body {i} inertia"), &b.inertia, 1)?;
-                    if b.inertia[0] <= 0.0 {
-                        return Err(bad(format!(
-                            "body {i}: inertia must be > 0, got {}",
-                            b.inertia[0]
-                        )));
-                    }
-                }
-                BodyKind::Spatial => {
-                    check_len(&format!("body {i} inertia"), &b.inertia, 9)?;
-                    let j = &b.inertia;
-                    let asym = (j[1] - j[3])
-                        .abs()
-                        .max((j[2] - j[6]).abs())
-                        .max((j[5] - j[7]).abs());
-                    let scale = j.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-                    if asym > 1e-12 * scale {
-                        return Err(bad(format!("body {i}: inertia must be symmetric")));
-                    }
-                    // Sylvester's criterion
-                    let d1 = j[0];
-                    let d2 = j[0] * j[4] - j[1] * j[3];
-                    let d3 = det3(j);
-                    if !(d1 > 0.0 && d2 > 0.0 && d3 > 0.0) {
-                        return Err(bad(format!("body {i}: inertia must be positive definite")));
-                    }
-                    let qn = b.q0[3..7].iter().map(|v| v * v).sum::<f64>().sqrt();
-                    if (qn - 1.0).abs() > 1e-6 {
-                        return Err(bad(format!(
-                            "body {i}: the orientation quaternion must be unit, has norm {qn}"
-                        )));
-                    }
-                }
-            }
+            validate_body(dim, i, b)?;
         }
         for (i, s) in self.shapes.iter().enumerate() {
             if s.body >= self.bodies.len() {
@@ -312,52 +258,58 @@ impl Scene {
             }
         }
         for (i, p) in self.pairs.iter().enumerate() {
-            let (mu, e) = match *p {
-                Pair::ShapeHalfSpace {
-                    shape,
-                    half_space,
-                    mu,
-                    e,
-                } => {
-                    if shape >= self.shapes.len() || half_space >= self.half_spaces.len() {
-                        return Err(bad(format!("pair {i}: index out of range")));
-                    }
-                    (mu, e)
+            self.validate_pair(i, p)?;
+        }
+        Ok(())
+    }
+
+    /// checks one contact pair: indices, mu and e.
+    fn validate_pair(&self, i: usize, p: &Pair) -> Result<()> {
+        let (mu, e) = match *p {
+            Pair::ShapeHalfSpace {
+                shape,
+                half_space,
+                mu,
+                e,
+            } => {
+                if shape >= self.shapes.len() || half_space >= self.half_spaces.len() {
+                    return Err(bad(format!("pair {i}: index out of range")));
                 }
-                Pair::SphereSphere { a, b, mu, e } => {
-                    if a >= self.shapes.len() || b >= self.shapes.len() {
-                        return Err(bad(format!("pair {i}: index out of range")));
-                    }
-                    if self.shapes[a].body == self.shapes[b].body {
-                        return Err(bad(format!(
-                            "pair {i}: both shapes are on body {}",
-                            self.shapes[a].body
-                        )));
-                    }
-                    (mu, e)
+                (mu, e)
+            }
+            Pair::SphereSphere { a, b, mu, e } => {
+                if a >= self.shapes.len() || b >= self.shapes.len() {
+                    return Err(bad(format!("pair {i}: index out of range")));
                 }
-                Pair::Spheres { mu, e } => {
-                    let count = self
-                        .pairs
-                        .iter()
-                        .filter(|p| matches!(p, Pair::Spheres { .. }))
-                        .count();
-                    if count > 1 {
-                        return Err(bad(format!(
+                if self.shapes[a].body == self.shapes[b].body {
+                    return Err(bad(format!(
+                        "pair {i}: both shapes are on body {}",
+                        self.shapes[a].body
+                    )));
+                }
+                (mu, e)
+            }
+            Pair::Spheres { mu, e } => {
+                let count = self
+                    .pairs
+                    .iter()
+                    .filter(|p| matches!(p, Pair::Spheres { .. }))
+                    .count();
+                if count > 1 {
+                    return Err(bad(format!(
                             "pair {i}: the scene asks {count} times for every sphere pair;                              at most once"
                         )));
-                    }
-                    (mu, e)
                 }
-            };
-            if !(mu.is_finite() && mu >= 0.0) {
-                return Err(bad(format!(
-                    "pair {i}: mu must be finite and >= 0, got {mu}"
-                )));
+                (mu, e)
             }
-            if !(0.0..=1.0).contains(&e) {
-                return Err(bad(format!("pair {i}: e must be in [0, 1], got {e}")));
-            }
+        };
+        if !(mu.is_finite() && mu >= 0.0) {
+            return Err(bad(format!(
+                "pair {i}: mu must be finite and >= 0, got {mu}"
+            )));
+        }
+        if !(0.0..=1.0).contains(&e) {
+            return Err(bad(format!("pair {i}: e must be in [0, 1], got {e}")));
         }
         Ok(())
     }
@@ -371,6 +323,66 @@ impl Scene {
     pub fn nv(&self) -> usize {
         self.bodies.iter().map(|b| b.kind.nv(self.dim)).sum()
     }
+}
+
+/// checks one body of a scene of dimension `dim`.
+fn validate_body(dim: usize, i: usize, b: &Body) -> Result<()> {
+    match (b.kind, dim) {
+        (BodyKind::Planar, 3) => {
+            return Err(bad(format!("body {i}: a planar rigid body needs dim = 2")))
+        }
+        (BodyKind::Spatial, 2) => {
+            return Err(bad(format!("body {i}: a spatial rigid body needs dim = 3")))
+        }
+        _ => {}
+    }
+    if !(b.mass.is_finite() && b.mass > 0.0) {
+        return Err(bad(format!(
+            "body {i}: mass must be finite and > 0, got {}",
+            b.mass
+        )));
+    }
+    check_len(&format!("body {i} q0"), &b.q0, b.kind.nq(dim))?;
+    check_len(&format!("body {i} v0"), &b.v0, b.kind.nv(dim))?;
+    check_len(&format!("body {i} force"), &b.force, dim)?;
+    match b.kind {
+        BodyKind::Particle => {}
+        BodyKind::Planar => {
+            check_len(&format!("body {i} inertia"), &b.inertia, 1)?;
+            if b.inertia[0] <= 0.0 {
+                return Err(bad(format!(
+                    "body {i}: inertia must be > 0, got {}",
+                    b.inertia[0]
+                )));
+            }
+        }
+        BodyKind::Spatial => {
+            check_len(&format!("body {i} inertia"), &b.inertia, 9)?;
+            let j = &b.inertia;
+            let asym = (j[1] - j[3])
+                .abs()
+                .max((j[2] - j[6]).abs())
+                .max((j[5] - j[7]).abs());
+            let scale = j.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            if asym > 1e-12 * scale {
+                return Err(bad(format!("body {i}: inertia must be symmetric")));
+            }
+            // Sylvester's criterion
+            let d1 = j[0];
+            let d2 = j[0] * j[4] - j[1] * j[3];
+            let d3 = det3(j);
+            if !(d1 > 0.0 && d2 > 0.0 && d3 > 0.0) {
+                return Err(bad(format!("body {i}: inertia must be positive definite")));
+            }
+            let qn = b.q0[3..7].iter().map(|v| v * v).sum::<f64>().sqrt();
+            if (qn - 1.0).abs() > 1e-6 {
+                return Err(bad(format!(
+                    "body {i}: the orientation quaternion must be unit, has norm {qn}"
+                )));
+            }
+        }
+    }
+    Ok(())
 }
 
 pub(crate) fn det3(j: &[f64]) -> f64 {

@@ -154,63 +154,19 @@ pub(super) fn solve_step_problem(
     record: &mut StepRecord,
     ws: &mut SolveBuffers,
 ) -> Result<Outcome> {
-    let n = problem.size();
     ws.basis.clear();
     // r = 0 solves the problem exactly when no contact's normal would close
     // (u = q, u_n >= 0, and 0 lies in every cone): no solve needed
     let separating = (0..problem.nc).all(|i| problem.q[i * problem.dim] >= 0.0);
     if separating {
-        ws.impulse.clear();
-        ws.impulse.resize(n, 0.0);
-        ws.velocity.resize(n, 0.0);
-        let m = measure_into(problem, &ws.impulse, &mut ws.velocity);
-        return Ok(Outcome {
-            status: ContactStatus::Solved,
-            iterations: 0,
-            measures: ContactMeasures {
-                error: 0.0,
-                error_q: 0.0,
-                ..m
-            },
-        });
+        return Ok(zero_answer(problem, ws));
     }
     match &settings.solver {
         StepSolver::Nsgs(s) => {
-            // a resting or sticking body's impulses often solve the next step's problem as
-            // they are: then NSGS (which would stop after 0 sweeps) need not be set up
-            let mut start = None;
-            if let Some(init) = initial {
-                ws.velocity.resize(n, 0.0);
-                let m = measure_into(problem, init, &mut ws.velocity);
-                if m.error <= s.tol && m.cone_violation == 0.0 {
-                    ws.impulse.clear();
-                    ws.impulse.extend_from_slice(init);
-                    return Ok(Outcome {
-                        status: ContactStatus::Solved,
-                        iterations: 0,
-                        measures: m,
-                    });
-                }
-                if m.error <= POLISH_NEAR * s.tol && problem.nc <= LEMKE_FALLBACK_MAX {
-                    // nearly solved already (a resting or sticking body whose velocity
-                    // residual has built up): a few sweeps towards POLISH_TOL s.tol, so
-                    // that the next steps' impulses stay within tol for longer
-                    let polish = NsgsSettings {
-                        initial: Some(init.to_vec()),
-                        max_iter: s.max_iter.min(POLISH_SWEEPS),
-                        tol: s.tol * POLISH_TOL,
-                        ..s.clone()
-                    };
-                    let p = solve_nsgs(problem, &polish)?;
-                    if p.measures.error <= s.tol {
-                        let mut out = ws.take(p);
-                        out.status = ContactStatus::Solved;
-                        return Ok(out);
-                    }
-                    start = Some(p.impulse);
-                }
-            }
-            let start = start.or_else(|| initial.map(<[f64]>::to_vec));
+            let start = match reuse_warm_start(s, problem, initial, ws)? {
+                Warm::Done(out) => return Ok(out),
+                Warm::Start(start) => start,
+            };
             // many contacts: a sweep budget before the robust mode (a landing layer on a
             // tall pile needs sweeps growing with the pile's height, the robust mode a few
             // Newton steps at a cost linear in the contacts)
@@ -229,67 +185,147 @@ pub(super) fn solve_step_problem(
             if first.success() || !settings.fallback {
                 return Ok(ws.take(first));
             }
-            // NSGS can stall on singular, strongly coupled W (e.g. a rod lying on two
-            // contacts with mu = 2): Lemke's pivoting on the polyhedral cone (exact in 2D)
-            // decides for few contacts, the robust mode (proximal Newton, sparse LU) for
-            // many, where the dense LCP of nc (facets + 2) unknowns would cost more than the
-            // whole run; keep the better answer
-            let tol = s.tol.max(1e-9);
-            let second = if !large {
-                let mut lemke = PolyhedralSettings::for_dim(problem.dim);
-                lemke.lemke.tol = tol;
-                solve_polyhedral_warm(problem, &lemke, guess, ws)?
-            } else {
-                let prox = ProxSettings {
-                    tol: s.tol,
-                    max_iter: PROX_MAX_ITER,
-                    initial: Some(first.impulse.clone()),
-                    ..ProxSettings::default()
-                };
-                ws.take(solve_prox(problem, &prox)?)
-            };
-            let better = second.measures.error < first.measures.error;
-            if large && budget < s.max_iter && !(better && second.measures.error <= s.tol) {
-                // the robust mode did not reach the tolerance either: NSGS's remaining
-                // sweeps from the better answer, and the best of the three
-                let from = if better {
-                    ws.impulse.clone()
-                } else {
-                    first.impulse.clone()
-                };
-                let rest = NsgsSettings {
-                    initial: Some(from),
-                    max_iter: s.max_iter - budget,
-                    ..s.clone()
-                };
-                let third = solve_nsgs(problem, &rest)?;
-                let best_so_far = if better {
-                    second.measures.error
-                } else {
-                    first.measures.error
-                };
-                if third.measures.error <= best_so_far {
-                    record.fallback = better;
-                    return Ok(ws.take(ContactSolution {
-                        iterations: budget + third.iterations,
-                        ..third
-                    }));
-                }
-            }
-            if better {
-                record.fallback = true;
-                Ok(Outcome {
-                    status: if second.measures.error <= tol {
-                        ContactStatus::Solved
-                    } else {
-                        second.status
-                    },
-                    ..second
-                })
-            } else {
-                Ok(ws.take(first))
-            }
+            nsgs_fallback(s, problem, guess, first, budget, large, record, ws)
         }
         StepSolver::Lemke(s) => solve_polyhedral_warm(problem, s, guess, ws),
+    }
+}
+
+/// the zero impulses of a step whose contacts all separate, with their measures.
+fn zero_answer(problem: &ContactProblem<'_>, ws: &mut SolveBuffers) -> Outcome {
+    let n = problem.size();
+    ws.impulse.clear();
+    ws.impulse.resize(n, 0.0);
+    ws.velocity.resize(n, 0.0);
+    let m = measure_into(problem, &ws.impulse, &mut ws.velocity);
+    Outcome {
+        status: ContactStatus::Solved,
+        iterations: 0,
+        measures: ContactMeasures {
+            error: 0.0,
+            error_q: 0.0,
+            ..m
+        },
+    }
+}
+
+/// What the previous step's impulses give NSGS: the answer itself, or where to start.
+enum Warm {
+    Done(Outcome),
+    Start(Option<Vec<f64>>),
+}
+
+/// A resting or sticking body's impulses often solve the next step's problem as they are:
+/// then NSGS (which would stop after 0 sweeps) need not be set up; nearly so (within
+/// [`POLISH_NEAR`] times the tolerance), a few sweeps towards [`POLISH_TOL`] times it, so that
+/// the next steps' impulses stay within the tolerance for longer.
+fn reuse_warm_start(
+    s: &NsgsSettings,
+    problem: &ContactProblem<'_>,
+    initial: Option<&[f64]>,
+    ws: &mut SolveBuffers,
+) -> Result<Warm> {
+    let Some(init) = initial else {
+        return Ok(Warm::Start(None));
+    };
+    ws.velocity.resize(problem.size(), 0.0);
+    let m = measure_into(problem, init, &mut ws.velocity);
+    if m.error <= s.tol && m.cone_violation == 0.0 {
+        ws.impulse.clear();
+        ws.impulse.extend_from_slice(init);
+        return Ok(Warm::Done(Outcome {
+            status: ContactStatus::Solved,
+            iterations: 0,
+            measures: m,
+        }));
+    }
+    if m.error <= POLISH_NEAR * s.tol && problem.nc <= LEMKE_FALLBACK_MAX {
+        let polish = NsgsSettings {
+            initial: Some(init.to_vec()),
+            max_iter: s.max_iter.min(POLISH_SWEEPS),
+            tol: s.tol * POLISH_TOL,
+            ..s.clone()
+        };
+        let p = solve_nsgs(problem, &polish)?;
+        if p.measures.error <= s.tol {
+            let mut out = ws.take(p);
+            out.status = ContactStatus::Solved;
+            return Ok(Warm::Done(out));
+        }
+        return Ok(Warm::Start(Some(p.impulse)));
+    }
+    Ok(Warm::Start(Some(init.to_vec())))
+}
+
+/// NSGS missed its tolerance (it can stall on singular, strongly coupled W, e.g. a rod lying
+/// on two contacts with mu = 2): Lemke's pivoting on the polyhedral cone (exact in 2D)
+/// decides for few contacts, the robust mode (proximal Newton, sparse LU) for many, where the
+/// dense LCP of nc (facets + 2) unknowns would cost more than the whole run; the better
+/// answer is kept, and for many contacts NSGS's remaining sweeps follow if the robust mode
+/// misses the tolerance too.
+#[allow(clippy::too_many_arguments)]
+fn nsgs_fallback(
+    s: &NsgsSettings,
+    problem: &ContactProblem<'_>,
+    guess: &[usize],
+    first: ContactSolution,
+    budget: usize,
+    large: bool,
+    record: &mut StepRecord,
+    ws: &mut SolveBuffers,
+) -> Result<Outcome> {
+    let tol = s.tol.max(1e-9);
+    let second = if !large {
+        let mut lemke = PolyhedralSettings::for_dim(problem.dim);
+        lemke.lemke.tol = tol;
+        solve_polyhedral_warm(problem, &lemke, guess, ws)?
+    } else {
+        let prox = ProxSettings {
+            tol: s.tol,
+            max_iter: PROX_MAX_ITER,
+            initial: Some(first.impulse.clone()),
+            ..ProxSettings::default()
+        };
+        ws.take(solve_prox(problem, &prox)?)
+    };
+    let better = second.measures.error < first.measures.error;
+    if large && budget < s.max_iter && !(better && second.measures.error <= s.tol) {
+        // NSGS's remaining sweeps from the better answer, and the best of the three
+        let from = if better {
+            ws.impulse.clone()
+        } else {
+            first.impulse.clone()
+        };
+        let rest = NsgsSettings {
+            initial: Some(from),
+            max_iter: s.max_iter - budget,
+            ..s.clone()
+        };
+        let third = solve_nsgs(problem, &rest)?;
+        let best_so_far = if better {
+            second.measures.error
+        } else {
+            first.measures.error
+        };
+        if third.measures.error <= best_so_far {
+            record.fallback = better;
+            return Ok(ws.take(ContactSolution {
+                iterations: budget + third.iterations,
+                ..third
+            }));
+        }
+    }
+    if better {
+        record.fallback = true;
+        Ok(Outcome {
+            status: if second.measures.error <= tol {
+                ContactStatus::Solved
+            } else {
+                second.status
+            },
+            ..second
+        })
+    } else {
+        Ok(ws.take(first))
     }
 }
