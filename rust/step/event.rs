@@ -27,7 +27,7 @@
 //! contact that stays closed, as after an inelastic impact under gravity). Otherwise the step
 //! is the plain one.
 
-use super::{frame, rotate, BodyKind, ContactRecord, Restitution, StepRecord, Stepper};
+use super::{frame, rotate, BodyKind, ContactRecord, Geometry, Restitution, StepRecord, Stepper};
 use crate::contact::{solve_nsgs, ContactProblem, NsgsSettings};
 use crate::error::Result;
 
@@ -214,23 +214,7 @@ impl Stepper {
         let dim = self.dim;
         let cand = self.candidates[self.active[which].cand];
         let geo = self.geometry(self.active[which].cand);
-        let fr = frame(dim, geo.normal);
-        // columns of G and M^{-1} G per side
-        let mut cols = [[[0.0; 6]; 3]; 2];
-        let mut bcols = [[[0.0; 6]; 3]; 2];
-        for s in 0..geo.nsides {
-            let (body, sign, r) = geo.sides[s];
-            let minv = &self.frozen[body].minv;
-            for (j, d) in fr.iter().enumerate().take(dim) {
-                let mut col = self.column(body, r, *d);
-                for x in &mut col {
-                    *x *= sign;
-                }
-                cols[s][j] = col;
-                bcols[s][j] =
-                    std::array::from_fn(|a| (0..6).map(|c| minv[a * 6 + c] * col[c]).sum());
-            }
-        }
+        let (cols, bcols) = self.columns_at(&geo);
         let side_dot = |s: usize, x: &[f64; 6], v: &[f64]| -> f64 {
             let b = &self.bodies[geo.sides[s].0];
             (0..b.nv).map(|k| x[k] * v[b.off_v + k]).sum()
@@ -246,33 +230,7 @@ impl Stepper {
             }
         }
         let approach = u[0].min(0.0);
-        let (impulse, error, iterations) = match self.settings.restitution {
-            Restitution::Poisson => {
-                let mut w3 = [[0.0; 3]; 3];
-                for a in 0..dim {
-                    for c in 0..dim {
-                        w3[a][c] = w[a * dim + c];
-                    }
-                }
-                let p = super::routh(dim, &w3, u, cand.mu, cand.e, 0.0);
-                (p, 0.0, 0)
-            }
-            Restitution::Newton => {
-                let mut q = u;
-                q[0] += cand.e * approach;
-                let mu = [cand.mu];
-                let problem = ContactProblem::new(dim, &w[..dim * dim], &q[..dim], &mu)?;
-                let settings = NsgsSettings {
-                    tol: 1e-14,
-                    max_iter: 100,
-                    ..NsgsSettings::default()
-                };
-                let sol = solve_nsgs(&problem, &settings)?;
-                let mut p = [0.0; 3];
-                p[..dim].copy_from_slice(&sol.impulse);
-                (p, sol.measures.error, sol.iterations)
-            }
-        };
+        let (impulse, error, iterations) = self.impact_law(&w, u, cand.mu, cand.e)?;
         // v+ = q'(s*) + M^{-1} G P, and the momentum balance M dv = G P at q(s*)
         let mut residual: f64 = 0.0;
         let mut scale: f64 = 0.0;
@@ -314,6 +272,69 @@ impl Stepper {
                 residual
             },
         })
+    }
+
+    /// the G columns of the contact frame's directions at a geometry, per side, and
+    /// `M^{-1}` times them.
+    #[allow(clippy::type_complexity)]
+    fn columns_at(&self, geo: &Geometry) -> ([[[f64; 6]; 3]; 2], [[[f64; 6]; 3]; 2]) {
+        let dim = self.dim;
+        let fr = frame(dim, geo.normal);
+        let mut cols = [[[0.0; 6]; 3]; 2];
+        let mut bcols = [[[0.0; 6]; 3]; 2];
+        for s in 0..geo.nsides {
+            let (body, sign, r) = geo.sides[s];
+            let minv = &self.frozen[body].minv;
+            for (j, d) in fr.iter().enumerate().take(dim) {
+                let mut col = self.column(body, r, *d);
+                for x in &mut col {
+                    *x *= sign;
+                }
+                cols[s][j] = col;
+                bcols[s][j] =
+                    std::array::from_fn(|a| (0..6).map(|c| minv[a * 6 + c] * col[c]).sum());
+            }
+        }
+        (cols, bcols)
+    }
+
+    /// the impulse of one contact's impact (W its `dim x dim` Delassus block row-major, u its
+    /// contact velocity before): Newton's law by NSGS on the single contact, or Poisson's by
+    /// Routh's method; with the solve's error and iterations.
+    fn impact_law(
+        &self,
+        w: &[f64; 9],
+        u: [f64; 3],
+        mu: f64,
+        e: f64,
+    ) -> Result<([f64; 3], f64, usize)> {
+        let dim = self.dim;
+        match self.settings.restitution {
+            Restitution::Poisson => {
+                let mut w3 = [[0.0; 3]; 3];
+                for a in 0..dim {
+                    for c in 0..dim {
+                        w3[a][c] = w[a * dim + c];
+                    }
+                }
+                Ok((super::routh(dim, &w3, u, mu, e, 0.0), 0.0, 0))
+            }
+            Restitution::Newton => {
+                let mut q = u;
+                q[0] += e * u[0].min(0.0);
+                let mu = [mu];
+                let problem = ContactProblem::new(dim, &w[..dim * dim], &q[..dim], &mu)?;
+                let settings = NsgsSettings {
+                    tol: 1e-14,
+                    max_iter: 100,
+                    ..NsgsSettings::default()
+                };
+                let sol = solve_nsgs(&problem, &settings)?;
+                let mut p = [0.0; 3];
+                p[..dim].copy_from_slice(&sol.impulse);
+                Ok((p, sol.measures.error, sol.iterations))
+            }
+        }
     }
 
     /// the records of a located step, the contacts' states, and the clock.
