@@ -5,8 +5,8 @@
 
 use super::super::impact::ImpactMemory;
 use super::bodies::norm3;
-use super::narrow::Candidate;
-use super::{dot_v, ContactRecord, PolyhedralSettings, StepSolver, Stepper};
+use super::narrow::{pad, Candidate};
+use super::{dot_v, ContactRecord, Pair, PolyhedralSettings, Scene, StepSolver, Stepper};
 
 /// What a candidate carries from one step to the next (reset when it is far).
 #[derive(Clone, Copy, Debug, Default)]
@@ -18,6 +18,46 @@ pub(super) struct CandState {
     /// the contact's variables in the last polyhedral LCP's final basis, for Lemke's warm
     /// start: bit 0 its normal impulse, bit 1 its λ, bit 2 + k its k-th β.
     pub(super) basis: u64,
+}
+
+/// The broad phase's spheres of a scene asking for [`Pair::Spheres`]: its `(mu, e)`, every
+/// point of every single-point shape as (body, body-frame centre, radius), and the sphere
+/// pairs `(i, j)`, `i < j`, declared explicitly (they keep their own mu and e).
+#[allow(clippy::type_complexity)]
+pub(super) fn sphere_points(
+    scene: &Scene,
+) -> (
+    Option<(f64, f64)>,
+    Vec<(usize, [f64; 3], f64)>,
+    Vec<(u32, u32)>,
+) {
+    let auto = scene.pairs.iter().find_map(|p| match *p {
+        Pair::Spheres { mu, e } => Some((mu, e)),
+        _ => None,
+    });
+    let mut balls = vec![];
+    let mut ball_of_shape = vec![None; scene.shapes.len()];
+    if auto.is_some() {
+        for (k, s) in scene.shapes.iter().enumerate() {
+            if s.points.len() == 1 {
+                ball_of_shape[k] = Some(balls.len() as u32);
+                balls.push((s.body, pad(&s.points[0]), s.radius));
+            }
+        }
+    }
+    let mut declared_balls: Vec<(u32, u32)> = scene
+        .pairs
+        .iter()
+        .filter_map(|p| match *p {
+            Pair::SphereSphere { a, b, .. } => match (ball_of_shape[a], ball_of_shape[b]) {
+                (Some(i), Some(j)) => Some((i.min(j), i.max(j))),
+                _ => None,
+            },
+            _ => None,
+        })
+        .collect();
+    declared_balls.sort_unstable();
+    (auto, balls, declared_balls)
 }
 
 impl Stepper {

@@ -23,8 +23,8 @@ mod persistence;
 mod solve;
 
 use self::bodies::{bodies_of, norm3, rotate, BodyInfo, Frozen};
-use self::narrow::{declared_candidates, frame, pad, Candidate, Geometry};
-use self::persistence::CandState;
+use self::narrow::{declared_candidates, frame, Candidate, Geometry};
+use self::persistence::{sphere_points, CandState};
 use self::solve::SolveBuffers;
 use super::broad::BroadPhase;
 use super::poisson::routh;
@@ -247,33 +247,7 @@ impl Stepper {
         let (off_q, off_v) = (q.len(), v.len());
         let candidates = declared_candidates(scene);
         let nc = candidates.len();
-        // the broad phase's spheres: every point of every single-point shape
-        let auto = scene.pairs.iter().find_map(|p| match *p {
-            Pair::Spheres { mu, e } => Some((mu, e)),
-            _ => None,
-        });
-        let mut balls = vec![];
-        let mut ball_of_shape = vec![None; scene.shapes.len()];
-        if auto.is_some() {
-            for (k, s) in scene.shapes.iter().enumerate() {
-                if s.points.len() == 1 {
-                    ball_of_shape[k] = Some(balls.len() as u32);
-                    balls.push((s.body, pad(&s.points[0]), s.radius));
-                }
-            }
-        }
-        let mut declared_balls: Vec<(u32, u32)> = scene
-            .pairs
-            .iter()
-            .filter_map(|p| match *p {
-                Pair::SphereSphere { a, b, .. } => match (ball_of_shape[a], ball_of_shape[b]) {
-                    (Some(i), Some(j)) => Some((i.min(j), i.max(j))),
-                    _ => None,
-                },
-                _ => None,
-            })
-            .collect();
-        declared_balls.sort_unstable();
+        let (auto, balls, declared_balls) = sphere_points(scene);
         Ok(Self {
             dim,
             settings: settings.clone(),
