@@ -377,6 +377,14 @@ impl BlockCsr {
         }
     }
 
+    /// replaces every stored value v by `f(v)` (an exact change of units by a power of two,
+    /// see [`super::normalize`]).
+    pub(crate) fn map_values(&mut self, f: impl Fn(f64) -> f64) {
+        for v in &mut self.values {
+            *v = f(*v);
+        }
+    }
+
     /// the dense row-major `(dim nc)^2` matrix (for tests and small problems).
     pub fn to_dense(&self) -> Vec<f64> {
         let d = self.dim;
