@@ -275,6 +275,33 @@ impl<'a> ContactProblem<'a> {
         }
     }
 
+    /// `((W x)_i, (|W| |x|)_i)`: the `dim` components of contact i and the sums of the
+    /// magnitudes of their terms (zero-padded to 3; O(tiles in the row) for block-sparse
+    /// storage); the first is bitwise [`Self::block_row_mul`].
+    pub fn block_row_terms(&self, i: usize, x: &[f64]) -> ([f64; 3], [f64; 3]) {
+        match self.w {
+            Delassus::Dense(w) => {
+                let n = self.size();
+                let d = self.dim;
+                let mut out = [0.0; 3];
+                let mut terms = [0.0; 3];
+                for a in 0..d {
+                    let row = &w[(i * d + a) * n..(i * d + a + 1) * n];
+                    let (mut s, mut t) = (0.0, 0.0);
+                    for (p, q) in row.iter().zip(x) {
+                        let v = p * q;
+                        s += v;
+                        t += v.abs();
+                    }
+                    out[a] = s;
+                    terms[a] = t;
+                }
+                (out, terms)
+            }
+            Delassus::BlockSparse(s) => s.row_mul_terms(i, x),
+        }
+    }
+
     /// `Σ_{j != i} W_ij x_j`: what the other contacts' impulses add to contact i's velocity
     /// (zero-padded to 3; O(tiles in the row) for block-sparse storage).
     #[inline]
