@@ -9,11 +9,10 @@
 //! may have no solution. Short by default; `COULOMB_PROPERTIES=long cargo test --release
 //! --test contact_properties` runs the long profile (docs/properties.md).
 
-use coulomb::contact::{
-    solve, ContactOrder, ContactProblem, ContactSolution, Method, NsgsSettings,
-    PolyhedralSettings,
-};
 use coulomb::contact::prox::ProxSettings;
+use coulomb::contact::{
+    solve, ContactOrder, ContactProblem, ContactSolution, Method, NsgsSettings, PolyhedralSettings,
+};
 use coulomb::testing::SplitMix64;
 use proptest::prelude::*;
 
@@ -232,7 +231,11 @@ fn power_of_two_units_scale_every_answer_exactly() {
             };
             for k in 0..3 {
                 let (a, b) = (run(&p, k), run(&scaled, k));
-                assert_eq!((a.status, a.iterations), (b.status, b.iterations), "seed {seed}");
+                assert_eq!(
+                    (a.status, a.iterations),
+                    (b.status, b.iterations),
+                    "seed {seed}"
+                );
                 for (x, y) in a.impulse.iter().zip(&b.impulse) {
                     assert_eq!(x * 2f64.powi(e), *y, "seed {seed} method {k} e {e}");
                 }

@@ -10,7 +10,9 @@ use coulomb::contact::{
 use coulomb::lcp::{solve_enumerate, solve_lemke, EnumerateSettings, LcpRef, LemkeSettings};
 
 fn close(a: &[f64], b: &[f64], tol: f64) -> bool {
-    a.iter().zip(b).all(|(x, y)| (x - y).abs() <= tol * y.abs().max(1.0))
+    a.iter()
+        .zip(b)
+        .all(|(x, y)| (x - y).abs() <= tol * y.abs().max(1.0))
 }
 
 #[test]
@@ -44,7 +46,10 @@ fn a_sticking_contact_with_a_huge_mu_pushes() {
         let mus = [mu];
         let p = ContactProblem::new(2, &w, &q, &mus).unwrap();
         let out = solve_nsgs(&p, &NsgsSettings::default()).unwrap();
-        assert!(out.success() && close(&out.impulse, &[6.0, -2.0], 1e-12), "{out:?}");
+        assert!(
+            out.success() && close(&out.impulse, &[6.0, -2.0], 1e-12),
+            "{out:?}"
+        );
         // r = 0 is not a solution, whatever De Saxce's map says
         let (_, m) = measure(&p, &[0.0, 0.0]).unwrap();
         assert!(!m.passes(1e-8) && m.error_q < 1e-7, "{m:?}");
@@ -74,8 +79,11 @@ fn lcp_measures_neither_overflow_nor_underflow() {
     let (m, q) = coulomb::testing::dense_spd(6, 5);
     let n = 6;
     let md: Vec<f64> = (0..n * n).map(|k| m.get(k / n, k % n)).collect();
-    let base = solve_enumerate(&LcpRef::new(n, &md, &q).unwrap(), &EnumerateSettings::default())
-        .unwrap();
+    let base = solve_enumerate(
+        &LcpRef::new(n, &md, &q).unwrap(),
+        &EnumerateSettings::default(),
+    )
+    .unwrap();
     for s in [1e-200, 1e200, 1e300] {
         let ms: Vec<f64> = md.iter().map(|v| v * s).collect();
         let qs: Vec<f64> = q.iter().map(|v| v * s).collect();
@@ -84,7 +92,11 @@ fn lcp_measures_neither_overflow_nor_underflow() {
         let l = solve_lemke(&lcp, &LemkeSettings::default()).unwrap();
         for out in [&e, &l] {
             assert_eq!(out.status, base.status, "scale {s}: {}", out.message);
-            assert!(out.measures.error.is_finite(), "scale {s}: {:?}", out.measures);
+            assert!(
+                out.measures.error.is_finite(),
+                "scale {s}: {:?}",
+                out.measures
+            );
             assert!(close(&out.z, &base.z, 1e-9), "scale {s}");
         }
     }

@@ -40,11 +40,12 @@ Methods:
     ``W_nn``), so Lemke's relative pivot tests see every entry at W's scale: with the raw form,
     data of size 1e-10 lost their friction. In 2D the polygon is exact and ``success`` follows
     the rule below; in 3D ``success`` means the polyhedral LCP was solved (to ``tol`` by
-    Lemke's rule, the LCP's own error is in ``message``); ``iterations`` counts Lemke's pivots and ``max_iter`` (if given) limits
-    them. The measures below are still taken against the exact disk, so in 3D ``error``
-    reflects the facet approximation (it shrinks as ``facets`` grows, not monotonically: a
-    sliding contact's impulse snaps to a facet). With anisotropic friction the directions are
-    scaled along the tangents so that the polygon is inscribed in the ellipse.
+    Lemke's rule, the LCP's own error is in ``message``); ``iterations`` counts Lemke's
+    pivots and ``max_iter`` (if given) limits them. The measures below are still taken
+    against the exact disk, so in 3D they reflect the facet approximation (they shrink as
+    ``facets`` grows, not monotonically: a sliding contact's impulse snaps to a facet). With
+    anisotropic friction the directions are scaled along the tangents so that the polygon is
+    inscribed in the ellipse.
 ``"prox"`` (the robust mode)
     A proximal-point semismooth Newton method on the natural map (Rust ``contact::prox``):
     each iteration is one Newton step on the proximal subproblem ``W + eta I`` centred at the

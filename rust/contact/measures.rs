@@ -350,7 +350,11 @@ pub(crate) fn measure_into(
         // size = 0 means r_i = 0 and every term of u_i is 0: both maps are exactly 0 there
         let rel = if size > 0.0 { err / size } else { err };
         // NaN propagates (f64::max would drop it)
-        scaled = if rel.is_nan() || rel > scaled { rel } else { scaled };
+        scaled = if rel.is_nan() || rel > scaled {
+            rel
+        } else {
+            scaled
+        };
         min_n = min_n.min(ri[0]);
         comp = comp.max((ri[0] * ui[0]).abs());
         cone = cone.max(viol);
@@ -447,7 +451,9 @@ mod tests {
             }
             let q: Vec<f64> = (0..n).map(|_| rng.normal()).collect();
             let r: Vec<f64> = (0..n).map(|_| rng.normal()).collect();
-            let mu: Vec<f64> = (0..nc).map(|_| [0.0, 0.3, 2.0, 1e8][rng.below(4)]).collect();
+            let mu: Vec<f64> = (0..nc)
+                .map(|_| [0.0, 0.3, 2.0, 1e8][rng.below(4)])
+                .collect();
             let p = ContactProblem::new(dim, &w, &q, &mu).unwrap();
             let (_, m) = measure(&p, &r).unwrap();
             for (a, b) in [(1e-8, 1e8), (1e8, 1.0), (1e-200, 1e-200), (1.0, 1e300)] {
@@ -494,7 +500,10 @@ mod tests {
         let (w, q) = ([0.5e-200, 0.0, 0.0, 0.5e-200], [-3e-200, 1e-200]);
         let p = ContactProblem::new(2, &w, &q, &[0.2]).unwrap();
         let (_, m) = measure(&p, &[0.0, 0.0]).unwrap();
-        assert!((m.scaled_error - 6.0 / (2.0 * 10f64.sqrt())).abs() < 1e-15, "{m:?}");
+        assert!(
+            (m.scaled_error - 6.0 / (2.0 * 10f64.sqrt())).abs() < 1e-15,
+            "{m:?}"
+        );
         assert!(m.error_q > 0.5, "{m:?}");
     }
 

@@ -31,9 +31,9 @@ pub mod sparse;
 
 use crate::error::{check_finite, CoulombError, Result};
 
+pub(crate) use measures::measure_into;
 pub use measures::{measure, ContactMeasures};
 pub use normalize::{solve, Method};
-pub(crate) use measures::measure_into;
 pub use nsgs::{solve_nsgs, ContactOrder, NsgsSettings};
 pub use polyhedral::{solve_polyhedral, PolyhedralSettings};
 pub use sparse::BlockCsr;

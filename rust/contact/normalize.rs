@@ -163,7 +163,10 @@ mod tests {
     fn ldexp_is_exact_over_the_range() {
         assert_eq!(ldexp(1.5, 3), 12.0);
         assert_eq!(ldexp(3.0, -1), 1.5);
-        assert_eq!(ldexp(1.0, 1023), f64::from_bits(((1023 + 1023) as u64) << 52));
+        assert_eq!(
+            ldexp(1.0, 1023),
+            f64::from_bits(((1023 + 1023) as u64) << 52)
+        );
         assert_eq!(ldexp(ldexp(0.7, 900), -900), 0.7);
         assert_eq!(ldexp(ldexp(0.7, -1000), 1000), 0.7);
         assert_eq!(ldexp(1.0, -1074), f64::from_bits(1));

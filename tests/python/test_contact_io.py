@@ -33,7 +33,6 @@ MUST_SOLVE = (
     "FC2D_SliderCrankLagrangian00000",
     "FrictionContactProblem00071",
     "NESpheres_10_1",
-    "OneObject-i1028-138.hdf5",
 )
 
 
@@ -162,8 +161,24 @@ def test_rover_nsgs_stall_is_not_reported_as_solved(problems):
     assert s.max_complementarity < 1e-3 * r.max_complementarity
 
 
-def test_iteration_limit_on_a_real_problem(problems):
+def test_one_object_nsgs_stall_is_not_reported_as_solved(problems):
+    """OneObject-i1028-138 used to be "solved" by NSGS (error_q 5.9e-7 <= 1e-6): NSGS stalls
+    there (the same figures after 1e3 and 1e5 sweeps) with a contact off the law by 9.5e-6 of
+    its own scale (contact_gen.law_violation, independent of coulomb's measures). The
+    unit-consistent measure, taken contact by contact, says so; the robust mode solves it."""
+    from contact_gen import law_violation
+
     p = problems["OneObject-i1028-138.hdf5"]
+    r = contact.solve(p.W, p.q, p.mu, p.dim, tol=TOL, max_iter=MAX_ITER)
+    assert not r.success and r.status == "iteration_limit"
+    assert law_violation(p.W, p.q, p.mu, p.dim, r.impulse) > 1e-6 >= r.error_q
+    s = contact.solve(p.W, p.q, p.mu, p.dim, tol=TOL, method="prox")
+    assert s.success and law_violation(p.W, p.q, p.mu, p.dim, s.impulse) <= 1e-6
+
+
+def test_iteration_limit_on_a_real_problem(problems):
+    # (OneObject-i1028-138, used here before, is not solved by NSGS: see above)
+    p = problems["FrictionContactProblem00071"]
     r = contact.solve(p.W, p.q, p.mu, p.dim, tol=TOL, max_iter=1)
     assert not r.success
     assert r.status == "iteration_limit" and r.iterations == 1

@@ -8,8 +8,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from coulomb import contact, lcp
 from contact_gen import law_violation
+from coulomb import contact, lcp
 from helpers import contact_scaled_error
 
 METHODS = ("nsgs", "prox", "lemke")
