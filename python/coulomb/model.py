@@ -516,7 +516,7 @@ class Scene:
             restitution=restitution,
         )
         return Trajectory._from_core(raw, scene=self, h=h, solver=solver,
-                                     gap_tolerance=gap_tolerance)
+                                     gap_tolerance=gap_tolerance, tol=tol)
 
 
 # --- user-defined models in generalized coordinates -----------------------------------------
@@ -654,7 +654,7 @@ class Model:
         landed = np.zeros(nc, dtype=bool)
         rec: dict[str, list[Any]] = {k: [] for k in (
             "t", "q", "v", "kinetic_energy", "potential_energy", "min_gap", "negative_gaps",
-            "active", "status", "error", "iterations", "momentum_residual",
+            "active", "status", "error", "scaled_error", "iterations", "momentum_residual",
             "min_normal_impulse", "cone_violation", "complementarity", "resumed", "fallback",
             "contact_step", "contact_id", "contact_impulse", "contact_velocity",
             "contact_approach", "contact_gap", "contact_closed")}
@@ -688,6 +688,7 @@ class Model:
             v_next = v_free.copy()
             gp = np.zeros(q.size)
             status, err, iters, mn, cone, comp = "no_contact", 0.0, 0, 0.0, 0.0, 0.0
+            serr = 0.0
             if active:
                 G = np.vstack([rows for _, _, rows, _, _ in active])  # (dim na, nv)
                 minv_gt = np.linalg.solve(m, G.T)
@@ -717,13 +718,17 @@ class Model:
                     if not res.success and fallback and solver == "nsgs":
                         alt = _contact.solve(W, qc, mus, dim=dim, method="lemke",
                                              tol=max(tol, 1e-9))
-                        if alt.error < res.error:
+                        if alt.scaled_error < res.scaled_error:
                             used_fallback = True
-                            res = alt
-                            if alt.error <= max(tol, 1e-9):
+                            first_status, res = res.status, alt
+                            if alt.scaled_error <= max(tol, 1e-9):
                                 res["status"] = "solved"
+                            elif alt.status == "solved":
+                                # a polygon's answer (3D) that misses the exact cone
+                                res["status"] = first_status
                     r = res.impulse.reshape(-1)
                     status, err, iters = res.status, res.error, res.iterations
+                    serr = res.scaled_error
                     mn, cone = res.min_normal_impulse, res.cone_violation
                     comp = res.max_complementarity
                 gp = G.T @ r
@@ -749,6 +754,7 @@ class Model:
             res_norm = float(np.linalg.norm(mdv - gp))
             rec["momentum_residual"].append(res_norm / scale if scale > 1e-300 else res_norm)
             for key, val in (("active", len(active)), ("status", status), ("error", err),
+                             ("scaled_error", serr),
                              ("iterations", iters), ("min_normal_impulse", mn),
                              ("cone_violation", cone), ("complementarity", comp),
                              ("resumed", resumed), ("fallback", used_fallback)):
@@ -776,4 +782,4 @@ class Model:
             else:
                 raw[key] = np.array(val, dtype=np.float64)
         return Trajectory._from_core(raw, scene=None, h=h, solver=solver,
-                                     gap_tolerance=gap_tolerance)
+                                     gap_tolerance=gap_tolerance, tol=tol)

@@ -18,7 +18,7 @@ use pyo3::types::{PyDict, PyType};
 
 mod step;
 
-use crate::contact::prox::{solve_prox, ProxSettings};
+use crate::contact::prox::ProxSettings;
 use crate::contact::{
     self, BlockCsr, ContactProblem, ContactSolution, NsgsSettings, PolyhedralSettings,
 };
@@ -347,6 +347,7 @@ fn contact_dict<'py>(
     let m = s.measures;
     d.set_item(intern!(py, "error"), m.error)?;
     d.set_item(intern!(py, "error_q"), m.error_q)?;
+    d.set_item(intern!(py, "scaled_error"), m.scaled_error)?;
     d.set_item(intern!(py, "min_normal_impulse"), m.min_normal_impulse)?;
     d.set_item(intern!(py, "max_complementarity"), m.max_complementarity)?;
     d.set_item(intern!(py, "cone_violation"), m.cone_violation)?;
@@ -552,20 +553,13 @@ fn contact_solve<'py>(
         if let Some(p) = pairs {
             problem = problem.with_anisotropic_friction(p)?;
         }
-        let s = match &settings {
-            ContactSettings::Nsgs(s) => contact::solve_nsgs(&problem, s)?,
-            ContactSettings::Lemke(s) => contact::solve_polyhedral(&problem, s)?,
-            ContactSettings::Prox(s) => {
-                if !problem.is_isotropic() {
-                    return Err(CoulombError::InvalidParameter(
-                        "the robust mode (prox) takes isotropic friction; solve anisotropic \
-                         (mu_1, mu_2) pairs with 'nsgs' or 'lemke'"
-                            .into(),
-                    ));
-                }
-                solve_prox(&problem, s)?
-            }
+        // every method runs in normalized units and is judged on the original data
+        let method = match &settings {
+            ContactSettings::Nsgs(s) => contact::Method::Nsgs(s.clone()),
+            ContactSettings::Lemke(s) => contact::Method::Polyhedral(s.clone()),
+            ContactSettings::Prox(s) => contact::Method::Prox(s.clone()),
         };
+        let s = contact::solve(&problem, &method)?;
         Ok((s, problem.nc, start.elapsed().as_secs_f64()))
     })?;
     contact_dict(py, solution, nc, dim, seconds)

@@ -265,6 +265,10 @@ pub(super) fn step_simulate<'py>(
     d.set_item("status", PyList::new(py, status)?)?;
     d.set_item("error", PyArray1::from_vec(py, col_f(|r| r.error)))?;
     d.set_item(
+        "scaled_error",
+        PyArray1::from_vec(py, col_f(|r| r.scaled_error)),
+    )?;
+    d.set_item(
         "iterations",
         PyArray1::from_vec(
             py,

@@ -27,6 +27,9 @@ pub struct StepRecord {
     pub status: Option<ContactStatus>,
     /// the contact solver's error (natural-map residual, relative); 0 without contacts.
     pub error: f64,
+    /// the contact solver's unit-consistent error, the measure its verdict (`status`) is
+    /// taken on ([`crate::contact::ContactMeasures::passes`]); 0 without contacts.
+    pub scaled_error: f64,
     /// the contact solver's sweeps or pivots.
     pub iterations: usize,
     /// `||M (v_{k+1} - v_free) - G P||` divided by `max(||G P||, ||M v_free||, ||M v_{k+1}||)`
@@ -944,6 +947,7 @@ impl Stepper {
             active: nc,
             status: None,
             error: 0.0,
+            scaled_error: 0.0,
             iterations: 0,
             momentum_residual: 0.0,
             min_normal_impulse: 0.0,
@@ -1028,6 +1032,7 @@ impl Stepper {
             self.p_impact = p_impact;
             record.status = Some(out.status);
             record.error = out.measures.error;
+            record.scaled_error = out.measures.scaled_error;
             record.iterations = out.iterations;
             record.min_normal_impulse = out.measures.min_normal_impulse;
             record.cone_violation = out.measures.cone_violation;
@@ -1581,7 +1586,7 @@ fn solve_step_problem(
             if let Some(init) = initial {
                 ws.velocity.resize(n, 0.0);
                 let m = measure_into(problem, init, &mut ws.velocity);
-                if m.error <= s.tol && m.cone_violation == 0.0 {
+                if m.passes(s.tol) && m.cone_violation == 0.0 {
                     ws.impulse.clear();
                     ws.impulse.extend_from_slice(init);
                     return Ok(Outcome {
@@ -1590,7 +1595,7 @@ fn solve_step_problem(
                         measures: m,
                     });
                 }
-                if m.error <= POLISH_NEAR * s.tol && problem.nc <= LEMKE_FALLBACK_MAX {
+                if m.passes(POLISH_NEAR * s.tol) && problem.nc <= LEMKE_FALLBACK_MAX {
                     // nearly solved already (a resting or sticking body whose velocity
                     // residual has built up): a few sweeps towards POLISH_TOL s.tol, so
                     // that the next steps' impulses stay within tol for longer
@@ -1601,7 +1606,7 @@ fn solve_step_problem(
                         ..s.clone()
                     };
                     let p = solve_nsgs(problem, &polish)?;
-                    if p.measures.error <= s.tol {
+                    if p.measures.passes(s.tol) {
                         let mut out = ws.take(p);
                         out.status = ContactStatus::Solved;
                         return Ok(out);
@@ -1647,8 +1652,8 @@ fn solve_step_problem(
                 };
                 ws.take(solve_prox(problem, &prox)?)
             };
-            let better = second.measures.error < first.measures.error;
-            if large && budget < s.max_iter && !(better && second.measures.error <= s.tol) {
+            let better = second.measures.scaled_error < first.measures.scaled_error;
+            if large && budget < s.max_iter && !(better && second.measures.passes(s.tol)) {
                 // the robust mode did not reach the tolerance either: NSGS's remaining
                 // sweeps from the better answer, and the best of the three
                 let from = if better {
@@ -1663,11 +1668,11 @@ fn solve_step_problem(
                 };
                 let third = solve_nsgs(problem, &rest)?;
                 let best_so_far = if better {
-                    second.measures.error
+                    second.measures.scaled_error
                 } else {
-                    first.measures.error
+                    first.measures.scaled_error
                 };
-                if third.measures.error <= best_so_far {
+                if third.measures.scaled_error <= best_so_far {
                     record.fallback = better;
                     return Ok(ws.take(ContactSolution {
                         iterations: budget + third.iterations,
@@ -1678,8 +1683,12 @@ fn solve_step_problem(
             if better {
                 record.fallback = true;
                 Ok(Outcome {
-                    status: if second.measures.error <= tol {
+                    // NSGS's contract is the exact cone: a polygon's answer (3D) that misses it
+                    // keeps NSGS's verdict
+                    status: if second.measures.passes(tol) {
                         ContactStatus::Solved
+                    } else if second.status == ContactStatus::Solved {
+                        first.status
                     } else {
                         second.status
                     },
