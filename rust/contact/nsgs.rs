@@ -372,7 +372,8 @@ pub fn solve_nsgs(problem: &ContactProblem<'_>, s: &NsgsSettings) -> Result<Cont
     let mut measures = measure_into(problem, &r, &mut u);
     let mut sweeps = 0;
     // a NaN error compares false and ends the loop too
-    while measures.error > s.tol && sweeps < s.max_iter {
+    // (the caller's interrupt hook can end the sweeps early, see crate::interrupt)
+    while measures.error > s.tol && sweeps < s.max_iter && !crate::interrupt::poll(n * n) {
         for &i in &sequence {
             let blk = &blocks[i];
             // W is finite, so this is the degenerate test above
