@@ -79,9 +79,12 @@ def real(
     low_open: bool = False,
     high_open: bool = False,
     finite: bool = True,
+    data: bool = False,
 ) -> float:
     """A real number (int or float, Python or numpy; not a bool, string, None or complex),
-    finite unless ``finite=False``, within the bounds given (closed unless ``*_open``)."""
+    finite unless ``finite=False``, within the bounds given (closed unless ``*_open``). A NaN
+    or infinity raises :class:`NonFiniteError` for ``data=True`` (a physical value such as a
+    mass or a time), :class:`InvalidParameterError` otherwise (an option such as ``tol``)."""
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
         raise ArgumentTypeError(f"{name} must be a real number, got {_kind(value)}")
     try:
@@ -89,13 +92,17 @@ def real(
     except OverflowError:
         raise InvalidParameterError(f"{name} is too large for a float: {value}") from None
     if math.isnan(v) or (finite and math.isinf(v)):
-        raise InvalidParameterError(f"{name} must be a finite number, got {v}")
+        raise (NonFiniteError if data else InvalidParameterError)(
+            f"{name} must be a finite number, got {v}"
+        )
     lo_ok = low is None or (v > low if low_open else v >= low)
     hi_ok = high is None or (v < high if high_open else v <= high)
     if not (lo_ok and hi_ok):
         lo = "-inf" if low is None else f"{low:g}"
         hi = "inf" if high is None else f"{high:g}"
-        span = f"{'(' if low is None or low_open else '['}{lo}, {hi}{')' if high is None or high_open else ']'}"
+        left = "(" if low is None or low_open else "["
+        right = ")" if high is None or high_open else "]"
+        span = f"{left}{lo}, {hi}{right}"
         raise InvalidParameterError(f"{name} must lie in {span}, got {v:g}")
     return v
 
@@ -133,11 +140,11 @@ def unused(method_name: str, method: str, **given: Any) -> None:
             )
 
 
-def array(x: Any, name: str, ndim: int) -> NDArray[np.float64]:
+def array(x: Any, name: str, ndim: int | None) -> NDArray[np.float64]:
     """A float64, C-contiguous array of ``ndim`` dimensions (no copy when it already is one),
     refusing None, ragged nested lists, strings, objects, complex numbers and wrong
-    dimensions with a message naming the argument. NaN and infinity pass (checked where the
-    data are used, with their position)."""
+    dimensions with a message naming the argument (``ndim=None``: any dimension). NaN and
+    infinity pass (checked where the data are used, with their position)."""
     if (
         type(x) is np.ndarray
         and x.dtype == _F64
@@ -155,7 +162,7 @@ def array(x: Any, name: str, ndim: int) -> NDArray[np.float64]:
         raw = np.asarray(x)
     except ValueError:
         raise ShapeError(
-            f"{name} must be a rectangular array of real numbers ({ndim}-D); got nested "
+            f"{name} must be a rectangular array of real numbers; got nested "
             "sequences of unequal lengths"
         ) from None
     kind = raw.dtype.kind
@@ -173,7 +180,7 @@ def array(x: Any, name: str, ndim: int) -> NDArray[np.float64]:
         raise ArgumentTypeError(
             f"{name} must be an array of real numbers, got an array of dtype {raw.dtype}"
         )
-    if raw.ndim != ndim:
+    if ndim is not None and raw.ndim != ndim:
         raise ShapeError(f"{name} must be {ndim}-D, got shape {raw.shape}")
     try:
         return np.ascontiguousarray(raw, dtype=np.float64)
@@ -186,7 +193,9 @@ def finite_array(x: Any, name: str, ndim: int) -> NDArray[np.float64]:
     a = array(x, name, ndim)
     if not np.isfinite(a).all():
         k = int(np.flatnonzero(~np.isfinite(a.reshape(-1)))[0])
-        raise NonFiniteError(f"{name} has a non-finite entry ({a.reshape(-1)[k]}) at flat index {k}")
+        raise NonFiniteError(
+            f"{name} has a non-finite entry ({a.reshape(-1)[k]}) at flat index {k}"
+        )
     return a
 
 
