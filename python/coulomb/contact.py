@@ -270,7 +270,7 @@ def solve(
     # W and q are checked for NaN and infinity by the core, before any work
     init = None
     if initial is not None:
-        r0 = _as_array(initial, "initial", np.ndim(initial))
+        r0 = _as_array(initial, "initial", None)
         if r0.shape not in ((nc, dim), (n,)):
             raise ShapeError(f"initial must have shape ({nc}, {dim}) or ({n},), got {r0.shape}")
         init = np.ascontiguousarray(r0.reshape(n))

@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 
 from . import _core, _validate
 from ._assembly import assemble
-from .errors import ProblemFormatError, ProblemTooLargeError, ShapeError
+from .errors import ArgumentTypeError, ProblemFormatError, ProblemTooLargeError, ShapeError
 
 __all__ = [
     "FrictionContactProblem",
@@ -44,13 +44,23 @@ class LcpProblem:
         return int(self.q.shape[0])
 
 
+def _path(path: Any) -> str:
+    """``os.fspath(path)``, refusing anything that is not a path with a coulomb error."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise ArgumentTypeError(f"path must be a str or os.PathLike, got {path!r}")
+    p = os.fspath(path)
+    if not isinstance(p, str):
+        raise ArgumentTypeError(f"path must be a str or os.PathLike of str, got {path!r}")
+    return p
+
+
 def read_siconos_lcp(path: str | os.PathLike[str]) -> LcpProblem:
     """Read a Siconos LCP file (``lcp_*.dat``), dense or sparse-block storage.
 
     Raises ``FileNotFoundError`` for a missing file and
     :class:`coulomb.errors.ProblemFormatError` for a malformed one.
     """
-    M, q = _core.read_siconos_lcp(os.fspath(path))
+    M, q = _core.read_siconos_lcp(_path(path))
     return LcpProblem(M=M, q=q, name=os.path.splitext(os.path.basename(os.fspath(path)))[0])
 
 
@@ -109,7 +119,7 @@ def read_siconos_fc(
     ``FileNotFoundError`` for a missing file and :class:`coulomb.errors.ProblemFormatError`
     for a malformed one.
     """
-    d = _core.read_siconos_fc(os.fspath(path))
+    d = _core.read_siconos_fc(_path(path))
     if d["kind"] == "global":
         return GlobalFrictionContactProblem(
             M=d["M"], H=d["H"], q=d["q"], b=d["b"], mu=d["mu"], dim=int(d["dim"]), name=_name(path)
@@ -261,7 +271,7 @@ def read_fclib(path: str | os.PathLike[str]) -> FrictionContactProblem:
         import scipy.sparse  # noqa: F401
     except ImportError as exc:
         raise ImportError("reading FCLib files needs scipy (pip install scipy)") from exc
-    p = os.fspath(path)
+    p = _path(path)
     if not os.path.exists(p):
         raise FileNotFoundError(p)
     try:

@@ -109,7 +109,7 @@ class LcpResult(Result):
     solve_time: float
 
 
-def _as_array(x: ArrayLike, name: str, ndim: int) -> NDArray[np.float64]:
+def _as_array(x: ArrayLike, name: str, ndim: int | None) -> NDArray[np.float64]:
     """float64, C-contiguous, of the given dimension; no copy when it already is (see
     :func:`coulomb._validate.array` for what is refused)."""
     return _validate.array(x, name, ndim)
