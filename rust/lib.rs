@@ -14,8 +14,10 @@
 
 pub mod contact;
 pub mod error;
+pub mod interrupt;
 pub mod io;
 pub mod lcp;
+pub mod limits;
 pub mod matrix;
 pub mod step;
 pub mod testing;

@@ -120,7 +120,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import _core
+from . import _core, _validate
 from ._assembly import assemble, post_velocity
 from ._result import Result
 from .errors import InvalidInputError, InvalidParameterError, NonFiniteError, ShapeError
@@ -250,9 +250,8 @@ def solve(
         ``dim`` not 2 or 3, an unknown method, ``tol <= 0``, ``max_iter < 1``, ``relaxation``
         outside (0, 2), ``facets`` odd or too small, or an option the method does not take).
     """
-    if isinstance(dim, bool) or not isinstance(dim, (int, np.integer)) or dim not in (2, 3):
-        raise InvalidParameterError(f"dim must be 2 (planar) or 3 (spatial), got {dim!r}")
-    dim = int(dim)
+    dim, tol, max_iter, relaxation, facets, eta = _validate.contact_options(
+        dim, method, tol, max_iter, relaxation, facets, eta)
     if method not in _METHODS:
         raise InvalidParameterError(
             f"unknown method {method!r}: expected 'nsgs' (exact friction disk), 'lemke' "
@@ -298,7 +297,7 @@ def solve(
     # W and q are checked for NaN and infinity by the core, before any work
     init = None
     if initial is not None:
-        r0 = _as_array(initial, "initial", np.ndim(initial))
+        r0 = _as_array(initial, "initial", None)
         if r0.shape not in ((nc, dim), (n,)):
             raise ShapeError(f"initial must have shape ({nc}, {dim}) or ({n},), got {r0.shape}")
         init = np.ascontiguousarray(r0.reshape(n))
@@ -372,6 +371,7 @@ def _delassus(
     shape = tuple(W.shape)  # type: ignore[attr-defined]
     if shape != (n, n):
         raise ShapeError(f"W must have shape ({n}, {n}) to match q of length {n}, got {shape}")
+    _validate.sparse_structure("W", W)  # before scipy's conversion trusts the indices
     csr = W.tocsr()  # type: ignore[attr-defined]  # no copy when already CSR
     data = csr.data
     if np.iscomplexobj(data):

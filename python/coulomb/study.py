@@ -32,8 +32,9 @@ from typing import Any
 
 import numpy as np
 
+from . import _validate
 from ._extras import require
-from .errors import InvalidParameterError
+from .errors import ArgumentTypeError, InvalidParameterError
 
 __all__ = [
     "Study",
@@ -285,8 +286,9 @@ def sweep(
     progress
         True prints one line per finished point to stderr; or a callable taking the line.
     """
-    if repeat < 1:
-        raise InvalidParameterError(f"repeat must be >= 1, got {repeat}")
+    if not callable(run):
+        raise ArgumentTypeError(f"run must be a callable returning a mapping, got {run!r}")
+    repeat = _validate.count("repeat", repeat)
     if reference is not None and reference_settings is not None:
         raise InvalidParameterError("give reference or reference_settings, not both")
     points = _grid_points(grid)

@@ -374,8 +374,13 @@ pub fn solve_nsgs(problem: &ContactProblem<'_>, s: &NsgsSettings) -> Result<Cont
     let mut u = vec![0.0; n];
     let mut measures = measure_into(problem, &r, &mut u);
     let mut sweeps = 0;
-    // a NaN error fails `passes` and is caught by the finiteness test below
-    while !measures.passes(s.tol) && measures.scaled_error.is_finite() && sweeps < s.max_iter {
+    // a NaN error fails `passes` and is caught by the finiteness test below; the caller's
+    // interrupt hook can end the sweeps early (see crate::interrupt)
+    while !measures.passes(s.tol)
+        && measures.scaled_error.is_finite()
+        && sweeps < s.max_iter
+        && !crate::interrupt::poll(n * n)
+    {
         for &i in &sequence {
             let blk = &blocks[i];
             // W is finite, so this is the degenerate test above

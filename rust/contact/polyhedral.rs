@@ -117,6 +117,7 @@ impl PolyhedralLcp {
     pub fn new(problem: &ContactProblem<'_>, facets: usize) -> Result<Self> {
         let dim = problem.dim;
         check_facets(dim, facets)?;
+        check_size(problem, facets)?;
         let directions: Vec<[f64; 2]> = if dim == 2 {
             vec![[1.0, 0.0], [-1.0, 0.0]]
         } else {
@@ -280,6 +281,31 @@ fn axis_scale(problem: &ContactProblem<'_>, i: usize) -> [f64; 2] {
         }
         None => [1.0, 1.0],
     }
+}
+
+/// refuses, before any allocation, a dense LCP (`n = nc + (facets + 1) n_f` unknowns for `n_f`
+/// frictional contacts) whose matrix and Lemke workspace exceed the memory budget.
+fn check_size(problem: &ContactProblem<'_>, facets: usize) -> Result<()> {
+    let nf = problem.mu.iter().filter(|&&m| m > 0.0).count();
+    let n = facets
+        .checked_add(1)
+        .and_then(|f| f.checked_mul(nf))
+        .and_then(|x| x.checked_add(problem.nc));
+    let entries = n
+        .and_then(crate::limits::dense_lemke_entries)
+        .unwrap_or(usize::MAX);
+    crate::limits::check_bytes(
+        &format!(
+            "the dense polyhedral LCP of {} contacts ({nf} with friction) with {facets} facets \
+             ({} unknowns)",
+            problem.nc,
+            n.map_or_else(|| "too many".to_string(), |n| n.to_string())
+        ),
+        entries,
+        8,
+        "use fewer facets, or method 'nsgs' or 'prox', whose memory grows with W's nonzeros",
+    )
+    .map(|_| ())
 }
 
 fn check_facets(dim: usize, facets: usize) -> Result<()> {

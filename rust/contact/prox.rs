@@ -381,6 +381,9 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
     let mut finish_tried = false;
     let mut finish: Option<(usize, usize, usize)> = None;
     while iterations < s.max_iter {
+        if crate::interrupt::poll(problem.size() * problem.size()) {
+            break; // the caller's interrupt hook asked to stop (see crate::interrupt)
+        }
         if measures.passes(s.tol) {
             r_try.copy_from_slice(&r);
             for (ri, &mu) in r_try.chunks_exact_mut(dim).zip(problem.mu) {

@@ -54,7 +54,7 @@
 pub mod broad;
 mod stepper;
 
-pub use stepper::{simulate, ContactRecord, StepRecord, Stepper, Trajectory};
+pub use stepper::{simulate, simulate_recorded, ContactRecord, StepRecord, Stepper, Trajectory};
 
 use crate::contact::{NsgsSettings, PolyhedralSettings};
 use crate::error::{check_finite, CoulombError, Result};
