@@ -549,8 +549,10 @@ class Scene:
             fallback=fallback, drift=drift, drift_bias=float(drift_bias),
             restitution=restitution, record_every=record_every,
         )
-        return Trajectory._from_core(raw, scene=self, h=h, solver=solver,
-                                     gap_tolerance=gap_tolerance)
+        tr = Trajectory._from_core(raw, scene=self, h=h, solver=solver,
+                                   gap_tolerance=gap_tolerance)
+        tr["record_every"] = record_every
+        return tr
 
 
 # --- user-defined models in generalized coordinates -----------------------------------------
