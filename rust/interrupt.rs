@@ -9,7 +9,9 @@
 //! - the fast path subtracts that work from a thread-local budget: a few instructions, no
 //!   clock, no call, so a small problem never pays more than that;
 //! - when the budget is spent (every [`WORK_PER_CLOCK`] units) the clock is read, and the
-//!   hook is called when at least [`HOOK_INTERVAL`] has passed since its last call.
+//!   hook is called when at least [`HOOK_INTERVAL`] has passed since its last call (or since
+//!   the first reading): a run too short to spend one budget never reads the clock or calls
+//!   the hook, and installing a capture-free hook allocates nothing.
 //!
 //! Once the hook says stop, every later [`poll`] in the same [`run`] answers true at once, so
 //! each loop ends at its next poll as if it had hit its iteration limit, and nested phases
@@ -20,7 +22,6 @@
 //! The state is per thread: concurrent solves on other threads have their own hooks.
 
 use std::cell::{Cell, RefCell};
-use std::rc::Rc;
 use std::time::{Duration, Instant};
 
 use crate::error::{CoulombError, Result};
@@ -31,9 +32,13 @@ pub const WORK_PER_CLOCK: u64 = 1 << 18;
 /// the least time between two calls of the hook.
 pub const HOOK_INTERVAL: Duration = Duration::from_millis(5);
 
+/// the hook and when it was last asked (boxed: no allocation for a plain function or a
+/// closure that captures nothing, such as the Python bindings' signal check).
 struct Hook {
-    ask: Rc<dyn Fn() -> bool>,
-    last: Instant,
+    ask: Box<dyn Fn() -> bool>,
+    /// the last call, or the first reading of the clock (`None` before it: a run too short
+    /// to spend one budget never reads the clock)
+    last: Option<Instant>,
 }
 
 thread_local! {
@@ -71,27 +76,47 @@ fn slow_poll() -> bool {
     if STOPPED.with(Cell::get) {
         return true;
     }
-    let ask = HOOK.with(|h| match h.borrow_mut().as_mut() {
-        None => None,
-        Some(hook) => {
-            let now = Instant::now();
-            if now.duration_since(hook.last) < HOOK_INTERVAL {
-                None
+    // the hook is taken out while it runs (no borrow held, so it may itself run stoppable
+    // work) and put back after
+    let due = HOOK.with(|h| {
+        let mut h = h.borrow_mut();
+        BUDGET.with(|b| {
+            b.set(if h.is_some() {
+                WORK_PER_CLOCK
             } else {
-                hook.last = now;
-                Some(hook.ask.clone())
-            }
+                u64::MAX
+            })
+        });
+        let now = Instant::now();
+        let due = match h.as_mut() {
+            None => false,
+            Some(hook) => match hook.last {
+                None => {
+                    hook.last = Some(now);
+                    false
+                }
+                Some(last) => now.duration_since(last) >= HOOK_INTERVAL,
+            },
+        };
+        if due {
+            h.take().map(|mut hook| {
+                hook.last = Some(now);
+                hook
+            })
+        } else {
+            None
         }
     });
-    let installed = HOOK.with(|h| h.borrow().is_some());
-    BUDGET.with(|b| b.set(if installed { WORK_PER_CLOCK } else { u64::MAX }));
-    // the hook runs with no borrow held, so it may itself run stoppable work
-    if ask.is_some_and(|f| f()) {
+    let Some(hook) = due else {
+        return false;
+    };
+    let stop = (hook.ask)();
+    HOOK.with(|h| *h.borrow_mut() = Some(hook));
+    if stop {
         STOPPED.with(|s| s.set(true));
         BUDGET.with(|b| b.set(0));
-        return true;
     }
-    false
+    stop
 }
 
 /// the state of an enclosing [`run`], restored when the inner one ends (also on unwinding).
@@ -115,8 +140,8 @@ impl Drop for Saved {
 /// `work` returned: its answer is the one of a cut-short loop), else what `work` returned.
 pub fn run<T>(hook: impl Fn() -> bool + 'static, work: impl FnOnce() -> Result<T>) -> Result<T> {
     let new = Hook {
-        ask: Rc::new(hook),
-        last: Instant::now(),
+        ask: Box::new(hook),
+        last: None,
     };
     let _saved = Saved {
         hook: HOOK.with(|h| h.borrow_mut().replace(new)),
@@ -133,6 +158,7 @@ pub fn run<T>(hook: impl Fn() -> bool + 'static, work: impl FnOnce() -> Result<T
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::rc::Rc;
 
     #[test]
     fn without_a_hook_nothing_stops() {

@@ -219,7 +219,7 @@ def solve(
         See the module documentation (``"prox"`` is the robust mode).
     tol : float
         Tolerance on ``scaled_error`` for ``success`` (every method; for ``"lemke"`` in 3D,
-        on Lemke's LCP error measures).
+        on Lemke's LCP error measures); in (0, 1).
     max_iter : int, optional
         Sweep limit (at least 1; default 1000) for ``"nsgs"``; pivot limit for ``"lemke"``
         (default Lemke's own, ``max(1000, 50 n)`` for n LCP unknowns).
@@ -230,7 +230,7 @@ def solve(
         first (``"nsgs"`` only).
     facets : int, optional
         ``"lemke"`` only: tangent directions per frictional contact, in +/- pairs: even and at
-        least 4 in 3D (default 8); exactly 2 in 2D (the default, and exact).
+        least 4 in 3D (default 8, at most 1024); exactly 2 in 2D (the default, and exact).
     eta : float, optional
         ``"prox"`` only: the initial proximal parameter relative to W's mean diagonal (> 0,
         default 0.1).

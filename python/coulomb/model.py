@@ -37,7 +37,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Any, Literal, cast
 
 import numpy as np
 
@@ -100,7 +100,7 @@ def _steps(t_end: float, h: float) -> int:
 
 def _solver_options(
     dim: int, solver: Any, tol: Any, max_iter: Any, relaxation: Any, facets: Any
-) -> tuple[str, float, int | None, float, int | None]:
+) -> tuple[Solver, float, int | None, float, int | None]:
     """A simulation's contact-solver options, checked as :func:`coulomb.contact.solve` checks
     them (the same messages, the same refusals)."""
     _validate.choice("solver", solver, ("nsgs", "lemke"),
@@ -117,7 +117,7 @@ def _solver_options(
         raise InvalidParameterError(
             f"facets must be even and at least 4 in 3D (tangent directions in +/- pairs), "
             f"got {fa}")
-    return solver, t, it, om, fa
+    return cast(Solver, solver), t, it, om, fa
 
 
 def _dim(dim: Any) -> None:
@@ -549,8 +549,10 @@ class Scene:
             fallback=fallback, drift=drift, drift_bias=float(drift_bias),
             restitution=restitution, record_every=record_every,
         )
-        return Trajectory._from_core(raw, scene=self, h=h, solver=solver,
-                                     gap_tolerance=gap_tolerance, tol=tol)
+        tr = Trajectory._from_core(raw, scene=self, h=h, solver=solver,
+                                   gap_tolerance=gap_tolerance, tol=tol)
+        tr["record_every"] = record_every
+        return tr
 
 
 # --- user-defined models in generalized coordinates -----------------------------------------

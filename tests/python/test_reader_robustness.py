@@ -113,8 +113,10 @@ FUZZ = textwrap.dedent(
                 b[pos] = rng.randrange(256)
             elif op < 0.7 and reader != "fclib":
                 b[pos:pos] = rng.choice([b"-", b"9", b"99999999999", b" ", b"\\n", b"e300"])
-            elif op < 0.85:
+            elif op < 0.75:
                 del b[pos:pos + rng.randint(1, 16)]
+            elif op < 0.85:
+                b[pos:pos + 64] = bytes(len(b[pos:pos + 64]))  # a zeroed block
             else:
                 b[pos:pos + 4] = rng.randbytes(4)
         path = Path(out)
@@ -145,7 +147,7 @@ def fuzz(src: Path, reader: str, tmp_path: Path, rounds: int) -> str:
 
 def test_fuzzed_fclib_files_never_crash(tmp_path):
     src = write_fclib(tmp_path / "src.hdf5", W_CSC)
-    print(fuzz(src, "fclib", tmp_path, 300))
+    print(fuzz(src, "fclib", tmp_path, 400))
 
 
 SICONOS_LCP = "3\n0\n2\n2\n2 2\n1 0 0 1\n-1 -1\n"
