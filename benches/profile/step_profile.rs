@@ -1,0 +1,234 @@
+//! Steps the benchmark's one-body scenes (a box down a 20 deg ramp, a box resting on the floor)
+//! and a sphere pile, for profiling the stepper's per-step cost:
+//!
+//! ```text
+//! cargo run --release --example step_profile -- ramp 10000
+//! valgrind --tool=callgrind target/release/examples/step_profile resting 2000
+//! cargo run --release --example step_profile -- pile 100 1000
+//! cargo run --release --example step_profile -- pile-declared 100 1000
+//! ```
+//!
+//! NSGS's sweep order, relaxation and sweep limit can be changed for experiments through the
+//! environment: `ORDER=symmetric|backward|forward`, `RELAX=1.3`, `MAXIT=100`.
+use coulomb::step::{simulate, Body, BodyKind, HalfSpace, Pair, Scene, Shape, StepSettings};
+
+const G: f64 = 9.81;
+
+fn box_body(half: [f64; 3], q0: [f64; 3], v0: [f64; 3]) -> (Body, Shape) {
+    let [a, b, c] = half.map(|x| 2.0 * x);
+    let m = 1.0;
+    let inertia = [
+        m * (b * b + c * c) / 12.0,
+        0.0,
+        0.0,
+        0.0,
+        m * (a * a + c * c) / 12.0,
+        0.0,
+        0.0,
+        0.0,
+        m * (a * a + b * b) / 12.0,
+    ];
+    let mut points = vec![];
+    for sx in [-1.0, 1.0] {
+        for sy in [-1.0, 1.0] {
+            for sz in [-1.0, 1.0] {
+                points.push(vec![sx * half[0], sy * half[1], sz * half[2]]);
+            }
+        }
+    }
+    (
+        Body {
+            kind: BodyKind::Spatial,
+            mass: m,
+            inertia: inertia.to_vec(),
+            q0: vec![q0[0], q0[1], q0[2], 1.0, 0.0, 0.0, 0.0],
+            v0: vec![v0[0], v0[1], v0[2], 0.0, 0.0, 0.0],
+            force: vec![0.0; 3],
+        },
+        Shape {
+            body: 0,
+            points,
+            radius: 0.0,
+        },
+    )
+}
+
+fn one_box(gravity: [f64; 3], half: [f64; 3], v0: [f64; 3], mu: f64) -> Scene {
+    let (body, shape) = box_body(half, [0.0, 0.0, half[2]], v0);
+    Scene {
+        dim: 3,
+        gravity: gravity.to_vec(),
+        bodies: vec![body],
+        shapes: vec![shape],
+        half_spaces: vec![HalfSpace {
+            point: vec![0.0; 3],
+            normal: vec![0.0, 0.0, 1.0],
+        }],
+        pairs: vec![Pair::ShapeHalfSpace {
+            shape: 0,
+            half_space: 0,
+            mu,
+            e: 0.0,
+        }],
+    }
+}
+
+/// `count` spheres of radius 0.05 on a grid above a floor inside four walls, as in
+/// benches/peer_step.py; sphere pairs found by the stepper's broad phase, or declared (the
+/// pairs within 3 grid spacings at the start).
+fn pile(count: usize, declared: bool) -> Scene {
+    let radius = 0.05;
+    let side = (count as f64).cbrt().ceil() as usize;
+    let spacing = 2.2 * radius;
+    let half = side as f64 * spacing / 2.0 + radius;
+    let mut scene = Scene {
+        dim: 3,
+        gravity: vec![0.0, 0.0, -G],
+        bodies: vec![],
+        shapes: vec![],
+        half_spaces: vec![],
+        pairs: vec![],
+    };
+    for (p, n) in [
+        ([0.0, 0.0, 0.0], [0.0, 0.0, 1.0]),
+        ([-half, 0.0, 0.0], [1.0, 0.0, 0.0]),
+        ([half, 0.0, 0.0], [-1.0, 0.0, 0.0]),
+        ([0.0, -half, 0.0], [0.0, 1.0, 0.0]),
+        ([0.0, half, 0.0], [0.0, -1.0, 0.0]),
+    ] {
+        scene.half_spaces.push(HalfSpace {
+            point: p.to_vec(),
+            normal: n.to_vec(),
+        });
+    }
+    let inertia = 0.4 * 0.1 * radius * radius;
+    for k in 0..count {
+        let (i, j, l) = (k % side, (k / side) % side, k / (side * side));
+        let x = -half + radius + spacing * (i as f64 + 0.5);
+        let y = -half + radius + spacing * (j as f64 + 0.5);
+        let z = radius + 0.01 + spacing * l as f64;
+        scene.bodies.push(Body {
+            kind: BodyKind::Spatial,
+            mass: 0.1,
+            inertia: vec![inertia, 0.0, 0.0, 0.0, inertia, 0.0, 0.0, 0.0, inertia],
+            q0: vec![x, y, z, 1.0, 0.0, 0.0, 0.0],
+            v0: vec![0.0; 6],
+            force: vec![0.0; 3],
+        });
+        scene.shapes.push(Shape {
+            body: k,
+            points: vec![vec![0.0; 3]],
+            radius,
+        });
+        for w in 0..5 {
+            scene.pairs.push(Pair::ShapeHalfSpace {
+                shape: k,
+                half_space: w,
+                mu: 0.5,
+                e: 0.0,
+            });
+        }
+    }
+    if !declared {
+        scene.pairs.push(Pair::Spheres { mu: 0.5, e: 0.0 });
+    } else {
+        // the benchmark's old candidate list: centres within 3 grid spacings
+        let c: Vec<[f64; 3]> = scene
+            .bodies
+            .iter()
+            .map(|b| [b.q0[0], b.q0[1], b.q0[2]])
+            .collect();
+        for a in 0..count {
+            for b in a + 1..count {
+                let d2: f64 = (0..3).map(|k| (c[a][k] - c[b][k]).powi(2)).sum();
+                if d2 < (3.0 * spacing) * (3.0 * spacing) {
+                    scene.pairs.push(Pair::SphereSphere {
+                        a,
+                        b,
+                        mu: 0.5,
+                        e: 0.0,
+                    });
+                }
+            }
+        }
+    }
+    scene
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().collect();
+    let which = args.get(1).map_or("ramp", |s| s.as_str());
+    let arg = |i: usize, d: usize| args.get(i).and_then(|s| s.parse().ok()).unwrap_or(d);
+    let th = 20f64.to_radians();
+    let (scene, steps) = match which {
+        "ramp" => (
+            one_box(
+                [G * th.sin(), 0.0, -G * th.cos()],
+                [0.05; 3],
+                [1.0, 0.0, 0.0],
+                0.4,
+            ),
+            arg(2, 10_000),
+        ),
+        "resting" => (
+            one_box([0.0, 0.0, -G], [0.1, 0.1, 0.05], [0.0; 3], 0.5),
+            arg(2, 10_000),
+        ),
+        "pile" => (pile(arg(2, 100), false), arg(3, 1000)),
+        "pile-declared" => (pile(arg(2, 100), true), arg(3, 1000)),
+        other => {
+            return Err(
+                format!("unknown scene {other:?}: ramp, resting, pile or pile-declared").into(),
+            )
+        }
+    };
+    let mut settings = StepSettings::new(1e-3, steps);
+    if let (Ok(order), coulomb::step::StepSolver::Nsgs(s)) =
+        (std::env::var("ORDER"), &mut settings.solver)
+    {
+        s.order = match order.as_str() {
+            "symmetric" => coulomb::contact::ContactOrder::Symmetric,
+            "backward" => coulomb::contact::ContactOrder::Backward,
+            _ => coulomb::contact::ContactOrder::Forward,
+        };
+    }
+    if let (Ok(w), coulomb::step::StepSolver::Nsgs(s)) =
+        (std::env::var("RELAX"), &mut settings.solver)
+    {
+        s.relaxation = w.parse()?;
+    }
+    if let (Ok(w), coulomb::step::StepSolver::Nsgs(s)) =
+        (std::env::var("MAXIT"), &mut settings.solver)
+    {
+        s.max_iter = w.parse()?;
+    }
+    let start = std::time::Instant::now();
+    let tr = simulate(&scene, &settings)?;
+    let sec = start.elapsed().as_secs_f64();
+    let active: usize = tr.steps.iter().map(|s| s.active).sum();
+    let sweeps: usize = tr.steps.iter().map(|s| s.iterations).sum();
+    let worst = tr.steps.iter().map(|s| s.iterations).max().unwrap_or(0);
+    println!("sweeps {sweeps}, worst step {worst}");
+    for (k, s) in tr.steps.iter().enumerate() {
+        if s.iterations > 300 || s.fallback {
+            println!(
+                "step {k}: {} sweeps, error {:.2e}, fallback {}, {} contacts",
+                s.iterations, s.error, s.fallback, s.active
+            );
+        }
+    }
+    let unsolved = tr
+        .steps
+        .iter()
+        .filter(|s| s.status.is_some_and(|x| x.as_str() != "solved"))
+        .count();
+    println!(
+        "{which}: {steps} steps in {sec:.3} s = {:.0} steps/s; {:.1} active contacts per step, \
+         {:.3} us per step per contact; {unsolved} steps unsolved; x_end = {:.6}",
+        steps as f64 / sec,
+        active as f64 / steps as f64,
+        sec * 1e6 / active.max(1) as f64,
+        tr.q[tr.q.len() - tr.nq]
+    );
+    Ok(())
+}
