@@ -276,7 +276,7 @@ class SceneAnimation:
                 for c in pts if r > 0 else ():
                     arts.append(ax.add_patch(Circle(c, r, facecolor=color, edgecolor="k",
                                                     lw=0.5, zorder=3)))
-            elif isinstance(shape, (Segment, PolygonShape)):
+            elif isinstance(shape, (Segment, PolygonShape)) and len(pts) >= 2:
                 arts += ax.plot(pts[:, 0], pts[:, 1], color=color, lw=3.0, zorder=3,
                                 solid_capstyle="round")
                 for c in pts if r > 0 else ():

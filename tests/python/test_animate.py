@@ -4,6 +4,7 @@ a ramp's solid side is shaded, and a GIF holds the frames asked for."""
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -19,9 +20,11 @@ from coulomb import (  # noqa: E402
     Model,
     Particle,
     Point,
+    Polygon,
     RigidBody2D,
     RigidBody3D,
     Scene,
+    Segment,
     Sphere,
 )
 from coulomb._animate import (  # noqa: E402
@@ -236,6 +239,67 @@ def test_3d_box_edges_follow_the_quaternion():
         expected = sorted(tuple(np.round(np.concatenate([corners[a], corners[b]]), 9))
                           for a, b in _box_edges_3d())
         assert np.allclose(drawn, expected, atol=1e-9)
+
+
+SHAPES_2D = [Point(), Point((0.1, -0.1)), Sphere(0.2), Sphere(0.0), Box((0.3, 0.2)),
+             Segment((-0.3, 0.0), (0.3, 0.1), radius=0.05), Segment((-0.3, 0.0), (0.3, 0.1)),
+             Polygon([(0.0, 0.0), (0.4, 0.0), (0.0, 0.3)]), Polygon([(0.0, 0.0), (0.3, 0.1)]),
+             Polygon([(0.1, 0.1)]), None]
+SHAPES_3D = [Point(), Sphere(0.2), Sphere(0.0), Box((0.3, 0.2, 0.1)),
+             Segment((-0.3, 0.0, 0.0), (0.3, 0.1, 0.2)),
+             Polygon([(0.0, 0.0, 0.0), (0.4, 0.0, 0.0), (0.0, 0.3, 0.1)]), None]
+
+
+def screen(anim, xyz) -> tuple[float, float]:
+    """(row, column) of a 3D data point on the rendered frame."""
+    from mpl_toolkits.mplot3d import proj3d
+
+    x, y, _ = proj3d.proj_transform(*xyz, anim.ax.get_proj())
+    px, py = anim.ax.transData.transform((x, y))
+    return anim.figure.canvas.get_width_height()[1] - py, px
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("kind", ["particle", "rigid"])
+def test_every_shape_kind_is_drawn_where_its_points_are(dim, kind):
+    """Each shape (or a body without one) shows pixels of its body's colour at every one of
+    its world-frame points (2D) or over their projection (3D)."""
+    from coulomb._animate import world_points
+
+    for shape in SHAPES_2D if dim == 2 else SHAPES_3D:
+        scene = Scene(dim=dim, gravity=(0.0,) * dim)
+        pos = (0.2, 0.1) if dim == 2 else (0.2, 0.1, 0.05)
+        if kind == "particle":
+            body = scene.add(Particle(mass=1.0, position=pos))
+        elif dim == 2:
+            body = scene.add(RigidBody2D(mass=1.0, position=pos, angle=0.5))
+        else:
+            body = scene.add(RigidBody3D(mass=1.0, position=pos,
+                                         orientation=(0.9, 0.3, -0.2, 0.1)))
+        if shape is not None:
+            scene.attach(body, shape)
+        tr = scene.simulate(1e-3, 1e-3)
+        lim = ((-1.0, 1.0),) * dim
+        anim = tr.animate(limits=lim, title=False, figsize=(3, 3), dpi=80)
+        img = anim.rgba(0)
+        mask = bluish(img)
+        placed = world_points(scene, tr.q[0])
+        pts = placed[0][2] if placed else np.array([pos])
+        radius = placed[0][3] if placed else 0.0
+        if dim == 2:
+            for p in pts:
+                r, c = pixel(anim, p)
+                assert mask[r - 3:r + 4, c - 3:c + 4].any(), (shape, p)
+            if radius > 0:  # filled out to the radius
+                r, c = pixel(anim, pts[0] + (0.0, 0.5 * radius))
+                assert mask[r, c], (shape, radius)
+        else:
+            corners = [screen(anim, p + d) for p in pts
+                       for d in itertools.product((-radius, radius), repeat=3)]
+            (r0, c0), (r1, c1) = np.min(corners, axis=0), np.max(corners, axis=0)
+            window = mask[int(r0) - 4:int(r1) + 5, int(c0) - 4:int(c1) + 5]
+            assert window.sum() >= 4, shape
+            assert window.sum() >= 0.5 * mask.sum(), shape  # drawn there, not elsewhere
 
 
 def test_generalized_model_has_nothing_to_draw():
