@@ -3,6 +3,7 @@ annotations apart."""
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
@@ -52,29 +53,54 @@ def study_axis_label(column: str) -> str:
     return column
 
 
+def _ring_offsets() -> list[tuple[float, float]]:
+    """Label offsets (points) around a marker: beside it first, then rings further out."""
+    out = [(4.0, 4.0), (4.0, -12.0), (-14.0, 4.0), (-14.0, -12.0)]
+    for radius in (18.0, 30.0, 42.0, 56.0):
+        for k in range(12):
+            a = 2 * math.pi * k / 12 + math.pi / 12
+            out.append((radius * math.cos(a) - 4.0, radius * math.sin(a) - 4.0))
+    return out
+
+
 def place_labels(ax: Any, points: list[tuple[float, float]], texts: list[str],
                  fontsize: float = 7.0) -> list[Any]:
-    """Annotates ``points`` (data coordinates) with ``texts``, each label moved to the first
-    of a ring of offsets where it overlaps no label placed before it (and no other point's
-    marker, approximately). Returns the annotations."""
+    """Annotates ``points`` (data coordinates) with ``texts``, each label at the first of a
+    ring of offsets where it lies inside the axes and overlaps no label placed before it (else
+    the first where it overlaps none; else beside its marker); a label away from its marker
+    gets a thin leader line. Returns the annotations."""
+    from matplotlib.text import Text
+
     fig = ax.figure
     ax.get_xlim(), ax.get_ylim()  # settles the autoscaled limits the offsets are measured in
-    renderer = fig.canvas.get_renderer()
-    offsets = [(4, 4), (4, -12), (-14, 4), (-14, -12), (4, 14), (-14, 14), (4, -22),
-               (-14, -22), (14, 0), (-24, 0), (4, 24), (4, -32)]
+    get = getattr(fig.canvas, "get_renderer", None)  # Agg canvases; others: the figure's
+    renderer = get() if get is not None else fig._get_renderer()
+    inside = ax.get_window_extent(renderer)
     placed: list[Any] = []
     boxes: list[Any] = []
     for (x, y), text in zip(points, texts, strict=True):
-        ann = None
-        for dx, dy in offsets:
-            if ann is not None:
-                ann.remove()
-            ann = ax.annotate(text, (x, y), xytext=(dx, dy), textcoords="offset points",
-                              fontsize=fontsize)
-            box = ann.get_window_extent(renderer).expanded(1.05, 1.1)
-            if not any(box.overlaps(b) for b in boxes):
+        ann = ax.annotate(text, (x, y), xytext=(4, 4), textcoords="offset points",
+                          fontsize=fontsize)
+        choice = None
+        for dx, dy in _ring_offsets():
+            ann.set_position((dx, dy))
+            box = Text.get_window_extent(ann, renderer)  # the text alone
+            if any(box.expanded(1.05, 1.1).overlaps(b) for b in boxes):
+                continue
+            if (inside.x0 <= box.x0 and box.x1 <= inside.x1 and inside.y0 <= box.y0
+                    and box.y1 <= inside.y1):
+                choice = (dx, dy)
                 break
-        assert ann is not None
-        boxes.append(ann.get_window_extent(renderer))
+            if choice is None:
+                choice = (dx, dy)  # apart but outside the axes: kept unless better turns up
+        dx, dy = choice if choice is not None else (4.0, 4.0)
+        ann.set_position((dx, dy))
+        if math.hypot(dx + 4.0, dy + 4.0) > 15.0:  # away from its marker: a leader line
+            ann.remove()
+            ann = ax.annotate(text, (x, y), xytext=(dx, dy), textcoords="offset points",
+                              fontsize=fontsize,
+                              arrowprops={"arrowstyle": "-", "lw": 0.4, "color": "0.4",
+                                          "shrinkA": 0, "shrinkB": 2})
+        boxes.append(Text.get_window_extent(ann, renderer))
         placed.append(ann)
     return placed
