@@ -5,10 +5,12 @@ use coulomb::io::siconos::read_siconos_lcp;
 use coulomb::lcp::{solve_enumerate, solve_lemke, EnumerateSettings, LcpRef, LemkeSettings};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let dir = std::env::args().nth(1).unwrap_or_else(|| match std::env::var("COULOMB_DATA") {
-        Ok(data) => format!("{data}/siconos-lcp"),
-        Err(_) => concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/siconos-lcp").into(),
-    });
+    let dir = std::env::args()
+        .nth(1)
+        .unwrap_or_else(|| match std::env::var("COULOMB_DATA") {
+            Ok(data) => format!("{data}/siconos-lcp"),
+            Err(_) => concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/siconos-lcp").into(),
+        });
     let mut paths: Vec<_> = std::fs::read_dir(&dir)?
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.extension().is_some_and(|x| x == "dat"))
