@@ -82,8 +82,8 @@ def _box_edges_3d() -> list[tuple[int, int]]:
 
 
 def _clip_halfplane(poly: np.ndarray, point: np.ndarray, normal: np.ndarray) -> np.ndarray:
-    """The part of a convex polygon with ``normal . (x - point) <= 0`` (Sutherland-Hodgman
-    against one line)."""
+    """The part of a convex polygon (2D or 3D vertices) with ``normal . (x - point) <= 0``
+    (Sutherland-Hodgman against one line or plane)."""
     out: list[np.ndarray] = []
     d = (poly - point) @ normal
     for i in range(len(poly)):
@@ -92,12 +92,13 @@ def _clip_halfplane(poly: np.ndarray, point: np.ndarray, normal: np.ndarray) -> 
             out.append(a)
         if (da < 0 < db) or (db < 0 < da):
             out.append(a + (b - a) * (da / (da - db)))
-    return np.array(out).reshape(-1, 2)
+    return np.array(out).reshape(-1, poly.shape[1])
 
 
 def _plane_patch(point: np.ndarray, normal: np.ndarray, limits: np.ndarray) -> np.ndarray:
-    """Four corners of a square of the plane ``n . (x - point) = 0`` around the projection of
-    the middle of ``limits`` (3 x 2), as wide as the limits' largest side."""
+    """The part of the plane ``n . (x - point) = 0`` inside the box ``limits`` (3 x 2): a
+    square of the plane around the projection of the box's middle, covering the box, clipped
+    by the box's six faces (empty when the plane misses the box)."""
     n = normal / np.linalg.norm(normal)
     mid = limits.mean(axis=1)
     centre = mid - ((mid - point) @ n) * n
@@ -105,9 +106,17 @@ def _plane_patch(point: np.ndarray, normal: np.ndarray, limits: np.ndarray) -> n
     u = np.cross(n, helper)
     u /= np.linalg.norm(u)
     w = np.cross(n, u)
-    half = 0.5 * float(np.max(limits[:, 1] - limits[:, 0]))
-    return np.array([centre + half * (su * u + sw * w)
+    half = float(np.linalg.norm(limits[:, 1] - limits[:, 0]))
+    poly = np.array([centre + half * (su * u + sw * w)
                      for su, sw in ((-1, -1), (1, -1), (1, 1), (-1, 1))])
+    for axis in range(3):
+        for side, sign in ((1, 1.0), (0, -1.0)):  # x <= high, then -x <= -low
+            if len(poly) < 3:
+                return poly
+            face = np.zeros(3)
+            face[axis] = limits[axis, side]
+            poly = _clip_halfplane(poly, face, sign * np.eye(3)[axis])
+    return poly
 
 
 def world_points(scene: Scene, q: np.ndarray) -> list[tuple[int, Any, np.ndarray, float]]:
@@ -232,6 +241,8 @@ class SceneAnimation:
                 )
 
                 patch = _plane_patch(p, n, lim)
+                if len(patch) < 3:
+                    continue
                 self.ax.add_collection3d(Poly3DCollection(
                     [patch], facecolor=HALF_SPACE_FILL, edgecolor=HALF_SPACE_EDGE, alpha=0.5))
 

@@ -302,6 +302,29 @@ def test_every_shape_kind_is_drawn_where_its_points_are(dim, kind):
             assert window.sum() >= 0.5 * mask.sum(), shape  # drawn there, not elsewhere
 
 
+def polygon_area_3d(poly: np.ndarray) -> float:
+    return 0.5 * float(np.linalg.norm(sum(np.cross(poly[i], poly[(i + 1) % len(poly)])
+                                          for i in range(len(poly)))))
+
+
+@pytest.mark.parametrize("angle", [0.0, 20.0, 50.0])
+def test_3d_half_space_patch_is_the_plane_inside_the_axes_box(angle):
+    from coulomb._animate import _plane_patch
+
+    lim = np.array([[-1.0, 1.0], [-1.0, 1.0], [-1.0, 1.0]])
+    hs = HalfSpace.ramp(angle, dim=3)
+    n = np.array(hs.normal)
+    patch = _plane_patch(np.array(hs.point), n, lim)
+    assert np.allclose(patch @ n, 0.0, atol=1e-12)  # on the plane
+    assert np.all(patch >= lim[:, 0] - 1e-12) and np.all(patch <= lim[:, 1] + 1e-12)
+    th = math.radians(angle)
+    # z = -tan(th) x: leaves through the x faces while tan(th) <= 1, else the z faces
+    width = 2.0 / math.cos(th) if math.tan(th) <= 1 else 2.0 / math.sin(th)
+    assert polygon_area_3d(patch) == pytest.approx(width * 2.0, rel=1e-12)
+    # a plane that misses the box has no patch
+    assert len(_plane_patch(np.array([0.0, 0.0, -3.0]), n, lim)) < 3
+
+
 def test_generalized_model_has_nothing_to_draw():
     model = Model(dim=2, mass_matrix=np.eye(1), q0=[1.0],
                   contacts=[GapContact(gap=lambda q: q[0], normal_jacobian=lambda q: [1.0])])
