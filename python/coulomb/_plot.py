@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     from .model import Scene
 
-__all__ = ["body_names", "coordinate_labels", "place_labels", "study_axis_label"]
+__all__ = ["body_names", "coordinate_labels", "place_labels", "study_axis_label", "text_box"]
 
 #: the coordinates of each body kind, with units, per scene dimension.
 _COORDS: dict[tuple[str, int], tuple[tuple[str, str], ...]] = {
@@ -63,14 +63,21 @@ def _ring_offsets() -> list[tuple[float, float]]:
     return out
 
 
+def text_box(ann: Any, renderer: Any) -> Any:
+    """The display box of an annotation's text alone (without its leader line), where it is
+    drawn."""
+    from matplotlib.text import Text
+
+    ann.update_positions(renderer)
+    return Text.get_window_extent(ann, renderer)
+
+
 def place_labels(ax: Any, points: list[tuple[float, float]], texts: list[str],
                  fontsize: float = 7.0) -> list[Any]:
     """Annotates ``points`` (data coordinates) with ``texts``, each label at the first of a
     ring of offsets where it lies inside the axes and overlaps no label placed before it (else
     the first where it overlaps none; else beside its marker); a label away from its marker
     gets a thin leader line. Returns the annotations."""
-    from matplotlib.text import Text
-
     fig = ax.figure
     ax.get_xlim(), ax.get_ylim()  # settles the autoscaled limits the offsets are measured in
     get = getattr(fig.canvas, "get_renderer", None)  # Agg canvases; others: the figure's
@@ -84,7 +91,7 @@ def place_labels(ax: Any, points: list[tuple[float, float]], texts: list[str],
         choice = None
         for dx, dy in _ring_offsets():
             ann.set_position((dx, dy))
-            box = Text.get_window_extent(ann, renderer)  # the text alone
+            box = text_box(ann, renderer)
             if any(box.expanded(1.05, 1.1).overlaps(b) for b in boxes):
                 continue
             if (inside.x0 <= box.x0 and box.x1 <= inside.x1 and inside.y0 <= box.y0
@@ -101,6 +108,6 @@ def place_labels(ax: Any, points: list[tuple[float, float]], texts: list[str],
                               fontsize=fontsize,
                               arrowprops={"arrowstyle": "-", "lw": 0.4, "color": "0.4",
                                           "shrinkA": 0, "shrinkB": 2})
-        boxes.append(Text.get_window_extent(ann, renderer))
+        boxes.append(text_box(ann, renderer))
         placed.append(ann)
     return placed

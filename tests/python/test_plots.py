@@ -25,8 +25,8 @@ from coulomb import (  # noqa: E402
     Scene,
     Sphere,
 )
+from coulomb._plot import text_box  # noqa: E402
 from coulomb.study import Study, pareto_front  # noqa: E402
-from matplotlib.text import Text  # noqa: E402
 
 
 @pytest.fixture(autouse=True)
@@ -116,7 +116,7 @@ def test_pareto_labels_do_not_overlap_and_the_legend_names_the_settings(tmp_path
     assert np.max(np.ptp(px, axis=0)) < 8
     labels = [t for t in ax.texts if t.get_text().isdigit()]
     assert sorted(int(t.get_text()) for t in labels) == list(range(1, 11))
-    boxes = [Text.get_window_extent(t, renderer) for t in labels]  # the text, not its leader
+    boxes = [text_box(t, renderer) for t in labels]  # the text, not its leader line
     inside = ax.get_window_extent(renderer)
     assert sum(inside.contains(b.x0, b.y0) and inside.contains(b.x1, b.y1) for b in boxes) >= 8
     for a, b in itertools.combinations(boxes, 2):
@@ -126,8 +126,11 @@ def test_pareto_labels_do_not_overlap_and_the_legend_names_the_settings(tmp_path
     assert texts[2:] == [f"{i + 1}: h={r['h']}, solver={r['solver']}"
                          for i, r in enumerate(front)]
     # each number is beside its own point
-    for t in labels:
+    for t, box in zip(labels, boxes, strict=True):
         r = front[int(t.get_text()) - 1]
         assert t.xy == (r["time"], r["error"])
+        # the text is drawn near its point (within 70 pixels)
+        x, y = ax.transData.transform(t.xy)
+        assert np.hypot(box.x0 + box.x1 - 2 * x, box.y0 + box.y1 - 2 * y) < 140
     assert ax.get_xlabel() == "wall time [s]"
     assert "[-]" in ax.get_ylabel() and "relative" in ax.get_ylabel()
