@@ -30,10 +30,12 @@ Like every coulomb result it has ``success``, ``status`` (``"completed"``,
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ._extras import require
 from ._result import Result
 from .errors import CoulombError
 
@@ -217,25 +219,58 @@ class Trajectory(Result):
 
     def plot(self, axes: Any = None) -> Any:
         """Coordinates, energy and normal impulses against time (needs matplotlib, the
-        ``plot`` extra). Returns the figure."""
-        try:
-            import matplotlib.pyplot as plt
-        except ImportError as exc:  # pragma: no cover - depends on the environment
-            raise ImportError(
-                "Trajectory.plot needs matplotlib: pip install 'coulomb[plot]'"
-            ) from exc
+        ``plot`` extra). Each coordinate is labelled by body and name with its unit
+        (``"ball y [m]"``, ``"box theta [rad]"``; ``q[i]`` for a generalized model), in a legend
+        up to 21 coordinates. Returns the figure."""
+        require("matplotlib", extra="plot", what="Trajectory.plot")
+        import matplotlib.pyplot as plt
+
+        from ._plot import coordinate_labels
+
         if axes is None:
             fig, axes = plt.subplots(3, 1, sharex=True, figsize=(7, 8))
         else:
             fig = axes[0].figure
         t = self["t"]
-        axes[0].plot(t, self["q"])
-        axes[0].set_ylabel("q")
+        labels = coordinate_labels(self._scene, self["q"].shape[1])
+        for column, label in zip(self["q"].T, labels, strict=True):
+            axes[0].plot(t, column, label=label)
+        if self._scene is None:
+            axes[0].set_ylabel("q (generalized)")
+        else:
+            units = sorted({lb[lb.rfind("[") + 1:-1] for lb in labels})
+            axes[0].set_ylabel(f"q [{', '.join(units)}]")
+        if len(labels) <= 21:
+            axes[0].legend(fontsize=7, ncol=1 + (len(labels) - 1) // 7, loc="best")
         axes[1].plot(t, self["kinetic_energy"], label="kinetic")
+        axes[1].plot(t, self["potential_energy"], label="potential")
         axes[1].plot(t, self["total_energy"], label="total")
-        axes[1].set_ylabel("energy (J)")
-        axes[1].legend()
-        axes[2].step(t[:-1], self.normal_impulse_per_step(), where="post")
-        axes[2].set_ylabel("normal impulse per step (N s)")
-        axes[2].set_xlabel("t (s)")
+        axes[1].set_ylabel("energy [J]")
+        axes[1].legend(fontsize=7)
+        axes[2].step(t[:-1], self.normal_impulse_per_step(), where="post",
+                     label="sum over contacts")
+        axes[2].set_ylabel("normal impulse per step [N s]")
+        axes[2].set_xlabel("t [s]")
+        axes[2].legend(fontsize=7)
         return fig
+
+    def animate(self, path: str | Path | None = None, **options: Any) -> Any:
+        """The scene's bodies and shapes moving over time, in 2D or 3D (needs matplotlib, the
+        ``plot`` extra; see :mod:`coulomb._animate` for what each shape looks like).
+
+        With ``path`` it writes a ``.gif`` (Pillow, which matplotlib brings), ``.mp4``
+        (needs ffmpeg; :class:`~coulomb._animate.WriterUnavailableError` otherwise, before any
+        work) or ``.html`` file and returns the path; without, it returns a
+        :class:`~coulomb._animate.SceneAnimation`, which Jupyter shows inline as a player
+        (``.animation`` is the matplotlib ``FuncAnimation``, ``.rgba(k)`` frame k's pixels).
+
+        Options: ``fps`` (default 25), ``every`` (draw every k-th state; default real time at
+        ``fps``), ``t_range=(t0, t1)`` (s), ``limits`` (``dim`` pairs (low, high) in m;
+        default every shape over the frames, with a margin), ``title`` (True: ``"t = ... s"``;
+        a format string with ``{t}``; False: none), ``figsize`` (inches), ``dpi``.
+        A generalized-coordinate :class:`~coulomb.Model` has no geometry: TypeError (plot its
+        coordinates with :meth:`plot`).
+        """
+        from ._animate import animate
+
+        return animate(self, path, **options)
