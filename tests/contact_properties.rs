@@ -28,6 +28,8 @@ struct Generated {
     mu: Vec<f64>,
 }
 
+// index loops over contacts and components read as the equations do
+#[allow(clippy::needless_range_loop)]
 fn generate(seed: u64, dim: usize, planted: bool, ka: i32, kb: i32, moderate: bool) -> Generated {
     let mut rng = SplitMix64::new(seed);
     let nc = 1 + rng.below(6);
@@ -105,6 +107,7 @@ fn generate(seed: u64, dim: usize, planted: bool, ka: i32, kb: i32, moderate: bo
 /// The worst violation of Signorini's condition and Coulomb's law by r, per contact relative
 /// to its velocity scale (the magnitudes of the terms of `u_i`) and impulse scale (its impulse
 /// or that velocity through its diagonal block); `polygon` checks only Signorini and the cone.
+#[allow(clippy::needless_range_loop)]
 fn law_violation(p: &Generated, r: &[f64], polygon: bool) -> f64 {
     let (dim, n) = (p.dim, p.q.len());
     let mut worst: f64 = 0.0;

@@ -205,7 +205,7 @@ impl ImpulseScale {
     /// `rho_i`.
     #[inline]
     pub(crate) fn rho(&self, problem: &ContactProblem<'_>, i: usize) -> f64 {
-        if !(self.mean > 0.0) {
+        if self.mean.is_nan() || self.mean <= 0.0 {
             return self.free;
         }
         let d = normal_diagonal(problem, i);
