@@ -422,8 +422,8 @@ pub fn solve_nsgs(problem: &ContactProblem<'_>, s: &NsgsSettings) -> Result<Cont
         (
             ContactStatus::Solved,
             format!(
-                "solved in {sweeps} sweeps (scaled_error {:.2e}, error_q {:.2e})",
-                measures.scaled_error, measures.error_q
+                "solved in {sweeps} sweeps (scaled_error {:.2e})",
+                measures.scaled_error
             ),
         )
     } else if !measures.scaled_error.is_finite() || r.iter().any(|v| !v.is_finite()) {
@@ -444,8 +444,8 @@ pub fn solve_nsgs(problem: &ContactProblem<'_>, s: &NsgsSettings) -> Result<Cont
         (
             ContactStatus::IterationLimit,
             format!(
-                "stopped at max_iter = {} with scaled_error {:.2e} > tol {:.1e} (error_q {:.2e})",
-                s.max_iter, measures.scaled_error, s.tol, measures.error_q
+                "stopped at max_iter = {} with scaled_error {:.2e} > tol {:.1e}",
+                s.max_iter, measures.scaled_error, s.tol
             ),
         )
     };

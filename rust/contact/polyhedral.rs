@@ -357,8 +357,8 @@ pub fn solve_polyhedral_lcp(
             ContactStatus::Solved,
             format!(
                 "{what} solved by Lemke in {} pivots (LCP error {:.2e}; against the exact disk \
-                 scaled_error {:.2e}, error_q {:.2e})",
-                ls.pivots, lm.error, measures.scaled_error, measures.error_q
+                 scaled_error {:.2e})",
+                ls.pivots, lm.error, measures.scaled_error
             ),
         ),
         LcpStatus::PivotLimit => (

@@ -531,9 +531,8 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
         (
             ContactStatus::Solved,
             format!(
-                "solved in {iterations} Newton steps{finished} (scaled_error {:.2e}, error_q \
-                 {:.2e})",
-                measures.scaled_error, measures.error_q
+                "solved in {iterations} Newton steps{finished} (scaled_error {:.2e})",
+                measures.scaled_error
             ),
         )
     } else if !measures.scaled_error.is_finite() || r.iter().any(|v| !v.is_finite()) {

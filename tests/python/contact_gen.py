@@ -129,6 +129,8 @@ class Counts:
     false_successes: int = 0
     planted: int = 0
     planted_successes: int = 0
+    planted_moderate: int = 0
+    planted_moderate_successes: int = 0
     status_changes: int = 0
     hard_cases: int = 0
     hard_status_changes: int = 0
@@ -171,9 +173,12 @@ def campaign(n: int, start: int = 0) -> dict[str, Counts]:
                 c.hard_status_changes += res.status != res2.status
             else:
                 c.status_changes += res.status != res2.status
+            moderate = planted and p.mu.max() <= 10
+            c.planted_moderate += moderate
             if res.success:
                 c.successes += 1
                 c.planted_successes += planted
+                c.planted_moderate_successes += moderate
                 v = law_violation(p.W, p.q, p.mu, dim, res.impulse,
                                   polygon=method == "lemke" and dim == 3)
                 if not v <= FALSE:

@@ -205,8 +205,7 @@ def test_every_local_siconos_problem_is_solved_at_1e_8(fc_set):
         r = contact.solve(p.W, p.q, p.mu, p.dim, method="prox", tol=TOL)
         assert r.success, (f.stem, r.message)
         _, err_q = contact_error(p.W, p.q, p.mu, p.dim, r.impulse)
-        # (agreement to rounding: near 1e-12 the residual is rounding in the sums of W r + q)
-        assert err_q == pytest.approx(r.error_q, rel=1e-6, abs=1e-12), f.stem
+        assert err_q == pytest.approx(r.error_q, rel=1e-6, abs=1e-3 * TOL), f.stem
         # the verdict's measure, recomputed independently (error_q, which adds velocities
         # to impulses, may exceed tol: Rover11035 has 1.5e-8)
         assert contact_scaled_error(p.W, p.q, p.mu, p.dim, r.impulse) <= TOL, f.stem

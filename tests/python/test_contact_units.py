@@ -101,3 +101,40 @@ def test_lcp_measures_do_not_overflow_or_underflow(method, scale):
     r = lcp.solve(M * scale, q * scale, method=method)
     assert np.isfinite(r.error) and r.status == ref.status == "solved", r.message
     np.testing.assert_allclose(r.z, ref.z, rtol=1e-9, atol=1e-12)
+
+
+def _two_box_stack(ratio: float, heavy_on_top: bool):
+    """A box on a box on the floor, one `ratio` times heavier (the extremes suite's scene)."""
+    from coulomb import extremes as ex
+    from coulomb.model import Model
+
+    b = 0.05
+    m_top, m_bottom = (ratio, 1.0) if heavy_on_top else (1.0, ratio)
+    a_bottom, a_top = 0.2, 0.1
+    j_bottom = m_bottom * (4 * a_bottom**2 + 4 * b * b) / 12
+    j_top = m_top * (4 * a_top**2 + 4 * b * b) / 12
+    mass = np.diag([m_bottom, m_bottom, j_bottom, m_top, m_top, j_top])
+    gravity = np.array([0.0, -ex.G0 * m_bottom, 0.0, 0.0, -ex.G0 * m_top, 0.0])
+    return Model(2, mass, q0=[0.0, b, 0.0, 0.03, 3 * b, 0.0],
+                 force=lambda q, v, t, g=gravity: g,
+                 contacts=ex._box_corner_gaps(a_bottom, a_top, b),
+                 potential=lambda q, g=gravity: float(-(g @ q)))
+
+
+@pytest.mark.parametrize("heavy_on_top", [False, True])
+def test_the_stepper_verdict_and_check_agree_on_a_stack_at_mass_ratio_1e6(heavy_on_top):
+    # every step was reported solved while check() flagged complementarity products of
+    # 2.4e-5 and 3.1e-5: the solver's verdict (a global relative residual) and check() (a
+    # product scaled by the largest impulse) used different measures
+    tr = _two_box_stack(1e6, heavy_on_top).simulate(0.1, 1e-3)
+    c = tr.check()
+    solved = np.array([s == "solved" for s in tr.solver_status])
+    # one rule, one measure: a step is solved exactly when its scaled_error passes tol (the
+    # Lemke fallback's tolerance is max(tol, 1e-9)), and check() judges by that rule
+    tol = np.where(tr.fallback, max(tr.tol, 1e-9), tr.tol)
+    np.testing.assert_array_equal(solved, tr.solver_scaled_error <= tol)
+    assert solved.all() and c.ok, c.violations
+    if not heavy_on_top:
+        # the light box on top: its contacts are judged at their own scale, so the products
+        # fall to rounding (2.4e-5 before)
+        assert float(np.max(tr.complementarity)) < 1e-8
