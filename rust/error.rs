@@ -20,6 +20,10 @@ pub enum CoulombError {
     /// a problem too large for the chosen method (enumeration beyond its size limit).
     #[error("problem too large: {0}")]
     TooLarge(String),
+    /// the caller's interrupt hook asked to stop (Ctrl-C from Python, see
+    /// [`crate::interrupt`]); the cut-short answer is discarded.
+    #[error("interrupted")]
+    Interrupted,
     /// a problem file that could not be read or parsed.
     #[error(transparent)]
     Read(#[from] crate::io::ReadError),

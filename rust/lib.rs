@@ -14,10 +14,16 @@
 
 pub mod contact;
 pub mod error;
+pub mod interrupt;
 pub mod io;
 pub mod lcp;
+pub mod limits;
 pub mod matrix;
 pub mod step;
+/// Reproducible problem generators for the tests, benches and profiling programs (the
+/// `testing` feature, which `cargo test` and `cargo bench` enable); not part of the API.
+#[cfg(any(test, feature = "testing"))]
+#[doc(hidden)]
 pub mod testing;
 
 #[cfg(feature = "python")]

@@ -212,7 +212,7 @@ fn random_3d_problem_passes_every_check() {
     assert!(s.success(), "{}", s.message);
     println!("random 3D: {}", s.message);
     let m = s.measures;
-    assert!(m.error <= 1e-8);
+    assert!(m.passes(1e-8), "{m:?}");
     assert!(m.cone_violation <= 1e-10, "{m:?}");
     assert!(m.min_normal_impulse >= -1e-12, "{m:?}");
     let qn = q.iter().map(|v| v * v).sum::<f64>().sqrt();

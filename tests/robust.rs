@@ -91,8 +91,10 @@ fn random_rank_deficient_problems_are_solved() {
         let s = solve_prox(&p, &settings(1e-10)).unwrap();
         assert!(s.success(), "case {case}: {}", s.message);
         let (_, m) = measure(&p, &s.impulse).unwrap();
+        // the verdict's rule on an independent call of the measures (error_q, which adds
+        // velocities to impulses, is reported beside it)
         assert!(
-            m.error_q <= 1e-10 && m.error <= m.error_q,
+            m.passes(1e-10) && m.error <= m.error_q,
             "case {case}: {m:?}"
         );
     }

@@ -46,7 +46,7 @@ from . import (
     study,
     trajectory,
 )
-from ._core import __version__
+from ._core import __version__, memory_budget, set_memory_budget
 from ._result import Result
 from .contact import ContactResult
 from .lcp import LcpResult
@@ -91,9 +91,11 @@ __all__ = [
     "extremes",
     "io",
     "lcp",
+    "memory_budget",
     "model",
     "painleve",
     "regularized",
+    "set_memory_budget",
     "study",
     "trajectory",
 ]

@@ -55,7 +55,7 @@ def _triplets(a: Any, name: str, diagonal_ok: bool = False) -> Triplets:
             np.ascontiguousarray(coo.col, dtype=np.int64),
             vals,
         )
-    arr = _as_array(a, name, np.ndim(a))
+    arr = _as_array(a, name, None)
     if arr.ndim == 1 and diagonal_ok:
         n = arr.shape[0]
         idx = np.arange(n, dtype=np.int64)

@@ -5,7 +5,8 @@ a check that says so before any work is done.
 extra    installs                 needed by
 ======== ======================== =====================================================
 hdf5     h5py, scipy              ``coulomb.io.read_fclib`` (FCLib HDF5 files)
-plot     matplotlib               ``Trajectory.plot``, ``Study.plot``, ``coulomb study --plot``
+plot     matplotlib               ``Trajectory.plot``, ``Trajectory.animate``, ``Study.plot``,
+                                  ``coulomb study --plot``
 ode      scipy                    ``coulomb.regularized.simulate_ramp``, the
                                   ``regularized-ramp`` study; scipy.sparse input to
                                   ``coulomb.contact``

@@ -35,13 +35,17 @@ Methods:
     by the polygon of ``facets`` unit tangent directions in +/- pairs (default 8 in 3D; in 2D
     only 2, the directions +1 and -1, which is exact), ``z = (P_n, beta, lambda)`` solves
     ``0 <= z ⊥ A z + b >= 0`` by Lemke's method and the impulses are mapped back
-    (``P_t = D beta``). Frictionless contacts carry only the normal unknown. ``success`` means
-    the polyhedral LCP was solved (to ``tol`` on Lemke's error measures, the LCP's own error is
-    in ``message``); ``iterations`` counts Lemke's pivots and ``max_iter`` (if given) limits
-    them. The measures below are still taken against the exact disk, so in 3D ``error``
-    reflects the facet approximation (it shrinks as ``facets`` grows, not monotonically: a
-    sliding contact's impulse snaps to a facet). With anisotropic friction the directions are
-    scaled along the tangents so that the polygon is inscribed in the ellipse.
+    (``P_t = D beta``). Frictionless contacts carry only the normal unknown. The LCP is
+    assembled in balanced units (the multiplier column and row scaled by each contact's
+    ``W_nn``), so Lemke's relative pivot tests see every entry at W's scale: with the raw form,
+    data of size 1e-10 lost their friction. In 2D the polygon is exact and ``success`` follows
+    the rule below; in 3D ``success`` means the polyhedral LCP was solved (to ``tol`` by
+    Lemke's rule, the LCP's own error is in ``message``); ``iterations`` counts Lemke's
+    pivots and ``max_iter`` (if given) limits them. The measures below are still taken
+    against the exact disk, so in 3D they reflect the facet approximation (they shrink as
+    ``facets`` grows, not monotonically: a sliding contact's impulse snaps to a facet). With
+    anisotropic friction the directions are scaled along the tangents so that the polygon is
+    inscribed in the ellipse.
 ``"prox"`` (the robust mode)
     A proximal-point semismooth Newton method on the natural map (Rust ``contact::prox``):
     each iteration is one Newton step on the proximal subproblem ``W + eta I`` centred at the
@@ -52,21 +56,41 @@ Methods:
     (``message`` then says "2D LCP finish"; Rust ``contact::lcp_finish``): it solves the
     FCLib granular flow whose rounded W is slightly indefinite and singular. For the
     problems where NSGS stalls at tight tolerances (redundant contacts, FCLib BoxesStack and
-    OneObject). ``success`` means ``error_q <= tol`` (which implies ``error <= tol``);
+    OneObject). ``success`` follows the rule below;
     ``iterations`` counts Newton steps (each one sparse LU factorization); ``max_iter`` defaults
     to 200; ``initial`` warm-starts it.
 
 The contact problem of a mechanism (mass matrix M, contact directions G, free velocity) is
 built by :func:`assemble` and the velocity after the impulses given by :func:`post_velocity`.
 
-Every answer is measured on the original data (W, q, mu):
+Every method runs on the problem rescaled by powers of two (exact) so that q and W's diagonal
+are of size one whatever the units, and every answer is measured on the original data
+(W, q, mu). **Success has one rule for every method** (except the 3D polygon, above):
+``success`` is True exactly when ``scaled_error <= tol``, and the iterative methods stop on
+that same test.
+
+``scaled_error``
+    The unit-consistent measure. Per contact, ``rho_i = 1 / W_nn,i`` (impulse per unit
+    velocity; a contact with no normal stiffness takes the mean's) turns velocities into
+    impulses, and two natural maps are taken in impulse units: De Saxcé's
+    ``e_i = r_i - P_K(r_i - rho_i (u_i + mu_i ||u_t,i|| n))`` and Alart-Curnier's
+    ``a_i = (r_n - max(0, r_n - rho_i u_n), r_t - P_D(mu_i r_n)(r_t - rho_i u_t))``, which
+    takes Signorini's condition and the sticking / sliding law apart (De Saxcé's alone is blind
+    for a large mu: ``mu ||u_t||`` hides an approaching contact, so with mu = 1e8 the answer
+    r = 0 of a contact that must push looked solved). ``scaled_error`` is the worst contact's
+    ``max(||e_i||, ||a_i||)`` divided by its own impulse scale
+    ``max(||r_i||, rho_i ||(|W| |r| + |q|)_i||)``. Multiplying impulse units by a and velocity
+    units by b (``W -> (b/a) W``, ``q -> b q``) leaves it unchanged, and so ``success`` and
+    ``status``; ``error`` and ``error_q`` add velocities to impulses and change with the
+    units, so they are reported, never used for the verdict (at W of order 1e-5 they accepted
+    answers of a problem without solution; at W of order 1e8 an exact answer may miss
+    ``error_q <= tol``).
 
 ``error``
     The natural-map residual on De Saxcé's form (as ../shared/DESIGN.md defines it),
     ``||r - P_K(r - (u + mu ||u_t|| n))||_2 / max(||q||, ||r||, ||u||)``, with ``P_K`` the
     projection on the product of the Coulomb cones (divided by 1 instead when all three norms
-    are below 1e-300). It is zero exactly at a solution. For ``"nsgs"``, ``success`` means
-    ``error <= tol``.
+    are below 1e-300). It is zero exactly at a solution.
     For a contact with anisotropic friction ``(mu_1, mu_2)``, with ``m = max(mu_1, mu_2)``
     and ``B = diag(1, mu_1 / m, mu_2 / m)``, the change of variables ``r = B r^``,
     ``u^ = B u`` maps the elliptic cone onto the isotropic cone ``K_m`` and keeps the power
@@ -96,7 +120,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import _core
+from . import _core, _validate
 from ._assembly import assemble, post_velocity
 from ._result import Result
 from .errors import InvalidInputError, InvalidParameterError, NonFiniteError, ShapeError
@@ -118,8 +142,8 @@ class ContactResult(Result):
     velocity : ndarray, shape (nc, dim)
         ``u = W r + q`` recomputed from the original data.
     success : bool
-        ``"nsgs"``: True only if ``error <= tol``; ``"lemke"``: True only if the polyhedral LCP
-        was solved.
+        True exactly when ``scaled_error <= tol`` (for ``"lemke"`` in 3D: when the polyhedral
+        LCP was solved).
     status : str
         ``"solved"``, ``"iteration_limit"`` or ``"numerical_failure"``.
     message : str
@@ -131,6 +155,8 @@ class ContactResult(Result):
         documentation).
     error_q : float
         The same residual divided by ``||q||``.
+    scaled_error : float
+        The unit-consistent measure the verdict is taken on (see the module documentation).
     min_normal_impulse, max_complementarity, cone_violation, dissipation_violation : float
         The separate checks (see the module documentation).
     solve_time : float
@@ -145,6 +171,7 @@ class ContactResult(Result):
     iterations: int
     error: float
     error_q: float
+    scaled_error: float
     min_normal_impulse: float
     max_complementarity: float
     cone_violation: float
@@ -191,8 +218,8 @@ def solve(
     method : {"nsgs", "lemke", "prox"}
         See the module documentation (``"prox"`` is the robust mode).
     tol : float
-        Tolerance on ``error`` for ``success`` (``"nsgs"``), or on Lemke's LCP error measures
-        (``"lemke"``).
+        Tolerance on ``scaled_error`` for ``success`` (every method; for ``"lemke"`` in 3D,
+        on Lemke's LCP error measures); in (0, 1).
     max_iter : int, optional
         Sweep limit (at least 1; default 1000) for ``"nsgs"``; pivot limit for ``"lemke"``
         (default Lemke's own, ``max(1000, 50 n)`` for n LCP unknowns).
@@ -203,7 +230,7 @@ def solve(
         first (``"nsgs"`` only).
     facets : int, optional
         ``"lemke"`` only: tangent directions per frictional contact, in +/- pairs: even and at
-        least 4 in 3D (default 8); exactly 2 in 2D (the default, and exact).
+        least 4 in 3D (default 8, at most 1024); exactly 2 in 2D (the default, and exact).
     eta : float, optional
         ``"prox"`` only: the initial proximal parameter relative to W's mean diagonal (> 0,
         default 0.1).
@@ -223,9 +250,8 @@ def solve(
         ``dim`` not 2 or 3, an unknown method, ``tol <= 0``, ``max_iter < 1``, ``relaxation``
         outside (0, 2), ``facets`` odd or too small, or an option the method does not take).
     """
-    if isinstance(dim, bool) or not isinstance(dim, (int, np.integer)) or dim not in (2, 3):
-        raise InvalidParameterError(f"dim must be 2 (planar) or 3 (spatial), got {dim!r}")
-    dim = int(dim)
+    dim, tol, max_iter, relaxation, facets, eta = _validate.contact_options(
+        dim, method, tol, max_iter, relaxation, facets, eta)
     if method not in _METHODS:
         raise InvalidParameterError(
             f"unknown method {method!r}: expected 'nsgs' (exact friction disk), 'lemke' "
@@ -271,7 +297,7 @@ def solve(
     # W and q are checked for NaN and infinity by the core, before any work
     init = None
     if initial is not None:
-        r0 = _as_array(initial, "initial", np.ndim(initial))
+        r0 = _as_array(initial, "initial", None)
         if r0.shape not in ((nc, dim), (n,)):
             raise ShapeError(f"initial must have shape ({nc}, {dim}) or ({n},), got {r0.shape}")
         init = np.ascontiguousarray(r0.reshape(n))
@@ -345,6 +371,7 @@ def _delassus(
     shape = tuple(W.shape)  # type: ignore[attr-defined]
     if shape != (n, n):
         raise ShapeError(f"W must have shape ({n}, {n}) to match q of length {n}, got {shape}")
+    _validate.sparse_structure("W", W)  # before scipy's conversion trusts the indices
     csr = W.tocsr()  # type: ignore[attr-defined]  # no copy when already CSR
     data = csr.data
     if np.iscomplexobj(data):

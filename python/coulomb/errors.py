@@ -8,6 +8,7 @@ raise: its result's ``status`` says what happened and ``success`` is False.
 from __future__ import annotations
 
 __all__ = [
+    "ArgumentTypeError",
     "CoulombError",
     "InternalError",
     "InvalidInputError",
@@ -39,8 +40,15 @@ class InvalidParameterError(InvalidInputError):
     """An option outside its domain (for example ``tol <= 0`` or an unknown method)."""
 
 
+class ArgumentTypeError(InvalidParameterError, TypeError):
+    """An argument of the wrong type (a float or a string where an int count is expected,
+    None where a number is): both an :class:`InvalidParameterError` and a ``TypeError``."""
+
+
 class ProblemTooLargeError(InvalidInputError):
-    """The problem is too large for the chosen method (enumeration beyond n = 15)."""
+    """The problem is too large for the chosen method or the memory budget (enumeration
+    beyond n = 15, a dense LCP or a trajectory whose bytes exceed
+    ``coulomb.memory_budget()``)."""
 
 
 class ProblemFormatError(CoulombError, ValueError):

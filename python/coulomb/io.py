@@ -16,9 +16,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from . import _core
+from . import _core, _validate
 from ._assembly import assemble
-from .errors import ProblemFormatError
+from .errors import ArgumentTypeError, ProblemFormatError, ProblemTooLargeError, ShapeError
 
 __all__ = [
     "FrictionContactProblem",
@@ -44,13 +44,23 @@ class LcpProblem:
         return int(self.q.shape[0])
 
 
+def _path(path: Any) -> str:
+    """``os.fspath(path)``, refusing anything that is not a path with a coulomb error."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise ArgumentTypeError(f"path must be a str or os.PathLike, got {path!r}")
+    p = os.fspath(path)
+    if not isinstance(p, str):
+        raise ArgumentTypeError(f"path must be a str or os.PathLike of str, got {path!r}")
+    return p
+
+
 def read_siconos_lcp(path: str | os.PathLike[str]) -> LcpProblem:
     """Read a Siconos LCP file (``lcp_*.dat``), dense or sparse-block storage.
 
     Raises ``FileNotFoundError`` for a missing file and
     :class:`coulomb.errors.ProblemFormatError` for a malformed one.
     """
-    M, q = _core.read_siconos_lcp(os.fspath(path))
+    M, q = _core.read_siconos_lcp(_path(path))
     return LcpProblem(M=M, q=q, name=os.path.splitext(os.path.basename(os.fspath(path)))[0])
 
 
@@ -109,7 +119,7 @@ def read_siconos_fc(
     ``FileNotFoundError`` for a missing file and :class:`coulomb.errors.ProblemFormatError`
     for a malformed one.
     """
-    d = _core.read_siconos_fc(os.fspath(path))
+    d = _core.read_siconos_fc(_path(path))
     if d["kind"] == "global":
         return GlobalFrictionContactProblem(
             M=d["M"], H=d["H"], q=d["q"], b=d["b"], mu=d["mu"], dim=int(d["dim"]), name=_name(path)
@@ -119,34 +129,77 @@ def read_siconos_fc(
     )
 
 
+def _dataset(group: Any, key: str, dtype: Any, what: str, path: str) -> NDArray[Any]:
+    """A dataset read whole, after checking that its declared size fits the memory budget."""
+    ds = group[key]
+    size = int(getattr(ds, "size", 0) or 0)
+    budget = _core.memory_budget()
+    if size * 8 > budget:
+        raise ProblemTooLargeError(
+            f"{path}: {what} declares {size} entries ({size * 8} bytes), over the memory "
+            f"budget of {budget} bytes (coulomb.set_memory_budget raises it)"
+        )
+    return np.asarray(ds[()], dtype=dtype).reshape(-1)
+
+
 def _fclib_matrix(group: Any, name: str, path: str) -> Any:
     """A CSparse matrix group of an FCLib file as a scipy.sparse CSR matrix (``nz >= 0``:
-    triplets with i = row, p = column; ``nz = -1``: CSC; ``nz = -2``: CSR)."""
+    triplets with i = row, p = column; ``nz = -1``: CSC; ``nz = -2``: CSR). The declared
+    sizes, counts, index pointers and indices are all checked before scipy sees them (its
+    conversions trust them and read out of bounds on a bad index)."""
     import scipy.sparse as sp
 
     try:
         g = group[name]
-        nz = int(g["nz"][0])
-        m = int(g["m"][0])
-        n = int(g["n"][0])
-        p = np.asarray(g["p"][:], dtype=np.int64)
-        i = np.asarray(g["i"][:], dtype=np.int64)
-        x = np.asarray(g["x"][:], dtype=np.float64)
-    except (KeyError, IndexError, TypeError, ValueError) as exc:
+        nz = int(_dataset(g, "nz", np.int64, f"matrix {name}'s nz", path)[0])
+        m = int(_dataset(g, "m", np.int64, f"matrix {name}'s m", path)[0])
+        n = int(_dataset(g, "n", np.int64, f"matrix {name}'s n", path)[0])
+        p = _dataset(g, "p", np.int64, f"matrix {name}'s p", path)
+        i = _dataset(g, "i", np.int64, f"matrix {name}'s i", path)
+        x = _dataset(g, "x", np.float64, f"matrix {name}'s x", path)
+    except (KeyError, IndexError, TypeError, ValueError, OverflowError) as exc:
+        if isinstance(exc, ProblemTooLargeError):
+            raise
         raise ProblemFormatError(f"{path}: matrix {name} is missing or malformed: {exc}") from None
+    if m < 0 or n < 0:
+        raise ProblemFormatError(f"{path}: matrix {name} declares a negative size {m} x {n}")
+    budget = _core.memory_budget()
+    if (max(m, n) + 1) * 8 > budget:
+        raise ProblemTooLargeError(
+            f"{path}: matrix {name} declares {m} x {n}: its index pointers alone need "
+            f"{(max(m, n) + 1) * 8} bytes, over the memory budget of {budget} bytes"
+        )
+    where = f"{path}: "
     try:
         if nz >= 0:
             if min(len(p), len(i), len(x)) < nz:
-                raise ValueError(f"fewer than nz = {nz} stored entries")
-            mat = sp.coo_matrix((x[:nz], (i[:nz], p[:nz])), shape=(m, n)).tocsr()
-        elif nz == -1:
-            mat = sp.csc_matrix((x[: p[-1]], i[: p[-1]], p), shape=(m, n)).tocsr()
-        elif nz == -2:
-            mat = sp.csr_matrix((x[: p[-1]], i[: p[-1]], p), shape=(m, n))
+                raise ProblemFormatError(
+                    f"{path}: matrix {name} has fewer than nz = {nz} stored entries"
+                )
+            rows, cols = i[:nz], p[:nz]
+            for idx, size, axis in ((rows, m, "row"), (cols, n, "column")):
+                if idx.size and (idx.min() < 0 or idx.max() >= size):
+                    raise ProblemFormatError(
+                        f"{path}: matrix {name} has a {axis} index outside [0, {size})"
+                    )
+            mat = sp.coo_matrix((x[:nz], (rows, cols)), shape=(m, n)).tocsr()
+        elif nz in (-1, -2):
+            major, minor = (n, m) if nz == -1 else (m, n)
+            ptr, idx = _validate.compressed_indices(f"matrix {name}", p, i, major, minor, where)
+            if x.shape[0] < ptr[-1]:
+                raise ProblemFormatError(
+                    f"{path}: matrix {name} has {x.shape[0]} values for {ptr[-1]} entries"
+                )
+            kind = sp.csc_matrix if nz == -1 else sp.csr_matrix
+            mat = kind((x[: ptr[-1]], idx, ptr), shape=(m, n)).tocsr()
         else:
-            raise ValueError(f"unknown storage nz = {nz}")
+            raise ProblemFormatError(f"{path}: matrix {name} has an unknown storage nz = {nz}")
         mat.check_format(full_check=True)
+    except ShapeError as exc:
+        raise ProblemFormatError(str(exc)) from None
     except (ValueError, IndexError) as exc:
+        if isinstance(exc, ProblemFormatError):
+            raise
         raise ProblemFormatError(f"{path}: matrix {name}: {exc}") from None
     if not np.isfinite(mat.data).all():
         raise ProblemFormatError(f"{path}: matrix {name} has NaN or infinite entries")
@@ -156,8 +209,10 @@ def _fclib_matrix(group: Any, name: str, path: str) -> Any:
 
 def _fclib_vector(group: Any, name: str, n: int, path: str) -> NDArray[np.float64]:
     try:
-        v = np.asarray(group["vectors"][name][:], dtype=np.float64).reshape(-1)
-    except (KeyError, TypeError, ValueError) as exc:
+        v = _dataset(group["vectors"], name, np.float64, f"vector {name}", path)
+    except (KeyError, TypeError, ValueError, IndexError) as exc:
+        if isinstance(exc, ProblemTooLargeError):
+            raise
         raise ProblemFormatError(f"{path}: vector {name} is missing or malformed: {exc}") from None
     if v.shape[0] != n:
         raise ProblemFormatError(f"{path}: vector {name} has {v.shape[0]} entries, expected {n}")
@@ -216,13 +271,27 @@ def read_fclib(path: str | os.PathLike[str]) -> FrictionContactProblem:
         import scipy.sparse  # noqa: F401
     except ImportError as exc:
         raise ImportError("reading FCLib files needs scipy (pip install scipy)") from exc
-    p = os.fspath(path)
+    p = _path(path)
     if not os.path.exists(p):
         raise FileNotFoundError(p)
     try:
         f = h5py.File(p, "r")
     except OSError as exc:
         raise ProblemFormatError(f"{p}: not an HDF5 file: {exc}") from None
+    try:
+        return _read_fclib_file(f, p)
+    except (RuntimeError, OSError, KeyError, TypeError, AttributeError) as exc:
+        # h5py's own errors on a corrupted file (bad object headers, truncated data, ...)
+        raise ProblemFormatError(f"{p}: corrupted or unreadable HDF5 content: {exc}") from None
+    finally:
+        try:
+            f.close()
+        except Exception:
+            pass
+
+
+def _read_fclib_file(f: Any, p: str) -> FrictionContactProblem:
+    """The body of :func:`read_fclib` on an open file."""
     with f:
         if "fclib_global_rolling" in f:
             raise ProblemFormatError(

@@ -34,9 +34,9 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import _core
+from . import _core, _validate
 from ._result import Result
-from .errors import InvalidInputError, InvalidParameterError, ShapeError
+from .errors import ArgumentTypeError, InvalidParameterError, ShapeError
 
 __all__ = ["LcpResult", "check", "solve"]
 
@@ -45,6 +45,8 @@ _METHODS = ("lemke", "pgs", "enumerate")
 Engine = Literal["auto", "tableau", "product_form"]
 _ENGINES = ("auto", "tableau", "product_form")
 _F64 = np.dtype(np.float64)
+#: the most covering vectors Lemke tries after the first (Rust ``lcp::lemke::MAX_RESTARTS``).
+_MAX_RESTARTS = 1000
 
 
 class LcpResult(Result):
@@ -107,26 +109,10 @@ class LcpResult(Result):
     solve_time: float
 
 
-def _as_array(x: ArrayLike, name: str, ndim: int) -> NDArray[np.float64]:
-    """float64, C-contiguous, of the given dimension; no copy when it already is."""
-    if (
-        type(x) is np.ndarray
-        and x.dtype == np.float64
-        and x.ndim == ndim
-        and x.flags.c_contiguous
-    ):
-        return x
-    if hasattr(x, "toarray") and callable(x.toarray):  # scipy.sparse
-        x = x.toarray()
-    if np.iscomplexobj(x):
-        raise InvalidInputError(f"{name} must be real, got a complex array")
-    try:
-        arr = np.ascontiguousarray(x, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise InvalidInputError(f"{name} must be an array of real numbers: {exc}") from None
-    if arr.ndim != ndim:
-        raise ShapeError(f"{name} must be {ndim}-D, got shape {arr.shape}")
-    return arr
+def _as_array(x: ArrayLike, name: str, ndim: int | None) -> NDArray[np.float64]:
+    """float64, C-contiguous, of the given dimension; no copy when it already is (see
+    :func:`coulomb._validate.array` for what is refused)."""
+    return _validate.array(x, name, ndim)
 
 
 def _basis_indices(warm_start: Any, n: int) -> list[int] | None:
@@ -134,7 +120,15 @@ def _basis_indices(warm_start: Any, n: int) -> list[int] | None:
         return None
     if isinstance(warm_start, LcpResult):
         warm_start = warm_start.basis
-    arr = np.asarray(warm_start)
+    if isinstance(warm_start, (str, bytes)) or np.ndim(warm_start) > 1:
+        raise ArgumentTypeError(
+            "warm_start must be indices (ints), a boolean mask, or a previous LcpResult, "
+            f"got {warm_start!r}"
+        )
+    try:
+        arr = np.asarray(warm_start)
+    except ValueError:
+        raise InvalidParameterError("warm_start must be a flat sequence of indices") from None
     if arr.dtype == bool:
         if arr.shape != (n,):
             raise ShapeError(f"a boolean warm_start must have shape ({n},), got {arr.shape}")
@@ -159,12 +153,12 @@ def solve(
     max_pivots: int | None = None,
     covering_vector: ArrayLike | None = None,
     warm_start: Sequence[int] | NDArray[Any] | LcpResult | None = None,
-    polish: bool = True,
-    restarts: int = 2,
-    max_iter: int = 10_000,
-    relaxation: float = 1.0,
+    polish: bool | None = None,
+    restarts: int | None = None,
+    max_iter: int | None = None,
+    relaxation: float | None = None,
     initial: ArrayLike | None = None,
-    engine: Engine = "auto",
+    engine: Engine | None = None,
 ) -> LcpResult:
     """Solve the LCP ``0 <= z ⊥ M z + q >= 0``.
 
@@ -177,9 +171,9 @@ def solve(
     method : {"lemke", "pgs", "enumerate"}
         See the module documentation.
     tol : float
-        Tolerance on ``error`` and ``scaled_error`` for ``success``.
+        Tolerance on ``error`` and ``scaled_error`` for ``success``, in (0, 1).
     max_pivots : int, optional
-        Lemke's pivot limit (default ``max(1000, 50 n)``).
+        Lemke's pivot limit, an int in [1, 10^9] (default ``max(1000, 50 n)``).
     covering_vector : (n,) array_like, optional
         Lemke's covering vector d > 0, in the units of q. Default: all ones on the equilibrated
         problem, which makes the pivot path independent of the rows' units. Pass
@@ -188,14 +182,15 @@ def solve(
         A guessed basis (the indices with z_i > 0, e.g. the previous time step's
         ``result.basis``). If it solves the problem no pivot is made; else Lemke starts cold.
     polish : bool
-        Re-solve the final basis's principal system on the original data; keep it if better.
+        Re-solve the final basis's principal system on the original data; keep it if better
+        (default True).
     restarts : int
         After a ray termination, how many other covering vectors Lemke tries (only when
-        ``covering_vector`` is not given).
+        ``covering_vector`` is not given): an int in [0, 1000], default 2.
     max_iter : int
-        PGS sweep limit.
+        PGS sweep limit, an int in [1, 10^9] (default 10,000).
     relaxation : float
-        PGS over-relaxation ω in (0, 2).
+        PGS over-relaxation ω in (0, 2) (default 1).
     initial : (n,) array_like, optional
         PGS starting point.
     engine : {"auto", "tableau", "product_form"}
@@ -208,10 +203,15 @@ def solve(
     -------
     LcpResult
 
+    The options of one method (``max_pivots``, ``covering_vector``, ``warm_start``,
+    ``polish``, ``restarts``, ``engine`` for Lemke; ``max_iter``, ``relaxation``, ``initial``
+    for PGS) are refused with another method. Ctrl-C stops the solve (``KeyboardInterrupt``).
+
     Raises
     ------
     ShapeError, NonFiniteError, InvalidParameterError, ProblemTooLargeError
-        Before any work, for bad input.
+        Before any work, for bad input (:class:`~coulomb.errors.ArgumentTypeError`, also a
+        ``TypeError``, for an argument of the wrong type).
     """
     # The common call (float64 C-contiguous arrays, default options) skips the generic
     # conversions: for small n the Python layer would otherwise cost more than the solve.
@@ -232,31 +232,35 @@ def solve(
     n = qa.shape[0]
     if Ma.shape != (n, n):
         raise ShapeError(f"M must have shape ({n}, {n}) to match q of length {n}, got {Ma.shape}")
-    if method not in _METHODS:
-        raise InvalidParameterError(f"unknown method {method!r}: expected one of {_METHODS}")
-    if engine not in _ENGINES:
-        raise InvalidParameterError(f"unknown engine {engine!r}: expected one of {_ENGINES}")
-    cover = None if covering_vector is None else _as_array(covering_vector, "covering_vector", 1)
-    init = None if initial is None else _as_array(initial, "initial", 1)
-    if max_pivots is not None and max_pivots < 1:
-        raise InvalidParameterError(f"max_pivots must be at least 1, got {max_pivots}")
-    if restarts < 0 or max_iter < 1:
-        raise InvalidParameterError("restarts must be >= 0 and max_iter >= 1")
-    out = _core.lcp_solve(
-        Ma,
-        qa,
-        method,
-        float(tol),
-        max_pivots,
-        cover,
-        None if warm_start is None else _basis_indices(warm_start, n),
-        bool(polish),
-        int(restarts),
-        int(max_iter),
-        float(relaxation),
-        init,
-        engine,
-    )
+    if type(tol) is not float or not 0.0 < tol < 1.0:
+        tol = _validate.tolerance("tol", tol)
+    if method == "lemke":
+        if max_iter is not None or relaxation is not None or initial is not None:
+            _validate.unused("method", method, max_iter=max_iter, relaxation=relaxation,
+                             initial=initial)
+        max_piv = None if max_pivots is None else _validate.count("max_pivots", max_pivots)
+        n_restarts = 2 if restarts is None else _validate.count(
+            "restarts", restarts, minimum=0, maximum=_MAX_RESTARTS)
+        do_polish = True if polish is None else _validate.boolean("polish", polish)
+        eng = "auto" if engine is None else _validate.choice("engine", engine, _ENGINES)
+        cover = (None if covering_vector is None
+                 else _as_array(covering_vector, "covering_vector", 1))
+        basis = None if warm_start is None else _basis_indices(warm_start, n)
+        out = _core.lcp_solve(Ma, qa, method, tol, max_piv, cover, basis, do_polish,
+                              n_restarts, 10_000, 1.0, None, eng)
+        return LcpResult(out)
+    _validate.choice("method", method, _METHODS)
+    _validate.unused("method", method, max_pivots=max_pivots, covering_vector=covering_vector,
+                     warm_start=warm_start, polish=polish, restarts=restarts, engine=engine)
+    if method == "enumerate":
+        _validate.unused("method", method, max_iter=max_iter, relaxation=relaxation,
+                         initial=initial)
+    sweeps = 10_000 if max_iter is None else _validate.count("max_iter", max_iter)
+    omega = 1.0 if relaxation is None else _validate.real(
+        "relaxation", relaxation, low=0.0, high=2.0, low_open=True, high_open=True)
+    init = None if initial is None else _validate.finite_array(initial, "initial", 1)
+    out = _core.lcp_solve(Ma, qa, method, tol, None, None, None, True, 2, sweeps, omega,
+                          init, "auto")
     return LcpResult(out)
 
 

@@ -43,12 +43,18 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Any, Literal, cast
 
 import numpy as np
 
-from . import _core
-from .errors import InvalidParameterError, NonFiniteError, ShapeError
+from . import _core, _validate
+from .errors import (
+    ArgumentTypeError,
+    InvalidParameterError,
+    NonFiniteError,
+    ProblemTooLargeError,
+    ShapeError,
+)
 from .trajectory import Trajectory
 
 __all__ = [
@@ -73,22 +79,58 @@ Solver = Literal["nsgs", "lemke"]
 
 
 def _vector(name: str, value: Any, n: int) -> list[float]:
-    arr = np.asarray(value, dtype=np.float64).reshape(-1) if value is not None else None
-    if arr is None or arr.shape != (n,):
-        got = None if arr is None else arr.shape
-        raise ShapeError(f"{name} must have {n} entries, got shape {got}")
+    if value is None:
+        raise ArgumentTypeError(f"{name} must be {n} real numbers, got None")
+    arr = _validate.array(value, name, None).reshape(-1)
+    if arr.shape != (n,):
+        raise ShapeError(f"{name} must have {n} entries, got {arr.shape[0]}")
     if not np.all(np.isfinite(arr)):
         raise NonFiniteError(f"{name} has a non-finite entry: {arr.tolist()}")
     return arr.tolist()
 
 
 def _positive(name: str, value: float) -> float:
-    v = float(value)
-    if not math.isfinite(v):
-        raise NonFiniteError(f"{name} must be finite, got {v}")
-    if v <= 0.0:
-        raise InvalidParameterError(f"{name} must be > 0, got {v}")
-    return v
+    return _validate.real(name, value, low=0.0, low_open=True, data=True)
+
+
+def _steps(t_end: float, h: float) -> int:
+    """``ceil(t_end / h)``, at least 1, at most :data:`coulomb._validate.MAX_COUNT`."""
+    ratio = t_end / h
+    if not ratio <= _validate.MAX_COUNT:
+        raise InvalidParameterError(
+            f"t_end / h = {ratio:.3g} steps, more than the limit of {_validate.MAX_COUNT}: "
+            "use a larger h or a shorter t_end"
+        )
+    return max(1, math.ceil(ratio - 1e-9))
+
+
+def _solver_options(
+    dim: int, solver: Any, tol: Any, max_iter: Any, relaxation: Any, facets: Any
+) -> tuple[Solver, float, int | None, float, int | None]:
+    """A simulation's contact-solver options, checked as :func:`coulomb.contact.solve` checks
+    them (the same messages, the same refusals)."""
+    _validate.choice("solver", solver, ("nsgs", "lemke"),
+                     "'nsgs' exact friction disk, 'lemke' polyhedral cone")
+    if tol is None:
+        tol = 1e-12 if solver == "nsgs" else 1e-9
+    _, t, it, om, fa, _ = _validate.contact_options(dim, solver, tol, max_iter, relaxation,
+                                                    facets, None)
+    if fa is not None and dim == 2 and fa != 2:
+        raise InvalidParameterError(
+            f"facets must be 2 in 2D (the tangent directions +1 and -1, which are exact), "
+            f"got {fa}")
+    if fa is not None and dim == 3 and (fa < 4 or fa % 2):
+        raise InvalidParameterError(
+            f"facets must be even and at least 4 in 3D (tangent directions in +/- pairs), "
+            f"got {fa}")
+    return cast(Solver, solver), t, it, om, fa
+
+
+def _dim(dim: Any) -> None:
+    if isinstance(dim, (bool, np.bool_)) or not isinstance(dim, (int, np.integer)) or int(
+        dim
+    ) not in (2, 3):
+        raise InvalidParameterError(f"dim must be 2 (planar) or 3 (spatial), got {dim!r}")
 
 
 # --- bodies --------------------------------------------------------------------------------
@@ -316,8 +358,7 @@ class Scene:
     """A planar (``dim=2``) or spatial (``dim=3``) scene under uniform gravity (m/s^2)."""
 
     def __init__(self, dim: int = 2, gravity: Sequence[float] | None = None) -> None:
-        if dim not in (2, 3):
-            raise InvalidParameterError(f"dim must be 2 (planar) or 3 (spatial), got {dim}")
+        _dim(dim)
         self.dim = int(dim)
         g = gravity if gravity is not None else [0.0] * (dim - 1) + [-9.81]
         self.gravity = _vector("gravity", g, dim)
@@ -354,11 +395,8 @@ class Scene:
                 e: float = 0.0) -> None:
         """Declares that ``shape`` may touch ``other`` (a half-space, or a sphere on another
         body), with friction coefficient ``mu >= 0`` and Newton restitution ``e`` in [0, 1]."""
-        mu, e = float(mu), float(e)
-        if not (math.isfinite(mu) and mu >= 0.0):
-            raise InvalidParameterError(f"mu must be finite and >= 0, got {mu}")
-        if not (math.isfinite(e) and 0.0 <= e <= 1.0):
-            raise InvalidParameterError(f"e must be in [0, 1], got {e}")
+        mu = _validate.real("mu", mu, low=0.0, data=True)
+        e = _validate.real("e", e, low=0.0, high=1.0, data=True)
         a = _index([s for _, s in self.shapes], shape, "shape")
         if isinstance(other, HalfSpace):
             self.pairs.append(("half_space", a, _index(self.half_spaces, other, "half-space"),
@@ -380,11 +418,8 @@ class Scene:
         declared with :meth:`contact` keeps that declaration's ``mu`` and ``e``. Contact ids
         of these pairs are ``D + i B + j`` (``D`` declared candidates, ``B`` spheres, ``i < j``
         the spheres' indices in the order they were attached)."""
-        mu, e = float(mu), float(e)
-        if not (math.isfinite(mu) and mu >= 0.0):
-            raise InvalidParameterError(f"mu must be finite and >= 0, got {mu}")
-        if not (math.isfinite(e) and 0.0 <= e <= 1.0):
-            raise InvalidParameterError(f"e must be in [0, 1], got {e}")
+        mu = _validate.real("mu", mu, low=0.0, data=True)
+        e = _validate.real("e", e, low=0.0, high=1.0, data=True)
         if any(p[0] == "spheres" for p in self.pairs):
             raise InvalidParameterError("contact_spheres was already called on this scene")
         self.pairs.append(("spheres", 0, 0, mu, e))
@@ -442,6 +477,7 @@ class Scene:
         drift: Literal["none", "bias", "projection"] = "none",
         drift_bias: float = 0.2,
         restitution: Literal["newton", "poisson"] = "newton",
+        record_every: int = 1,
         locate_impacts: bool = False,
     ) -> Trajectory:
         """Runs ``ceil(t_end / h)`` steps of the impulse time stepper from the initial state.
@@ -498,45 +534,47 @@ class Scene:
             apex energy is then kept bounce after bounce (the plain step loses ``m g y_k`` per
             bounce, ``y_k`` the height at the start of the landing step). Other steps are
             plain steps.
+        record_every : int
+            Keep the state only after every ``record_every``-th step (and after the last); a
+            kept step's checks (status, error, residuals, violations) are the worst over the
+            steps since the previous kept one, so no failure is lost, and the contact records
+            are those of the kept steps (``contact_step`` is then the row in the step
+            arrays). The records grow as the run goes; their size is checked against
+            ``coulomb.memory_budget()`` and a run that would exceed it is refused
+            (:class:`~coulomb.errors.ProblemTooLargeError`, saying which ``record_every``
+            fits).
+
+        Counts are ints (``max_iter``, ``facets``, ``record_every``), ``t_end / h`` at most
+        10^9 steps; options of the other solver are refused (``relaxation`` is NSGS's,
+        ``facets`` Lemke's). Ctrl-C stops the run (``KeyboardInterrupt``).
         """
         t_end = _positive("t_end", t_end)
         h = _positive("h", h)
-        if solver not in ("nsgs", "lemke"):
-            raise InvalidParameterError(
-                f"unknown solver {solver!r}: expected 'nsgs' (exact friction disk) or 'lemke' "
-                "(polyhedral cone)"
-            )
-        if tol is None:
-            tol = 1e-12 if solver == "nsgs" else 1e-9
-        tol = _positive("tol", tol)
-        if not (0.0 < relaxation < 2.0):
-            raise InvalidParameterError(f"relaxation must lie in (0, 2), got {relaxation}")
-        if max_iter is not None and int(max_iter) < 1:
-            raise InvalidParameterError(f"max_iter must be >= 1, got {max_iter}")
-        gap_tolerance = float(gap_tolerance)
-        if not (math.isfinite(gap_tolerance) and gap_tolerance >= 0.0):
-            raise InvalidParameterError(f"gap_tolerance must be finite and >= 0, got "
-                                        f"{gap_tolerance}")
-        if drift not in ("none", "bias", "projection"):
-            raise InvalidParameterError(
-                f"unknown drift correction {drift!r}: expected 'none', 'bias' or 'projection'")
-        if drift == "bias" and not (0.0 < float(drift_bias) <= 1.0):
-            raise InvalidParameterError(f"drift_bias must lie in (0, 1], got {drift_bias}")
-        if restitution not in ("newton", "poisson"):
-            raise InvalidParameterError(
-                f"unknown restitution law {restitution!r}: expected 'newton' or 'poisson'")
+        steps = _steps(t_end, h)
+        solver, tol, max_iter, relaxation, facets = _solver_options(
+            self.dim, solver, tol, max_iter, relaxation, facets)
+        gap_tolerance = _validate.real("gap_tolerance", gap_tolerance, low=0.0)
+        warm_start = _validate.boolean("warm_start", warm_start)
+        fallback = _validate.boolean("fallback", fallback)
+        _validate.choice("drift", drift, ("none", "bias", "projection"), "drift correction")
+        drift_bias = _validate.real("drift_bias", drift_bias, low=0.0, high=1.0, low_open=True)
+        _validate.choice("restitution", restitution, ("newton", "poisson"), "impact law")
+        record_every = _validate.count("record_every", record_every)
+        locate_impacts = _validate.boolean("locate_impacts", locate_impacts)
         if not self.bodies:
             raise InvalidParameterError("the scene has no bodies")
-        steps = max(1, math.ceil(t_end / h - 1e-9))
         spec = self._spec()
         raw = _core.step_simulate(
             spec, h, steps, solver=solver, tol=tol, max_iter=max_iter, relaxation=relaxation,
             facets=facets, gap_tolerance=gap_tolerance, warm_start=warm_start,
             fallback=fallback, drift=drift, drift_bias=float(drift_bias),
-            restitution=restitution, locate_impacts=bool(locate_impacts),
+            restitution=restitution, record_every=record_every,
+            locate_impacts=locate_impacts,
         )
-        return Trajectory._from_core(raw, scene=self, h=h, solver=solver,
-                                     gap_tolerance=gap_tolerance)
+        tr = Trajectory._from_core(raw, scene=self, h=h, solver=solver,
+                                   gap_tolerance=gap_tolerance, tol=tol)
+        tr["record_every"] = record_every
+        return tr
 
 
 # --- user-defined models in generalized coordinates -----------------------------------------
@@ -592,10 +630,11 @@ class Model:
         contacts: Sequence[GapContact] = (),
         potential: Callable[[np.ndarray], float] | None = None,
     ) -> None:
-        if dim not in (2, 3):
-            raise InvalidParameterError(f"dim must be 2 (planar) or 3 (spatial), got {dim}")
+        _dim(dim)
         self.dim = int(dim)
-        q = np.asarray(q0, dtype=np.float64).reshape(-1)
+        if q0 is None:
+            raise ArgumentTypeError("q0 must be an array of real numbers, got None")
+        q = _validate.array(q0, "q0", None).reshape(-1)
         self.q0 = np.asarray(_vector("q0", q, q.size))
         n = self.q0.size
         self.v0 = np.asarray(_vector("v0", v0 if v0 is not None else np.zeros(n), n))
@@ -604,11 +643,11 @@ class Model:
         self.potential = potential
         for i, c in enumerate(contacts):
             if not isinstance(c, GapContact):
-                raise InvalidParameterError(f"contact {i} must be a GapContact")
-            if not (math.isfinite(c.mu) and c.mu >= 0.0):
-                raise InvalidParameterError(f"contact {i}: mu must be finite and >= 0")
-            if not (0.0 <= c.e <= 1.0):
-                raise InvalidParameterError(f"contact {i}: e must be in [0, 1], got {c.e}")
+                raise ArgumentTypeError(f"contact {i} must be a GapContact, got {c!r}")
+            _validate.real(f"contact {i}'s mu", c.mu, low=0.0)
+            _validate.real(f"contact {i}'s e", c.e, low=0.0, high=1.0)
+            if not callable(c.gap):
+                raise ArgumentTypeError(f"contact {i}'s gap must be a function of q")
             if c.mu > 0 and c.tangent_jacobian is None and c.tangent_position is None:
                 raise InvalidParameterError(
                     f"contact {i} has friction: give tangent_jacobian or tangent_position")
@@ -634,16 +673,35 @@ class Model:
     def _frame(self, c: GapContact, q: np.ndarray) -> tuple[float, np.ndarray]:
         """The gap and the rows ``[J_n; J_t]`` (dim x nv) of one contact at q."""
         n = q.size
-        g = float(c.gap(q))
-        jn = (np.asarray(c.normal_jacobian(q), dtype=np.float64).reshape(n)
-              if c.normal_jacobian is not None else _numeric_jacobian(c.gap, q, 1)[0])
+        i = next(k for k, x in enumerate(self.contacts) if x is c)
+        try:
+            g = float(c.gap(q))
+        except (TypeError, ValueError) as exc:
+            raise ArgumentTypeError(
+                f"contact {i}'s gap function must return a real number: {exc}") from None
+        if not math.isfinite(g):
+            raise NonFiniteError(
+                f"contact {i}'s gap function returned {g} at q = {q.tolist()}")
         rows = np.zeros((self.dim, n))
-        rows[0] = jn
-        if c.tangent_jacobian is not None:
-            rows[1:] = np.asarray(c.tangent_jacobian(q), dtype=np.float64).reshape(
-                self.dim - 1, n)
-        elif c.tangent_position is not None:
-            rows[1:] = _numeric_jacobian(c.tangent_position, q, self.dim - 1)
+        try:
+            rows[0] = (_validate.array(c.normal_jacobian(q), f"contact {i}'s normal_jacobian",
+                                       None).reshape(n)
+                       if c.normal_jacobian is not None else _numeric_jacobian(c.gap, q, 1)[0])
+            if c.tangent_jacobian is not None:
+                rows[1:] = _validate.array(c.tangent_jacobian(q),
+                                           f"contact {i}'s tangent_jacobian",
+                                           None).reshape(self.dim - 1, n)
+            elif c.tangent_position is not None:
+                rows[1:] = _numeric_jacobian(c.tangent_position, q, self.dim - 1)
+        except ValueError as exc:
+            if isinstance(exc, (ShapeError, InvalidParameterError)):
+                raise
+            raise ShapeError(f"contact {i}: the Jacobian rows must be {self.dim} x {n} "
+                             f"(J_n: {n} entries, J_t: {self.dim - 1} x {n}): {exc}") from None
+        if not np.all(np.isfinite(rows)):
+            raise NonFiniteError(
+                f"contact {i}'s Jacobian rows [J_n; J_t] have a non-finite entry at "
+                f"q = {q.tolist()}")
         return g, rows
 
     def simulate(
@@ -663,10 +721,19 @@ class Model:
         from . import contact as _contact
 
         t_end, h = _positive("t_end", t_end), _positive("h", h)
-        if solver not in ("nsgs", "lemke"):
-            raise InvalidParameterError(f"unknown solver {solver!r}")
-        tol = _positive("tol", tol if tol is not None else (1e-12 if solver == "nsgs" else 1e-9))
-        steps = max(1, math.ceil(t_end / h - 1e-9))
+        steps = _steps(t_end, h)
+        solver, tol, max_iter, _, facets = _solver_options(
+            self.dim, solver, tol, max_iter, 1.0, facets)
+        gap_tolerance = _validate.real("gap_tolerance", gap_tolerance, low=0.0)
+        warm_start = _validate.boolean("warm_start", warm_start)
+        fallback = _validate.boolean("fallback", fallback)
+        row_bytes = 8 * (2 * self.q0.size + 16)
+        if (steps + 1) * row_bytes > _core.memory_budget():
+            raise ProblemTooLargeError(
+                f"recording {steps + 1} states of {self.q0.size} coordinates needs about "
+                f"{(steps + 1) * row_bytes} bytes, over the memory budget of "
+                f"{_core.memory_budget()} bytes (coulomb.set_memory_budget raises it): "
+                "simulate a shorter span per call")
         dim, nc = self.dim, len(self.contacts)
         q, v = self.q0.copy(), self.v0.copy()
         warm = np.zeros((nc, dim))
@@ -674,7 +741,7 @@ class Model:
         landed = np.zeros(nc, dtype=bool)
         rec: dict[str, list[Any]] = {k: [] for k in (
             "t", "q", "v", "kinetic_energy", "potential_energy", "min_gap", "negative_gaps",
-            "active", "status", "error", "iterations", "momentum_residual",
+            "active", "status", "error", "scaled_error", "iterations", "momentum_residual",
             "min_normal_impulse", "cone_violation", "complementarity", "resumed", "fallback",
             "contact_step", "contact_id", "contact_impulse", "contact_velocity",
             "contact_approach", "contact_gap", "contact_closed")}
@@ -709,6 +776,7 @@ class Model:
             v_next = v_free.copy()
             gp = np.zeros(q.size)
             status, err, iters, mn, cone, comp = "no_contact", 0.0, 0, 0.0, 0.0, 0.0
+            serr = 0.0
             if active:
                 G = np.vstack([rows for _, _, rows, _, _ in active])  # (dim na, nv)
                 minv_gt = np.linalg.solve(m, G.T)
@@ -738,13 +806,17 @@ class Model:
                     if not res.success and fallback and solver == "nsgs":
                         alt = _contact.solve(W, qc, mus, dim=dim, method="lemke",
                                              tol=max(tol, 1e-9))
-                        if alt.error < res.error:
+                        if alt.scaled_error < res.scaled_error:
                             used_fallback = True
-                            res = alt
-                            if alt.error <= max(tol, 1e-9):
+                            first_status, res = res.status, alt
+                            if alt.scaled_error <= max(tol, 1e-9):
                                 res["status"] = "solved"
+                            elif alt.status == "solved":
+                                # a polygon's answer (3D) that misses the exact cone
+                                res["status"] = first_status
                     r = res.impulse.reshape(-1)
                     status, err, iters = res.status, res.error, res.iterations
+                    serr = res.scaled_error
                     mn, cone = res.min_normal_impulse, res.cone_violation
                     comp = res.max_complementarity
                 gp = G.T @ r
@@ -769,6 +841,7 @@ class Model:
             res_norm = float(np.linalg.norm(mdv - gp))
             rec["momentum_residual"].append(res_norm / scale if scale > 1e-300 else res_norm)
             for key, val in (("active", len(active)), ("status", status), ("error", err),
+                             ("scaled_error", serr),
                              ("iterations", iters), ("min_normal_impulse", mn),
                              ("cone_violation", cone), ("complementarity", comp),
                              ("resumed", resumed), ("fallback", used_fallback)):
@@ -796,4 +869,4 @@ class Model:
             else:
                 raw[key] = np.array(val, dtype=np.float64)
         return Trajectory._from_core(raw, scene=None, h=h, solver=solver,
-                                     gap_tolerance=gap_tolerance)
+                                     gap_tolerance=gap_tolerance, tol=tol)

@@ -34,8 +34,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import _validate
 from ._result import Result
-from .errors import InvalidParameterError, NonFiniteError
+from .errors import InvalidParameterError
 
 __all__ = ["PainleveAnalysis", "PainleveRod"]
 
@@ -53,10 +54,7 @@ class PainleveAnalysis(Result):
 
 
 def _finite(name: str, value: float) -> float:
-    value = float(value)
-    if not math.isfinite(value):
-        raise NonFiniteError(f"{name} must be finite, got {value}")
-    return value
+    return _validate.real(name, value, data=True)
 
 
 @dataclass(frozen=True)

@@ -32,8 +32,9 @@ from typing import Any
 
 import numpy as np
 
+from . import _validate
 from ._extras import require
-from .errors import InvalidParameterError
+from .errors import ArgumentTypeError, InvalidParameterError
 
 __all__ = [
     "Study",
@@ -227,27 +228,27 @@ class Study:
 
         if ax is None:
             _, ax = plt.subplots(figsize=(6, 4))
+        from ._plot import place_labels, study_axis_label
+
         xs = [float(r[x]) for r in self.records]
         ys = [float(r[y]) for r in self.records]
         ax.scatter(xs, ys, s=14, alpha=0.6, label="settings")
         front = pareto_front(self.records, y, x)
         ax.plot([r[x] for r in front], [r[y] for r in front], "r.-", label="Pareto front")
-        for r in front:
-            ax.annotate(
-                ", ".join(f"{k}={r[k]}" for k in self.settings),
-                (r[x], r[y]),
-                fontsize=6,
-                xytext=(3, 3),
-                textcoords="offset points",
-            )
         if all(v > 0 for v in xs):
             ax.set_xscale("log")
         if all(v > 0 for v in ys):
             ax.set_yscale("log")
-        ax.set_xlabel(x)
-        ax.set_ylabel(y)
+        # the front's points numbered beside them (kept apart), their settings in the legend
+        place_labels(ax, [(float(r[x]), float(r[y])) for r in front],
+                     [str(i + 1) for i in range(len(front))])
+        for i, r in enumerate(front):
+            ax.plot([], [], " ", label=f"{i + 1}: " + ", ".join(
+                f"{k}={r[k]}" for k in self.settings))
+        ax.set_xlabel(study_axis_label(x))
+        ax.set_ylabel(study_axis_label(y))
         ax.set_title(self.name)
-        ax.legend(fontsize=7)
+        ax.legend(fontsize=6, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0)
         if path is not None:
             ax.figure.savefig(path, dpi=120, bbox_inches="tight")
         return ax
@@ -285,8 +286,9 @@ def sweep(
     progress
         True prints one line per finished point to stderr; or a callable taking the line.
     """
-    if repeat < 1:
-        raise InvalidParameterError(f"repeat must be >= 1, got {repeat}")
+    if not callable(run):
+        raise ArgumentTypeError(f"run must be a callable returning a mapping, got {run!r}")
+    repeat = _validate.count("repeat", repeat)
     if reference is not None and reference_settings is not None:
         raise InvalidParameterError("give reference or reference_settings, not both")
     points = _grid_points(grid)

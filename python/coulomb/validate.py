@@ -86,15 +86,14 @@ def _stepper_rows() -> Iterator[Row]:
 
 
 def default_data_dir() -> Path | None:
-    """``$COULOMB_DATA``, else ``../shared/data`` beside a source checkout, else the sets
-    shipped in the checkout's ``tests/data``, if present."""
+    """``$COULOMB_DATA``, else ``../shared/data`` beside a source checkout, else the sets a
+    checkout ships in ``tests/data`` (when run from the checkout's root), if present."""
     env = os.environ.get("COULOMB_DATA")
     candidates = [Path(env)] if env else []
     checkout = Path(__file__).resolve().parents[2]
     candidates.append(Path.cwd().parent / "shared" / "data")
     candidates.append(checkout.parent / "shared" / "data")
     candidates.append(Path.cwd() / "tests" / "data")
-    candidates.append(checkout / "tests" / "data")
     for c in candidates:
         if (c / "siconos-lcp").is_dir():
             return c

@@ -53,7 +53,7 @@ pub struct Finish {
 
 /// Solves the 2D problem on a working set grown from the contacts with `r_n > 0` in `r` (see
 /// the module notes). `None` when the problem is not 2D with isotropic friction, the working
-/// set grows past [`MAX_CONTACTS`], Lemke fails, or no round reaches `error_q <= tol` on the
+/// set grows past [`MAX_CONTACTS`], Lemke fails, or no round passes `tol` ([`super::ContactMeasures::passes`]) on the
 /// whole problem.
 pub fn finish_2d(problem: &ContactProblem<'_>, r: &[f64], tol: f64) -> Result<Option<Finish>> {
     if problem.dim != 2 || !problem.is_isotropic() || r.len() != problem.size() {
@@ -109,7 +109,7 @@ pub fn finish_2d(problem: &ContactProblem<'_>, r: &[f64], tol: f64) -> Result<Op
         }
         let mut u = vec![0.0; problem.size()];
         let measures = measure_into(problem, &full, &mut u);
-        if measures.error_q <= tol {
+        if measures.passes(tol) {
             return Ok(Some(Finish {
                 impulse: full,
                 velocity: u,

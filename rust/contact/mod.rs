@@ -12,12 +12,17 @@
 //!
 //! - [`projection`]: exact projections on the interval, disk, cone and ellipse;
 //! - [`nsgs`]: nonsmooth Gauss-Seidel with the exact friction disk;
-//! - [`polyhedral`]: the Stewart-Trinkle polyhedral-cone LCP solved by Lemke's method.
+//! - [`polyhedral`]: the Stewart-Trinkle polyhedral-cone LCP solved by Lemke's method;
+//! - [`prox`]: the robust mode, proximal semismooth Newton;
+//! - [`solve`]: any of them in normalized units ([`normalize`]).
 //!
-//! Every answer is measured with the literature's natural-map error (see [`measure`]).
+//! Every answer is measured against the original data ([`measure`]); success means the
+//! unit-consistent `scaled_error` passes the tolerance, the rule of [`measures`].
 
 pub mod assembly;
 pub mod lcp_finish;
+pub mod measures;
+pub mod normalize;
 pub mod nsgs;
 pub mod polyhedral;
 pub mod projection;
@@ -25,8 +30,10 @@ pub mod prox;
 pub mod sparse;
 
 use crate::error::{check_finite, CoulombError, Result};
-use projection::{project_cone, tangent_norm};
 
+pub(crate) use measures::measure_into;
+pub use measures::{measure, ContactMeasures};
+pub use normalize::{solve, Method};
 pub use nsgs::{solve_nsgs, ContactOrder, NsgsSettings};
 pub use polyhedral::{solve_polyhedral, PolyhedralSettings};
 pub use sparse::BlockCsr;
@@ -268,6 +275,33 @@ impl<'a> ContactProblem<'a> {
         }
     }
 
+    /// `((W x)_i, (|W| |x|)_i)`: the `dim` components of contact i and the sums of the
+    /// magnitudes of their terms (zero-padded to 3; O(tiles in the row) for block-sparse
+    /// storage); the first is bitwise [`Self::block_row_mul`].
+    pub fn block_row_terms(&self, i: usize, x: &[f64]) -> ([f64; 3], [f64; 3]) {
+        match self.w {
+            Delassus::Dense(w) => {
+                let n = self.size();
+                let d = self.dim;
+                let mut out = [0.0; 3];
+                let mut terms = [0.0; 3];
+                for a in 0..d {
+                    let row = &w[(i * d + a) * n..(i * d + a + 1) * n];
+                    let (mut s, mut t) = (0.0, 0.0);
+                    for (p, q) in row.iter().zip(x) {
+                        let v = p * q;
+                        s += v;
+                        t += v.abs();
+                    }
+                    out[a] = s;
+                    terms[a] = t;
+                }
+                (out, terms)
+            }
+            Delassus::BlockSparse(s) => s.row_mul_terms(i, x),
+        }
+    }
+
     /// `Σ_{j != i} W_ij x_j`: what the other contacts' impulses add to contact i's velocity
     /// (zero-padded to 3; O(tiles in the row) for block-sparse storage).
     #[inline]
@@ -368,29 +402,6 @@ impl std::fmt::Display for ContactStatus {
     }
 }
 
-/// How far impulses r are from solving the problem, from the original W, q, mu.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ContactMeasures {
-    /// the natural-map residual on De Saxce's form,
-    /// `||r - P_K(r - (u + mu ||u_t|| n))|| / max(||q||, ||r||, ||u||)` (divided by 1 instead
-    /// when all three norms are below 1e-300); for a contact with anisotropic friction its
-    /// part of the residual is the elliptic-cone one of [`anisotropic_residual`].
-    pub error: f64,
-    /// the same residual divided by `||q||` (by 1 when `||q|| < 1e-300`), as Acary et al.
-    /// report it.
-    pub error_q: f64,
-    /// `min_i r_{n,i}` (negative means infeasible); 0 without contacts.
-    pub min_normal_impulse: f64,
-    /// `max_i |r_{n,i} u_{n,i}|`.
-    pub max_complementarity: f64,
-    /// `max_i max(||r_{t,i}|| - mu_i r_{n,i}, 0)` (anisotropic contacts: see
-    /// [`anisotropic_residual`]).
-    pub cone_violation: f64,
-    /// `max_i max(0, r_{t,i} . u_{t,i})` over sliding contacts (`||u_t||` above 1e-12 times the
-    /// largest velocity): a sliding impulse must oppose the slip.
-    pub dissipation_violation: f64,
-}
-
 /// The answer of a contact solver.
 #[derive(Clone, Debug)]
 pub struct ContactSolution {
@@ -415,140 +426,9 @@ impl ContactSolution {
     }
 }
 
-const TINY: f64 = 1e-300;
-
-/// `u = W r + q` and the measures of r (see [`ContactMeasures`]); r must have `dim nc`
-/// entries.
-pub fn measure(problem: &ContactProblem<'_>, r: &[f64]) -> Result<(Vec<f64>, ContactMeasures)> {
-    if r.len() != problem.size() {
-        return Err(CoulombError::Shape(format!(
-            "r has length {}, expected {}",
-            r.len(),
-            problem.size()
-        )));
-    }
-    let mut u = vec![0.0; problem.size()];
-    let m = measure_into(problem, r, &mut u);
-    Ok((u, m))
-}
-
-/// `u = W r + q` into `u` and the measures of r, without allocating.
-pub(crate) fn measure_into(
-    problem: &ContactProblem<'_>,
-    r: &[f64],
-    u: &mut [f64],
-) -> ContactMeasures {
-    let dim = problem.dim;
-    problem.mul_w(r, u);
-    for (ui, qi) in u.iter_mut().zip(problem.q) {
-        *ui += qi;
-    }
-    let unorm = norm2(u);
-    let rnorm = norm2(r);
-    let qnorm = norm2(problem.q);
-    let vscale = u.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let mut res2 = 0.0;
-    let mut min_n = if problem.nc == 0 { 0.0 } else { f64::INFINITY };
-    let mut comp: f64 = 0.0;
-    let mut cone: f64 = 0.0;
-    let mut diss: f64 = 0.0;
-    for i in 0..problem.nc {
-        let mu = problem.mu[i];
-        let ri = &r[i * dim..(i + 1) * dim];
-        let ui = &u[i * dim..(i + 1) * dim];
-        let (d2, viol) = match problem.anisotropy(i) {
-            None => {
-                let ut_norm = tangent_norm(&ui[1..]);
-                // v = r - (u + mu ||u_t|| n), residual r - P_K(v)
-                let mut v = [0.0; 3];
-                v[0] = ri[0] - (ui[0] + mu * ut_norm);
-                for k in 1..dim {
-                    v[k] = ri[k] - ui[k];
-                }
-                project_cone(&mut v[..dim], mu);
-                let d2: f64 = (0..dim).map(|k| (ri[k] - v[k]).powi(2)).sum();
-                (d2, tangent_norm(&ri[1..]) - mu * ri[0])
-            }
-            Some(pair) => anisotropic_residual(pair, ri, ui),
-        };
-        res2 += d2;
-        min_n = min_n.min(ri[0]);
-        comp = comp.max((ri[0] * ui[0]).abs());
-        cone = cone.max(viol);
-        let ut_norm = tangent_norm(&ui[1..]);
-        if ut_norm > 1e-12 * vscale {
-            let dot: f64 = (1..dim).map(|k| ri[k] * ui[k]).sum();
-            diss = diss.max(dot);
-        }
-    }
-    let res = res2.sqrt();
-    let denom = qnorm.max(rnorm).max(unorm);
-    let denom = if denom < TINY { 1.0 } else { denom };
-    let denom_q = if qnorm < TINY { 1.0 } else { qnorm };
-    ContactMeasures {
-        error: res / denom,
-        error_q: res / denom_q,
-        min_normal_impulse: min_n,
-        max_complementarity: comp,
-        cone_violation: cone.max(0.0),
-        dissipation_violation: diss.max(0.0),
-    }
-}
-
-/// The natural-map residual of one contact with elliptic friction `(mu_1, mu_2)` (3D), squared,
-/// and its cone violation.
-///
-/// With `m = max(mu_1, mu_2)` and `B = diag(1, mu_1 / m, mu_2 / m)`, the change of variables
-/// `r = B r^`, `u^ = B u` maps the elliptic cone `(r_t1 / mu_1)^2 + (r_t2 / mu_2)^2 <= r_n^2` onto
-/// the isotropic cone `K_m = { ||r^_t|| <= m r^_n }` and keeps the power `r . u = r^ . u^`, so
-/// Coulomb's law with maximal dissipation becomes the isotropic law in the hatted variables
-/// (De Saxce's modified velocity `u^ + m ||u^_t|| n`, where `m ||u^_t|| =
-/// sqrt((mu_1 u_t1)^2 + (mu_2 u_t2)^2)` is the support function of the ellipse, the dissipation
-/// rate per unit normal impulse). The residual is mapped back to impulse units by B:
-///
-/// ```text
-///     e = r - B P_{K_m}( B^+ r - (u^ + m ||u^_t|| n) ),     u^ = B u,
-/// ```
-///
-/// with `B^+` the pseudo-inverse (a tangent with `mu_k = 0` gets `r^_k = 0`, and then
-/// `e_k = r_k`: the impulse must vanish along it). B is invertible on the cone's span, so
-/// `e = 0` exactly at a solution; for `mu_1 = mu_2` it is `B = I` and e is the isotropic
-/// residual. The cone violation is `max(||B^+ r_t|| - m r_n, |r_k| for mu_k = 0)`.
-pub(crate) fn anisotropic_residual(pair: [f64; 2], r: &[f64], u: &[f64]) -> (f64, f64) {
-    let m = pair[0].max(pair[1]);
-    if m <= 0.0 {
-        // frictionless: the half-line
-        let mut v = [r[0] - u[0], r[1] - u[1], r[2] - u[2]];
-        project_cone(&mut v, 0.0);
-        let d2 = (0..3).map(|k| (r[k] - v[k]).powi(2)).sum();
-        return (d2, r[1].abs().max(r[2].abs()));
-    }
-    let b = [pair[0] / m, pair[1] / m];
-    let mut rh = [r[0], 0.0, 0.0];
-    let mut uh = [u[0], 0.0, 0.0];
-    let mut flat: f64 = 0.0;
-    for k in 0..2 {
-        if b[k] > 0.0 {
-            rh[1 + k] = r[1 + k] / b[k];
-            uh[1 + k] = u[1 + k] * b[k];
-        } else {
-            flat = flat.max(r[1 + k].abs());
-        }
-    }
-    let uht = uh[1].hypot(uh[2]);
-    let mut v = [rh[0] - (uh[0] + m * uht), rh[1] - uh[1], rh[2] - uh[2]];
-    project_cone(&mut v, m);
-    let e = [r[0] - v[0], r[1] - b[0] * v[1], r[2] - b[1] * v[2]];
-    let d2 = e.iter().map(|x| x * x).sum();
-    (d2, (rh[1].hypot(rh[2]) - m * r[0]).max(flat))
-}
-
-fn norm2(x: &[f64]) -> f64 {
-    x.iter().map(|v| v * v).sum::<f64>().sqrt()
-}
-
 #[cfg(test)]
 mod tests {
+    use super::projection::project_cone;
     use super::*;
 
     #[test]
@@ -620,7 +500,8 @@ mod tests {
             let r = [rng.normal(), rng.normal(), rng.normal()];
             let u = [rng.normal(), rng.normal(), rng.normal()];
             let mu = rng.range(0.0, 2.0);
-            let (d2, viol) = anisotropic_residual([mu, mu], &r, &u);
+            let (e, viol) = measures::anisotropic_residual([mu, mu], &r, &u);
+            let d2: f64 = e.iter().map(|x| x * x).sum();
             let mut v = [
                 r[0] - u[0] - mu * u[1].hypot(u[2]),
                 r[1] - u[1],
@@ -633,31 +514,5 @@ mod tests {
             let iso = (r[1].hypot(r[2]) - mu * r[0]).max(0.0);
             assert!((viol.max(0.0) - iso).abs() <= 1e-14 * (1.0 + iso));
         }
-    }
-
-    #[test]
-    fn measures_of_the_seed_answer_and_of_zero() {
-        let w = [0.5, 0.0, 0.0, 0.5];
-        let q = [-3.0, 1.0];
-        let p = ContactProblem::new(2, &w, &q, &[0.2]).unwrap();
-        let (u, m) = measure(&p, &[6.0, -1.2]).unwrap();
-        assert!((u[0]).abs() < 1e-15 && (u[1] - 0.4).abs() < 1e-15);
-        assert!(m.error < 1e-15, "{m:?}");
-        assert_eq!(m.dissipation_violation, 0.0);
-        // r = 0: u = q, residual r - P_K(-(q + mu |q_t| n)) = -P_K((2.8, -1)), outside K and
-        // its polar: n' = (2.8 + 0.2) / 1.04, |t'| = 0.2 n', norm 3 / sqrt(1.04)
-        let (_, m) = measure(&p, &[0.0, 0.0]).unwrap();
-        let expected = 3.0 / 1.04f64.sqrt() / 10f64.sqrt();
-        assert!(
-            (m.error - expected).abs() < 1e-14,
-            "{} vs {expected}",
-            m.error
-        );
-        assert_eq!(m.error, m.error_q);
-        // a sliding impulse along the slip is flagged
-        let (_, m) = measure(&p, &[6.0, 1.2]).unwrap();
-        assert!(m.dissipation_violation > 1.0);
-        assert!(measure(&p, &[1.0]).is_err());
-        assert_eq!(ContactStatus::IterationLimit.as_str(), "iteration_limit");
     }
 }

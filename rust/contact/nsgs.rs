@@ -37,8 +37,10 @@
 //!   is the ellipse projection of `-g / t` ([`super::projection::project_ellipse`]); a test pins
 //!   that.
 //!
-//! Frictionless contacts (mu = 0) carry no tangential impulse. The error (see
-//! [`super::ContactMeasures`]) is computed after every sweep from the original W and q, into
+//! Frictionless contacts (mu = 0) carry no tangential impulse. The measures (see
+//! [`super::ContactMeasures`]) are computed after every sweep from the original W and q, and
+//! the sweeps stop when the unit-consistent `scaled_error` passes the tolerance (the verdict's
+//! own test, so NSGS never stops on a measure the verdict would reject), into
 //! buffers allocated once. `b_i` is read from the stored blocks of W's block row i
 //! ([`ContactProblem::block_row_mul_offdiag`]), so with block-sparse W a sweep costs
 //! O(nnz(W)); a sweep allocates nothing (tests/nsgs_alloc.rs counts the allocations).
@@ -54,7 +56,8 @@ pub const LOCAL_ITERS: usize = 8;
 /// Settings of [`solve_nsgs`].
 #[derive(Clone, Debug)]
 pub struct NsgsSettings {
-    /// stop when [`super::ContactMeasures::error`] is at most this.
+    /// stop when [`super::ContactMeasures::scaled_error`] is at most this (the success rule,
+    /// [`super::ContactMeasures::passes`]).
     pub tol: f64,
     /// sweeps at most (at least 1).
     pub max_iter: usize,
@@ -269,7 +272,7 @@ fn local_descent(blk: &LocalBlock, mu: f64, b: &[f64; 3], dim: usize, r: &mut [f
 
 /// Projects contact i's impulse in place onto its friction cone: the Coulomb cone, or for
 /// anisotropic friction the elliptic cone through the change of variables of
-/// [`super::anisotropic_residual`] (`r^ = B^+ r` projected on `K_m`, mapped back by B: a point of
+/// [`super::measures::anisotropic_residual`] (`r^ = B^+ r` projected on `K_m`, mapped back by B: a point of
 /// the elliptic cone, the nearest one in the B-weighted norm). Used for warm starts.
 /// The starting impulses of an iterative solver: zeros, or the caller's warm start (`dim nc`
 /// finite entries), each contact's projected on its friction cone.
@@ -371,8 +374,13 @@ pub fn solve_nsgs(problem: &ContactProblem<'_>, s: &NsgsSettings) -> Result<Cont
     let mut u = vec![0.0; n];
     let mut measures = measure_into(problem, &r, &mut u);
     let mut sweeps = 0;
-    // a NaN error compares false and ends the loop too
-    while measures.error > s.tol && sweeps < s.max_iter {
+    // a NaN error fails `passes` and is caught by the finiteness test below; the caller's
+    // interrupt hook can end the sweeps early (see crate::interrupt)
+    while !measures.passes(s.tol)
+        && measures.scaled_error.is_finite()
+        && sweeps < s.max_iter
+        && !crate::interrupt::poll(n * n)
+    {
         for &i in &sequence {
             let blk = &blocks[i];
             // W is finite, so this is the degenerate test above
@@ -410,12 +418,15 @@ pub fn solve_nsgs(problem: &ContactProblem<'_>, s: &NsgsSettings) -> Result<Cont
         measures = measure_into(problem, &r, &mut u);
     }
 
-    let (status, message) = if measures.error <= s.tol {
+    let (status, message) = if measures.passes(s.tol) {
         (
             ContactStatus::Solved,
-            format!("solved in {sweeps} sweeps (error {:.2e})", measures.error),
+            format!(
+                "solved in {sweeps} sweeps (scaled_error {:.2e})",
+                measures.scaled_error
+            ),
         )
-    } else if !measures.error.is_finite() || r.iter().any(|v| !v.is_finite()) {
+    } else if !measures.scaled_error.is_finite() || r.iter().any(|v| !v.is_finite()) {
         (
             ContactStatus::NumericalFailure,
             format!("the iterates became non-finite after {sweeps} sweeps"),
@@ -424,17 +435,17 @@ pub fn solve_nsgs(problem: &ContactProblem<'_>, s: &NsgsSettings) -> Result<Cont
         (
             ContactStatus::NumericalFailure,
             format!(
-                "contact {i} has no normal stiffness (W_nn = {:.2e} <= 0) and the error stays at \
-                 {:.2e} > tol {:.1e} after {sweeps} sweeps",
-                blocks[i].a, measures.error, s.tol
+                "contact {i} has no normal stiffness (W_nn = {:.2e} <= 0) and scaled_error stays \
+                 at {:.2e} > tol {:.1e} after {sweeps} sweeps",
+                blocks[i].a, measures.scaled_error, s.tol
             ),
         )
     } else {
         (
             ContactStatus::IterationLimit,
             format!(
-                "stopped at max_iter = {} with error {:.2e} > tol {:.1e}",
-                s.max_iter, measures.error, s.tol
+                "stopped at max_iter = {} with scaled_error {:.2e} > tol {:.1e}",
+                s.max_iter, measures.scaled_error, s.tol
             ),
         )
     };

@@ -23,6 +23,24 @@
 //!
 //! (E: each contact's β block to its λ).
 //!
+//! As written, A mixes units: its W blocks are velocity per impulse, the λ column and the
+//! last row are pure numbers (mu, ±1), and b holds velocities and zeros. Lemke's pivot
+//! tolerances are relative to the entries, so with W and q of order 1e-10 the λ column looked
+//! like the large entries and the W blocks like rounding: friction was dropped (r = (6, 0) for
+//! the seed's step scaled by 1e-10, instead of (6, -1.2)). The LCP is therefore assembled in
+//! balanced units: per frictional contact, with `c_i = 1 / rho_i` its normal stiffness
+//! `W_nn,i` (the scale of [`super::measures`]), the λ column is multiplied by `c_i` and the last
+//! row too,
+//!
+//! ```text
+//!     [ mu c_i   -c_i E^T   0 ],     λ column c_i E,     z_λ = λ / c_i,
+//! ```
+//!
+//! a positive scaling of one row and one column, which leaves the complementarity problem
+//! unchanged (`λ = c_i z_λ` is still the sliding speed) while every entry of A now scales as W
+//! does: changing the impulse and velocity units scales A and b as a whole, which Lemke's
+//! scale-aware tests do not see.
+//!
 //! Anisotropic friction (3D, the ellipse `(r_t1 / mu_1)^2 + (r_t2 / mu_2)^2 <= r_n^2`): the
 //! directions of contact i are scaled along the tangents,
 //! `d_k = (mu_1 cos θ_k, mu_2 sin θ_k) / m` with `m = max(mu_1, mu_2) = mu_i` in the row
@@ -38,9 +56,12 @@
 //!
 //! The reported [`super::ContactMeasures`] are the same natural-map measures as NSGS, i.e.
 //! measured against the *exact* friction disk. In 3D the polyhedral answer is an
-//! approximation: a sliding contact's impulse snaps to a facet, so `error` there reflects the
-//! facet error (it shrinks as `s` grows, not monotonically). Success therefore means only that
-//! the polyhedral LCP was solved to the Lemke tolerance; the LCP's own error is in the message.
+//! approximation: a sliding contact's impulse snaps to a facet, so the measures there reflect
+//! the facet error (they shrink as `s` grows, not monotonically). Success in 3D therefore
+//! means that the polyhedral LCP was solved by Lemke's rule (its literature error and its
+//! unit-free error within the tolerance); the LCP's own error is in the message. In 2D the
+//! polygon is exact and success is the rule of every contact method,
+//! [`super::ContactMeasures::passes`] on the impulses.
 
 use super::{measure_into, ContactProblem, ContactSolution, ContactStatus};
 use crate::error::{CoulombError, Result};
@@ -87,6 +108,8 @@ pub struct PolyhedralLcp {
     beta: Vec<Option<usize>>,
     /// per contact, the index of its λ in z (`None` when frictionless).
     lambda: Vec<Option<usize>>,
+    /// per contact, the unit `c_i` of its λ column and last row (see the module notes).
+    unit: Vec<f64>,
 }
 
 impl PolyhedralLcp {
@@ -94,6 +117,7 @@ impl PolyhedralLcp {
     pub fn new(problem: &ContactProblem<'_>, facets: usize) -> Result<Self> {
         let dim = problem.dim;
         check_facets(dim, facets)?;
+        check_size(problem, facets)?;
         let directions: Vec<[f64; 2]> = if dim == 2 {
             vec![[1.0, 0.0], [-1.0, 0.0]]
         } else {
@@ -165,12 +189,16 @@ impl PolyhedralLcp {
             }
         }
         let s = directions.len();
+        // c_i = 1 / rho_i, in W's units (see the module notes)
+        let scales = super::measures::ImpulseScale::of(problem, 1.0);
+        let unit: Vec<f64> = (0..nc).map(|i| 1.0 / scales.rho(problem, i)).collect();
         for i in 0..nc {
             if let (Some(b0), Some(l)) = (beta[i], lambda[i]) {
-                m[l * n + i] = problem.mu[i];
+                let c = unit[i];
+                m[l * n + i] = problem.mu[i] * c;
                 for k in b0..b0 + s {
-                    m[k * n + l] = 1.0;
-                    m[l * n + k] = -1.0;
+                    m[k * n + l] = c;
+                    m[l * n + k] = -c;
                 }
             }
         }
@@ -183,6 +211,7 @@ impl PolyhedralLcp {
             scale: (0..nc).map(|i| axis_scale(problem, i)).collect(),
             beta,
             lambda,
+            unit,
         })
     }
 
@@ -199,9 +228,16 @@ impl PolyhedralLcp {
         }
     }
 
-    /// the index of contact i's λ in z (`None` when frictionless).
+    /// the index of contact i's λ in z (`None` when frictionless); z holds `λ / c_i` there
+    /// (see the module notes and [`Self::slip_speed`]).
     pub fn lambda_index(&self, i: usize) -> Option<usize> {
         self.lambda[i]
+    }
+
+    /// contact i's λ of an LCP answer z, the sliding speed `c_i z_λ` (`None` when
+    /// frictionless).
+    pub fn slip_speed(&self, i: usize, z: &[f64]) -> Option<f64> {
+        self.lambda[i].map(|l| self.unit[i] * z[l])
     }
 
     /// the unit tangent directions `d_k` (`(±1, 0)` in 2D), before the per-contact scale of
@@ -247,6 +283,31 @@ fn axis_scale(problem: &ContactProblem<'_>, i: usize) -> [f64; 2] {
     }
 }
 
+/// refuses, before any allocation, a dense LCP (`n = nc + (facets + 1) n_f` unknowns for `n_f`
+/// frictional contacts) whose matrix and Lemke workspace exceed the memory budget.
+fn check_size(problem: &ContactProblem<'_>, facets: usize) -> Result<()> {
+    let nf = problem.mu.iter().filter(|&&m| m > 0.0).count();
+    let n = facets
+        .checked_add(1)
+        .and_then(|f| f.checked_mul(nf))
+        .and_then(|x| x.checked_add(problem.nc));
+    let entries = n
+        .and_then(crate::limits::dense_lemke_entries)
+        .unwrap_or(usize::MAX);
+    crate::limits::check_bytes(
+        &format!(
+            "the dense polyhedral LCP of {} contacts ({nf} with friction) with {facets} facets \
+             ({} unknowns)",
+            problem.nc,
+            n.map_or_else(|| "too many".to_string(), |n| n.to_string())
+        ),
+        entries,
+        8,
+        "use fewer facets, or method 'nsgs' or 'prox', whose memory grows with W's nonzeros",
+    )
+    .map(|_| ())
+}
+
 fn check_facets(dim: usize, facets: usize) -> Result<()> {
     if dim == 2 && facets != 2 {
         return Err(CoulombError::InvalidParameter(format!(
@@ -282,12 +343,22 @@ pub fn solve_polyhedral_lcp(
         lcp.n
     );
     let (status, message) = match ls.status {
+        // 2D: the polygon is the interval, the LCP is the problem, and the success rule of
+        // every contact method applies to the impulses
+        LcpStatus::Solved if problem.dim == 2 && !measures.passes(settings.lemke.tol) => (
+            ContactStatus::NumericalFailure,
+            format!(
+                "{what} solved by Lemke in {} pivots (LCP error {:.2e}), but the impulses miss \
+                 the tolerance on the contact problem (scaled_error {:.2e} > tol {:.1e})",
+                ls.pivots, lm.error, measures.scaled_error, settings.lemke.tol
+            ),
+        ),
         LcpStatus::Solved => (
             ContactStatus::Solved,
             format!(
-                "{what} solved by Lemke in {} pivots (LCP error {:.2e}; error against the \
-                 exact disk {:.2e})",
-                ls.pivots, lm.error, measures.error
+                "{what} solved by Lemke in {} pivots (LCP error {:.2e}; against the exact disk \
+                 scaled_error {:.2e})",
+                ls.pivots, lm.error, measures.scaled_error
             ),
         ),
         LcpStatus::PivotLimit => (
@@ -330,17 +401,20 @@ mod tests {
         let p = ContactProblem::new(2, &w, &q, &[0.2]).unwrap();
         let lcp = PolyhedralLcp::new(&p, 2).unwrap();
         assert_eq!(lcp.n, 4);
+        // the slide's matrix with λ's column and row scaled by c = W_nn = 0.5 (balanced
+        // units, see the module notes)
         #[rustfmt::skip]
         let a = [
             0.5, 0.0, 0.0, 0.0,
-            0.0, 0.5, -0.5, 1.0,
-            0.0, -0.5, 0.5, 1.0,
-            0.2, -1.0, -1.0, 0.0,
+            0.0, 0.5, -0.5, 0.5,
+            0.0, -0.5, 0.5, 0.5,
+            0.1, -0.5, -0.5, 0.0,
         ];
         assert_eq!(lcp.m, a);
         assert_eq!(lcp.q, [-3.0, 1.0, -1.0, 0.0]);
         assert_eq!(lcp.lambda_index(0), Some(3));
-        assert_eq!(lcp.impulses(&[6.0, 0.0, 1.2, 0.4]), vec![6.0, -1.2]);
+        assert_eq!(lcp.impulses(&[6.0, 0.0, 1.2, 0.8]), vec![6.0, -1.2]);
+        assert_eq!(lcp.slip_speed(0, &[6.0, 0.0, 1.2, 0.8]), Some(0.4));
     }
 
     #[test]

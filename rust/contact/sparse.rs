@@ -368,12 +368,41 @@ impl BlockCsr {
         out
     }
 
+    /// `(Σ_j W_ij x_j, Σ_j |W_ij| |x_j|)` for the `dim` components of contact i (zero-padded
+    /// to 3), the first summed in the order of [`Self::row_mul`] (bitwise the same).
+    pub fn row_mul_terms(&self, i: usize, x: &[f64]) -> ([f64; 3], [f64; 3]) {
+        let d = self.dim;
+        let mut out = [0.0; 3];
+        let mut terms = [0.0; 3];
+        for t in self.row_ptr[i]..self.row_ptr[i + 1] {
+            let j = self.cols[t];
+            let b = &self.values[t * d * d..(t + 1) * d * d];
+            let xj = &x[d * j..d * j + d];
+            for a in 0..d {
+                for c in 0..d {
+                    let p = b[d * a + c] * xj[c];
+                    out[a] += p;
+                    terms[a] += p.abs();
+                }
+            }
+        }
+        (out, terms)
+    }
+
     /// `out = W x`, O(nnz).
     pub fn mul(&self, x: &[f64], out: &mut [f64]) {
         let d = self.dim;
         for i in 0..self.nc {
             let o = self.row_mul(i, x, false);
             out[i * d..(i + 1) * d].copy_from_slice(&o[..d]);
+        }
+    }
+
+    /// replaces every stored value v by `f(v)` (an exact change of units by a power of two,
+    /// see [`super::normalize`]).
+    pub(crate) fn map_values(&mut self, f: impl Fn(f64) -> f64) {
+        for v in &mut self.values {
+            *v = f(*v);
         }
     }
 

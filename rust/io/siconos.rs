@@ -74,6 +74,9 @@ impl SparseTriplets {
     /// an LCP file may declare a huge sparse matrix in a few tokens.
     fn try_to_dense(&self) -> Option<DenseMatrix> {
         let len = self.nrows.checked_mul(self.ncols)?;
+        // within the memory budget (an allocation the system grants lazily could still
+        // exhaust memory when filled)
+        crate::limits::check_bytes("", len, 8, "").ok()?;
         let mut data: Vec<f64> = Vec::new();
         data.try_reserve_exact(len).ok()?;
         data.resize(len, 0.0);
@@ -222,7 +225,11 @@ pub fn parse_siconos_lcp(text: &str, origin: &str) -> Result<LcpProblem> {
         NumericsMatrix::Sparse(s) => s.try_to_dense().ok_or_else(|| {
             t.error_at(
                 start,
-                format_args!("matrix M ({n}x{n}) is too large to store densely"),
+                format_args!(
+                    "matrix M ({n}x{n}) is too large to store densely (over the memory budget \
+                     of {} bytes)",
+                    crate::limits::memory_budget()
+                ),
             )
         })?,
     };

@@ -48,6 +48,9 @@ pub fn solve_enumerate(lcp: &LcpRef<'_>, s: &EnumerateSettings) -> Result<LcpSol
     let mut z = vec![0.0; n];
     let bases = 1usize << n;
     for mask in 0..bases {
+        if crate::interrupt::poll(n * n * n) {
+            break; // the caller's interrupt hook asked to stop (see crate::interrupt)
+        }
         a.clear();
         a.extend((0..n).filter(|i| mask >> i & 1 == 1));
         let k = a.len();

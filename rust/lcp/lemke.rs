@@ -439,7 +439,8 @@ impl LemkeWorkspace {
             if leaving == z0 {
                 return (Ending::Terminal, pivots);
             }
-            if pivots >= max_pivots {
+            // a stop asked by the caller's interrupt hook ends the path like the limit
+            if pivots >= max_pivots || crate::interrupt::poll(n * self.width) {
                 return (Ending::Limit, pivots);
             }
             let entering = self.complement(leaving);
@@ -569,6 +570,9 @@ fn principal(lcp: &LcpRef<'_>, eq: &Equilibration, a: &[usize]) -> Option<Candid
     Some(candidate(lcp, eq, z))
 }
 
+/// the most covering vectors Lemke tries after the first ([`LemkeSettings::restarts`]).
+pub const MAX_RESTARTS: usize = 1000;
+
 fn validate(lcp: &LcpRef<'_>, s: &LemkeSettings) -> Result<()> {
     check_tol(s.tol)?;
     if let Some(d) = &s.covering_vector {
@@ -609,6 +613,19 @@ fn validate(lcp: &LcpRef<'_>, s: &LemkeSettings) -> Result<()> {
             "max_pivots must be at least 1".into(),
         ));
     }
+    if s.restarts > MAX_RESTARTS {
+        return Err(CoulombError::InvalidParameter(format!(
+            "restarts must be at most {MAX_RESTARTS}, got {}",
+            s.restarts
+        )));
+    }
+    let entries = crate::limits::dense_lemke_entries(lcp.n).unwrap_or(usize::MAX);
+    crate::limits::check_bytes(
+        &format!("Lemke's workspace for n = {}", lcp.n),
+        entries / 2,
+        8,
+        "",
+    )?;
     Ok(())
 }
 
@@ -711,6 +728,9 @@ pub fn solve_lemke_with(
     let mut basis = Vec::with_capacity(n);
     let mut abandoned = 0;
     for attempt in 0..tries {
+        if attempt > 0 && crate::interrupt::poll(n * n) {
+            break;
+        }
         covering(attempt, &eq, user, &mut cover);
         let product_form = match settings.engine {
             LemkeEngine::Auto => ws.product_form.size() == n && n > 0,

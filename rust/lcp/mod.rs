@@ -318,8 +318,15 @@ impl<'a> LcpRef<'a> {
             min_z = 0.0;
             min_w = 0.0;
         }
+        // ||min(z, w)||: the plain sum overflows at 1e300 (an error of inf / inf = NaN) and
+        // underflows at 1e-200 (an error of 0 on a wrong answer)
+        let mnorm = if sq.is_finite() && sq > 1e-280 {
+            sq.sqrt()
+        } else {
+            robust_sqrt_sum(z.iter().zip(w).map(|(a, b)| a.min(*b)))
+        };
         LcpMeasures {
-            error: sq.sqrt() / qnorm.max(1.0),
+            error: mnorm / qnorm.max(1.0),
             scaled_error: scaled,
             min_z,
             min_w,
@@ -328,9 +335,27 @@ impl<'a> LcpRef<'a> {
     }
 }
 
-/// `||x||_2`
+/// `||x||_2`, without overflow or underflow: the plain sum of squares, redone with a running
+/// scale ([`crate::contact::measures`]'s scheme) when that sum is not finite or so small that
+/// squares may have underflowed (data of size 1e300 or 1e-200).
 pub(crate) fn norm2(x: &[f64]) -> f64 {
-    x.iter().map(|v| v * v).sum::<f64>().sqrt()
+    robust_sqrt_sum(x.iter().copied())
+}
+
+/// `sqrt(Σ v^2)` over `values` (iterated twice at most), robust as [`norm2`].
+fn robust_sqrt_sum<I: Iterator<Item = f64> + Clone>(values: I) -> f64 {
+    let sq: f64 = values.clone().map(|v| v * v).sum();
+    if sq.is_finite() && (sq > 1e-280 || sq == 0.0 && values.clone().all(|v| v == 0.0)) {
+        return sq.sqrt();
+    }
+    if sq.is_nan() {
+        return sq;
+    }
+    let mut n = crate::contact::measures::Norm2::default();
+    for v in values {
+        n.add(v);
+    }
+    n.value()
 }
 
 /// the measures of z on `lcp`, equilibrating it first (for callers outside a solve, such as

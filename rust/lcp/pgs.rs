@@ -74,7 +74,8 @@ pub fn solve_pgs(lcp: &LcpRef<'_>, s: &PgsSettings) -> Result<LcpSolution> {
     let omega = s.relaxation;
     let mut sweeps = 0;
     let (mut w, mut measures) = lcp.evaluate(&z, &eq);
-    while !passes(&measures, s.tol) && sweeps < s.max_iter {
+    // (the caller's interrupt hook can end the sweeps early, see crate::interrupt)
+    while !passes(&measures, s.tol) && sweeps < s.max_iter && !crate::interrupt::poll(n * n) {
         for i in 0..n {
             let row = &lcp.m[i * n..(i + 1) * n];
             let wi: f64 = row.iter().zip(&z).map(|(a, b)| a * b).sum::<f64>() + lcp.q[i];

@@ -539,7 +539,8 @@ impl RevisedLemke {
             if leaving == z0 {
                 return (PathEnd::Terminal, pivots);
             }
-            if pivots >= max_pivots {
+            // a stop asked by the caller's interrupt hook ends the path like the limit
+            if pivots >= max_pivots || crate::interrupt::poll(self.n * (pivots + 1)) {
                 return (PathEnd::Limit, pivots);
             }
             let entering = self.complement(leaving);

@@ -166,11 +166,18 @@ fn contact_assemble<'py>(
             ))
         }
     };
+    let n = gt.ncols;
+    crate::limits::check_bytes(
+        &format!("the dense W = G^T M^-1 G of {n} contact components"),
+        n.saturating_mul(n),
+        8,
+        "",
+    )
+    .map_err(|e| to_py(py, e))?;
     let work = gt.ncols * gt.ncols + mt.vals.len() + gt.vals.len();
     let out = guarded(py, work, || {
         assembly::assemble(&mt.view(), &gt.view(), free, es)
     })?;
-    let n = gt.ncols;
     let w = Array2::from_shape_vec((n, n), out.w)
         .map_err(|e| PyRuntimeError::new_err(format!("internal shape error: {e}")))?
         .into_pyarray(py)

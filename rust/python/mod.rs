@@ -9,8 +9,11 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
 
 use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
-use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyRuntimeError};
+use numpy::{
+    IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2,
+    PyUntypedArrayMethods,
+};
+use pyo3::exceptions::{PyFileNotFoundError, PyKeyboardInterrupt, PyOSError, PyRuntimeError};
 use pyo3::intern;
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
@@ -18,7 +21,7 @@ use pyo3::types::{PyDict, PyType};
 
 mod step;
 
-use crate::contact::prox::{solve_prox, ProxSettings};
+use crate::contact::prox::ProxSettings;
 use crate::contact::{
     self, BlockCsr, ContactProblem, ContactSolution, NsgsSettings, PolyhedralSettings,
 };
@@ -53,6 +56,10 @@ fn to_py(py: Python<'_>, err: CoulombError) -> PyErr {
             raise(py, &INVALID_PARAMETER_ERROR, "InvalidParameterError", msg)
         }
         CoulombError::TooLarge(_) => raise(py, &TOO_LARGE_ERROR, "ProblemTooLargeError", msg),
+        // the signal's own exception (KeyboardInterrupt for SIGINT), kept by the hook
+        CoulombError::Interrupted => PENDING_SIGNAL
+            .with(|p| p.borrow_mut().take())
+            .unwrap_or_else(|| PyKeyboardInterrupt::new_err("interrupted")),
         CoulombError::Read(ReadError::Io { source, .. })
             if source.kind() == std::io::ErrorKind::NotFound =>
         {
@@ -68,17 +75,39 @@ fn to_py(py: Python<'_>, err: CoulombError) -> PyErr {
 /// below this many matrix entries a solve is too short for releasing the GIL to pay.
 const DETACH_ENTRIES: usize = 4096;
 
-/// runs `f` (with the GIL released when `work` entries make it worth it); a Rust panic
-/// becomes `coulomb.errors.InternalError`.
+thread_local! {
+    /// the exception `py.check_signals()` raised inside a solve, raised when the solve ends.
+    static PENDING_SIGNAL: std::cell::RefCell<Option<PyErr>> =
+        const { std::cell::RefCell::new(None) };
+}
+
+/// The interrupt hook of every call into the core (see `crate::interrupt`): re-attaches to the
+/// interpreter for a moment and runs its signal handlers (on the main thread; elsewhere it
+/// returns at once). A handler's exception (KeyboardInterrupt for Ctrl-C) stops the solve and
+/// is raised once it has ended.
+fn signal_hook() -> bool {
+    Python::attach(|py| match py.check_signals() {
+        Ok(()) => false,
+        Err(e) => {
+            PENDING_SIGNAL.with(|p| *p.borrow_mut() = Some(e));
+            true
+        }
+    })
+}
+
+/// runs `f` (with the GIL released when `work` entries make it worth it) so that Ctrl-C stops
+/// it (the core's loops poll [`signal_hook`] every few milliseconds); a Rust panic becomes
+/// `coulomb.errors.InternalError`.
 fn guarded<T: Send>(
     py: Python<'_>,
     work: usize,
     f: impl FnOnce() -> Result<T, CoulombError> + Send,
 ) -> PyResult<T> {
+    let stoppable = || crate::interrupt::run(signal_hook, f);
     let out = if work >= DETACH_ENTRIES {
-        py.detach(|| catch_unwind(AssertUnwindSafe(f)))
+        py.detach(|| catch_unwind(AssertUnwindSafe(stoppable)))
     } else {
-        catch_unwind(AssertUnwindSafe(f))
+        catch_unwind(AssertUnwindSafe(stoppable))
     };
     match out {
         Ok(Ok(v)) => Ok(v),
@@ -347,6 +376,7 @@ fn contact_dict<'py>(
     let m = s.measures;
     d.set_item(intern!(py, "error"), m.error)?;
     d.set_item(intern!(py, "error_q"), m.error_q)?;
+    d.set_item(intern!(py, "scaled_error"), m.scaled_error)?;
     d.set_item(intern!(py, "min_normal_impulse"), m.min_normal_impulse)?;
     d.set_item(intern!(py, "max_complementarity"), m.max_complementarity)?;
     d.set_item(intern!(py, "cone_violation"), m.cone_violation)?;
@@ -552,20 +582,13 @@ fn contact_solve<'py>(
         if let Some(p) = pairs {
             problem = problem.with_anisotropic_friction(p)?;
         }
-        let s = match &settings {
-            ContactSettings::Nsgs(s) => contact::solve_nsgs(&problem, s)?,
-            ContactSettings::Lemke(s) => contact::solve_polyhedral(&problem, s)?,
-            ContactSettings::Prox(s) => {
-                if !problem.is_isotropic() {
-                    return Err(CoulombError::InvalidParameter(
-                        "the robust mode (prox) takes isotropic friction; solve anisotropic \
-                         (mu_1, mu_2) pairs with 'nsgs' or 'lemke'"
-                            .into(),
-                    ));
-                }
-                solve_prox(&problem, s)?
-            }
+        // every method runs in normalized units and is judged on the original data
+        let method = match &settings {
+            ContactSettings::Nsgs(s) => contact::Method::Nsgs(s.clone()),
+            ContactSettings::Lemke(s) => contact::Method::Polyhedral(s.clone()),
+            ContactSettings::Prox(s) => contact::Method::Prox(s.clone()),
         };
+        let s = contact::solve(&problem, &method)?;
         Ok((s, problem.nc, start.elapsed().as_secs_f64()))
     })?;
     contact_dict(py, solution, nc, dim, seconds)
@@ -678,8 +701,42 @@ fn simd_level() -> &'static str {
     crate::lcp::simd_level()
 }
 
+/// The memory budget in bytes (see `crate::limits`).
+#[pyfunction]
+fn memory_budget() -> usize {
+    crate::limits::memory_budget()
+}
+
+/// Sets the memory budget (bytes, at least 1 MiB); returns the previous one.
+#[pyfunction]
+fn set_memory_budget(py: Python<'_>, bytes: usize) -> PyResult<usize> {
+    crate::limits::set_memory_budget(bytes).map_err(|e| to_py(py, e))
+}
+
+/// Loads numpy's C API and the array borrow checker now, at import, with errors propagated:
+/// loaded lazily, the first call would load them, and a signal arriving then (Ctrl-C during
+/// the first solve of a process) would surface as a panic inside the numpy crate.
+fn load_numpy(py: Python<'_>) -> PyResult<()> {
+    let np = py.import("numpy")?;
+    np.getattr("__version__")?;
+    let multiarray = py
+        .import("numpy._core.multiarray")
+        .or_else(|_| py.import("numpy.core.multiarray"))?;
+    multiarray.getattr("_ARRAY_API")?;
+    let f = PyArray1::<f64>::zeros(py, 0, false);
+    drop(f.try_readonly());
+    let i = PyArray1::<i64>::zeros(py, 0, false);
+    drop(i.try_readonly());
+    let j = PyArray1::<i32>::zeros(py, 0, false);
+    drop(j.try_readonly());
+    Ok(())
+}
+
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    load_numpy(m.py())?;
+    m.add_function(wrap_pyfunction!(memory_budget, m)?)?;
+    m.add_function(wrap_pyfunction!(set_memory_budget, m)?)?;
     m.add_function(wrap_pyfunction!(lcp_solve, m)?)?;
     m.add_function(wrap_pyfunction!(lcp_measures, m)?)?;
     m.add_function(wrap_pyfunction!(read_siconos_lcp, m)?)?;

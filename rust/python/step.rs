@@ -12,8 +12,8 @@ use super::{guarded, to_py};
 use crate::contact::{NsgsSettings, PolyhedralSettings};
 use crate::error::CoulombError;
 use crate::step::{
-    simulate, Body, BodyKind, Drift, HalfSpace, Pair, Restitution, Scene, Shape, StepSettings,
-    StepSolver,
+    simulate_recorded, Body, BodyKind, Drift, HalfSpace, Pair, Restitution, Scene, Shape,
+    StepSettings, StepSolver,
 };
 
 fn item<'py, T: FromPyObjectOwned<'py>>(d: &Bound<'py, PyDict>, key: &str) -> PyResult<T> {
@@ -139,7 +139,8 @@ fn matrix<'py, T: numpy::Element>(
 #[pyfunction]
 #[pyo3(signature = (scene, h, steps, solver="nsgs", tol=1e-12, max_iter=None, relaxation=1.0,
                     facets=None, gap_tolerance=1e-9, warm_start=true, fallback=true,
-                    drift="none", drift_bias=0.2, restitution="newton", locate_impacts=false))]
+                    drift="none", drift_bias=0.2, restitution="newton", record_every=1,
+                    locate_impacts=false))]
 #[allow(clippy::too_many_arguments)]
 pub(super) fn step_simulate<'py>(
     py: Python<'py>,
@@ -157,6 +158,7 @@ pub(super) fn step_simulate<'py>(
     drift: &str,
     drift_bias: f64,
     restitution: &str,
+    record_every: usize,
     locate_impacts: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let scene = scene_from_dict(scene)?;
@@ -225,7 +227,7 @@ pub(super) fn step_simulate<'py>(
     };
     let (tr, seconds) = guarded(py, usize::MAX, || {
         let start = std::time::Instant::now();
-        let tr = simulate(&scene, &settings)?;
+        let tr = simulate_recorded(&scene, &settings, record_every)?;
         Ok((tr, start.elapsed().as_secs_f64()))
     })?;
     let d = PyDict::new(py);
@@ -266,6 +268,10 @@ pub(super) fn step_simulate<'py>(
     }
     d.set_item("status", PyList::new(py, status)?)?;
     d.set_item("error", PyArray1::from_vec(py, col_f(|r| r.error)))?;
+    d.set_item(
+        "scaled_error",
+        PyArray1::from_vec(py, col_f(|r| r.scaled_error)),
+    )?;
     d.set_item(
         "iterations",
         PyArray1::from_vec(

@@ -48,6 +48,7 @@ struct Hit {
     /// the contact velocity after the impact.
     velocity: [f64; 3],
     error: f64,
+    scaled_error: f64,
     iterations: usize,
     residual: f64,
 }
@@ -230,7 +231,8 @@ impl Stepper {
             }
         }
         let approach = u[0].min(0.0);
-        let (impulse, error, iterations) = self.impact_law(&w, u, cand.mu, cand.e)?;
+        let (impulse, (error, scaled_error), iterations) =
+            self.impact_law(&w, u, cand.mu, cand.e)?;
         // v+ = q'(s*) + M^{-1} G P, and the momentum balance M dv = G P at q(s*)
         let mut residual: f64 = 0.0;
         let mut scale: f64 = 0.0;
@@ -265,6 +267,7 @@ impl Stepper {
             approach,
             velocity,
             error,
+            scaled_error,
             iterations,
             residual: if scale > 0.0 {
                 residual / scale
@@ -307,7 +310,7 @@ impl Stepper {
         u: [f64; 3],
         mu: f64,
         e: f64,
-    ) -> Result<([f64; 3], f64, usize)> {
+    ) -> Result<([f64; 3], (f64, f64), usize)> {
         let dim = self.dim;
         match self.settings.restitution {
             Restitution::Poisson => {
@@ -317,7 +320,7 @@ impl Stepper {
                         w3[a][c] = w[a * dim + c];
                     }
                 }
-                Ok((super::routh(dim, &w3, u, mu, e, 0.0), 0.0, 0))
+                Ok((super::routh(dim, &w3, u, mu, e, 0.0), (0.0, 0.0), 0))
             }
             Restitution::Newton => {
                 let mut q = u;
@@ -332,7 +335,11 @@ impl Stepper {
                 let sol = solve_nsgs(&problem, &settings)?;
                 let mut p = [0.0; 3];
                 p[..dim].copy_from_slice(&sol.impulse);
-                Ok((p, sol.measures.error, sol.iterations))
+                Ok((
+                    p,
+                    (sol.measures.error, sol.measures.scaled_error),
+                    sol.iterations,
+                ))
             }
         }
     }
@@ -366,6 +373,7 @@ impl Stepper {
         let mut record = Self::blank_record(1);
         record.status = Some(crate::contact::ContactStatus::Solved);
         record.error = hit.error;
+        record.scaled_error = hit.scaled_error;
         record.iterations = hit.iterations;
         record.momentum_residual = hit.residual;
         record.min_normal_impulse = hit.impulse[0];

@@ -90,6 +90,7 @@ impl Stepper {
         self.p_impact = p_impact;
         record.status = Some(out.status);
         record.error = out.measures.error;
+        record.scaled_error = out.measures.scaled_error;
         record.iterations = out.iterations;
         record.min_normal_impulse = out.measures.min_normal_impulse;
         record.cone_violation = out.measures.cone_violation;

@@ -68,7 +68,7 @@ mod impact;
 mod poisson;
 mod stepper;
 
-pub use stepper::{simulate, ContactRecord, StepRecord, Stepper, Trajectory};
+pub use stepper::{simulate, simulate_recorded, ContactRecord, StepRecord, Stepper, Trajectory};
 
 use crate::contact::{NsgsSettings, PolyhedralSettings};
 use crate::error::{check_finite, CoulombError, Result};

@@ -230,7 +230,7 @@ fn reuse_warm_start(
     };
     ws.velocity.resize(problem.size(), 0.0);
     let m = measure_into(problem, init, &mut ws.velocity);
-    if m.error <= s.tol && m.cone_violation == 0.0 {
+    if m.passes(s.tol) && m.cone_violation == 0.0 {
         ws.impulse.clear();
         ws.impulse.extend_from_slice(init);
         return Ok(Warm::Done(Outcome {
@@ -239,7 +239,7 @@ fn reuse_warm_start(
             measures: m,
         }));
     }
-    if m.error <= POLISH_NEAR * s.tol && problem.nc <= LEMKE_FALLBACK_MAX {
+    if m.passes(POLISH_NEAR * s.tol) && problem.nc <= LEMKE_FALLBACK_MAX {
         let polish = NsgsSettings {
             initial: Some(init.to_vec()),
             max_iter: s.max_iter.min(POLISH_SWEEPS),
@@ -247,7 +247,7 @@ fn reuse_warm_start(
             ..s.clone()
         };
         let p = solve_nsgs(problem, &polish)?;
-        if p.measures.error <= s.tol {
+        if p.measures.passes(s.tol) {
             let mut out = ws.take(p);
             out.status = ContactStatus::Solved;
             return Ok(Warm::Done(out));
@@ -288,8 +288,8 @@ fn nsgs_fallback(
         };
         ws.take(solve_prox(problem, &prox)?)
     };
-    let better = second.measures.error < first.measures.error;
-    if large && budget < s.max_iter && !(better && second.measures.error <= s.tol) {
+    let better = second.measures.scaled_error < first.measures.scaled_error;
+    if large && budget < s.max_iter && !(better && second.measures.passes(s.tol)) {
         // NSGS's remaining sweeps from the better answer, and the best of the three
         let from = if better {
             ws.impulse.clone()
@@ -303,11 +303,11 @@ fn nsgs_fallback(
         };
         let third = solve_nsgs(problem, &rest)?;
         let best_so_far = if better {
-            second.measures.error
+            second.measures.scaled_error
         } else {
-            first.measures.error
+            first.measures.scaled_error
         };
-        if third.measures.error <= best_so_far {
+        if third.measures.scaled_error <= best_so_far {
             record.fallback = better;
             return Ok(ws.take(ContactSolution {
                 iterations: budget + third.iterations,
@@ -318,8 +318,12 @@ fn nsgs_fallback(
     if better {
         record.fallback = true;
         Ok(Outcome {
-            status: if second.measures.error <= tol {
+            // NSGS's contract is the exact cone: a polygon's answer (3D) that misses it keeps
+            // NSGS's verdict
+            status: if second.measures.passes(tol) {
                 ContactStatus::Solved
+            } else if second.status == ContactStatus::Solved {
+                first.status
             } else {
                 second.status
             },

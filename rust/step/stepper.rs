@@ -46,6 +46,9 @@ pub struct StepRecord {
     pub status: Option<ContactStatus>,
     /// the contact solver's error (natural-map residual, relative); 0 without contacts.
     pub error: f64,
+    /// the contact solver's unit-consistent error, the measure its verdict (`status`) is
+    /// taken on ([`crate::contact::ContactMeasures::passes`]); 0 without contacts.
+    pub scaled_error: f64,
     /// the contact solver's sweeps or pivots.
     pub iterations: usize,
     /// `||M (v_{k+1} - v_free) - G P||` divided by `max(||G P||, ||M v_free||, ||M v_{k+1}||)`
@@ -347,6 +350,7 @@ impl Stepper {
             active,
             status: None,
             error: 0.0,
+            scaled_error: 0.0,
             iterations: 0,
             momentum_residual: 0.0,
             min_normal_impulse: 0.0,
@@ -544,38 +548,111 @@ impl Stepper {
 /// a contact solve that misses its tolerance is recorded in its step's status and the run goes
 /// on with the best impulses found.
 pub fn simulate(scene: &Scene, settings: &StepSettings) -> Result<Trajectory> {
+    simulate_recorded(scene, settings, 1)
+}
+
+/// [`simulate`], keeping the state only after every `record_every`-th step (and after the
+/// last): the trajectory has `ceil(steps / record_every) + 1` states. The step records in
+/// between are folded into the one of the next recorded step, which holds the worst of each
+/// check over the steps it stands for ([`StepRecord::fold`]), so a solver failure or a
+/// violated check is never lost; [`ContactRecord`]s are kept for the recorded steps only,
+/// their `step` being the record's row. The records grow as the run goes (nothing is
+/// reserved for every step up front) and their size is checked against the memory budget
+/// ([`crate::limits`]) before the run (the states) and as it goes (the contacts). The run can
+/// be stopped by the caller's interrupt hook ([`crate::interrupt`]).
+pub fn simulate_recorded(
+    scene: &Scene,
+    settings: &StepSettings,
+    record_every: usize,
+) -> Result<Trajectory> {
     let mut st = Stepper::new(scene, settings)?;
     let steps = settings.steps;
+    let every = record_every.max(1);
+    let rows = steps.div_ceil(every) + 1;
+    let row_bytes = 8 * (st.nq + st.nv + 5) + std::mem::size_of::<StepRecord>();
+    let budget = crate::limits::memory_budget();
+    let needed = (steps as f64 * row_bytes as f64 / budget as f64)
+        .ceil()
+        .max(1.0);
+    crate::limits::check_bytes(
+        &format!("recording {rows} states of {} coordinates", st.nq),
+        rows,
+        row_bytes,
+        &format!("record fewer states with record_every >= {needed:.0}"),
+    )?;
+    let reserve = rows.min(4096);
     let mut out = Trajectory {
         dim: st.dim,
         nq: st.nq,
         nv: st.nv,
-        t: Vec::with_capacity(steps + 1),
-        q: Vec::with_capacity((steps + 1) * st.nq),
-        v: Vec::with_capacity((steps + 1) * st.nv),
-        kinetic_energy: Vec::with_capacity(steps + 1),
-        potential_energy: Vec::with_capacity(steps + 1),
-        min_gap: Vec::with_capacity(steps + 1),
-        negative_gaps: Vec::with_capacity(steps + 1),
-        steps: Vec::with_capacity(steps),
+        t: Vec::with_capacity(reserve),
+        q: Vec::with_capacity(reserve * st.nq),
+        v: Vec::with_capacity(reserve * st.nv),
+        kinetic_energy: Vec::with_capacity(reserve),
+        potential_energy: Vec::with_capacity(reserve),
+        min_gap: Vec::with_capacity(reserve),
+        negative_gaps: Vec::with_capacity(reserve),
+        steps: Vec::with_capacity(reserve),
         contacts: Vec::new(),
         stopped: None,
     };
     st.push_state(&mut out);
+    let mut pending: Option<StepRecord> = None;
     for k in 0..steps {
-        let rec = st.step(&mut out.contacts)?;
-        out.steps.push(rec);
+        if crate::interrupt::poll(st.nq * st.nv + 64) {
+            break; // the caller's interrupt hook asked to stop (see crate::interrupt)
+        }
+        let kept = out.contacts.len();
+        let mut rec = st.step(&mut out.contacts)?;
+        if let Some(p) = pending.take() {
+            rec.fold(&p);
+        }
+        let row = out.steps.len();
+        out.contacts[kept..].iter_mut().for_each(|c| c.step = row);
         let finite = st.v.iter().chain(st.q.iter()).all(|x| x.is_finite());
         if !finite {
             out.stopped = Some(format!(
                 "step {k} produced a non-finite state (contact solver: {})",
-                out.steps[k].status.map_or("no contacts", |s| s.as_str())
+                rec.status.map_or("no contacts", |s| s.as_str())
             ));
-            out.steps.pop();
-            out.contacts.retain(|c| c.step < k);
+            out.contacts.truncate(kept);
             break;
         }
+        if (k + 1) % every != 0 && k + 1 != steps {
+            out.contacts.truncate(kept);
+            pending = Some(rec);
+            continue;
+        }
+        crate::limits::check_bytes(
+            &format!("recording {} contact records", out.contacts.len()),
+            out.contacts.len(),
+            std::mem::size_of::<ContactRecord>(),
+            "record fewer states with record_every",
+        )?;
+        out.steps.push(rec);
         st.push_state(&mut out);
     }
     Ok(out)
+}
+
+impl StepRecord {
+    /// folds the record of an earlier, unrecorded step into this one: the worst of each check
+    /// (the first failed status, the largest error, residual, violation and iteration count,
+    /// the smallest normal impulse, and whether any step resumed or fell back).
+    pub fn fold(&mut self, earlier: &StepRecord) {
+        let failed = |s: Option<ContactStatus>| s.is_some_and(|s| s != ContactStatus::Solved);
+        if failed(earlier.status) || (self.status.is_none() && earlier.status.is_some()) {
+            self.status = earlier.status;
+        }
+        self.active = self.active.max(earlier.active);
+        self.error = self.error.max(earlier.error);
+        self.iterations = self.iterations.max(earlier.iterations);
+        self.momentum_residual = self.momentum_residual.max(earlier.momentum_residual);
+        self.min_normal_impulse = self.min_normal_impulse.min(earlier.min_normal_impulse);
+        self.cone_violation = self.cone_violation.max(earlier.cone_violation);
+        self.complementarity = self.complementarity.max(earlier.complementarity);
+        self.resumed |= earlier.resumed;
+        self.fallback |= earlier.fallback;
+        self.projection = self.projection.max(earlier.projection);
+    }
 }

@@ -220,6 +220,44 @@ def contact_error(W: Array, q: Array, mu: Array, dim: int, r: Array) -> tuple[fl
     return norm / denom, norm / (qn if qn >= 1e-300 else 1.0)
 
 
+def contact_scaled_error(W: Array, q: Array, mu: Array, dim: int, r: Array) -> float:
+    """The unit-consistent measure that decides ``success`` (coulomb.contact's module notes),
+    recomputed here in numpy for isotropic friction: with ``rho_i = 1 / W_nn,i`` (the mean
+    positive ``W_nn`` for a contact whose own is not positive or below 1e-12 times it), the
+    worst contact's larger of De Saxce's and Alart-Curnier's natural maps in impulse units,
+    relative to ``max(||r_i||, rho_i ||(|W| |r| + |q|)_i||)``."""
+    r = np.asarray(r, dtype=float).reshape(-1)
+    q = np.asarray(q, dtype=float)
+    W = np.asarray(W, dtype=float)
+    nc = r.size // dim
+    u = W @ r + q
+    terms = np.abs(W) @ np.abs(r) + np.abs(q)
+    diag = np.array([W[i * dim, i * dim] for i in range(nc)])
+    pos = diag[diag > 0]
+    mean = float(pos.mean()) if pos.size else 0.0
+    if mean > 0:
+        rho = 1.0 / np.where(diag > 1e-12 * mean, diag, mean)
+    else:
+        rn, qn = np.linalg.norm(r), np.linalg.norm(q)
+        rho = np.full(nc, rn / qn if rn > 0 and qn > 0 else 1.0)
+    worst = 0.0
+    for i, m in enumerate(np.broadcast_to(mu, (nc,))):
+        s = slice(i * dim, (i + 1) * dim)
+        ri, su = r[s], rho[i] * u[s]
+        v = ri - su
+        v[0] -= m * np.linalg.norm(su[1:])
+        ds = ri - project_coulomb_cone(v, float(m))
+        x = ri[1:] - su[1:]
+        radius = m * max(ri[0], 0.0)
+        nx = np.linalg.norm(x)
+        ac = np.concatenate([[ri[0] - max(0.0, ri[0] - su[0])],
+                             ri[1:] - (x if nx <= radius else x * (radius / nx))])
+        err = max(np.linalg.norm(ds), np.linalg.norm(ac))
+        size = max(np.linalg.norm(ri), rho[i] * np.linalg.norm(terms[s]))
+        worst = max(worst, err / size if size > 0 else err)
+    return float(worst)
+
+
 def count_during(call):
     """Runs ``call()`` in a thread while this thread counts; returns its result and the count
     made while it ran. With a short switch interval a thread that holds the GIL through a long

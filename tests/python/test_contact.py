@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 from coulomb import contact, errors
-from helpers import contact_error, count_during
+from helpers import contact_error, contact_scaled_error, count_during
 
 
 def seed_problem(dim: int, mu: float):
@@ -93,7 +93,11 @@ def test_reported_error_matches_independent_residual(seed, dim):
         assert r.error == pytest.approx(err, rel=1e-9, abs=1e-15)
         assert r.error_q == pytest.approx(err_q, rel=1e-9, abs=1e-15)
         np.testing.assert_allclose(r.velocity.ravel(), W @ r.impulse.ravel() + q, atol=1e-12)
-        assert r.success == (r.error <= 1e-10)
+        assert r.scaled_error == pytest.approx(
+            contact_scaled_error(W, q, mu, dim, r.impulse), rel=1e-9, abs=1e-15
+        )
+        # the one rule: success means the unit-consistent measure passes tol
+        assert r.success == (r.scaled_error <= 1e-10)
     assert r.success, r.message
     # at the solution every contact pushes, stays in its cone and dissipates
     assert r.min_normal_impulse >= 0.0

@@ -14,7 +14,7 @@ from coulomb.io import (
     GlobalFrictionContactProblem,
     read_siconos_fc,
 )
-from helpers import ProblemSet, contact_error, data_file, full_set_dir
+from helpers import ProblemSet, contact_error, contact_scaled_error, data_file, full_set_dir
 
 TOL = 1e-6
 MAX_ITER = 5000
@@ -33,8 +33,6 @@ MUST_SOLVE = (
     "FC2D_SliderCrankLagrangian00000",
     "FrictionContactProblem00071",
     "NESpheres_10_1",
-    "OneObject-i1028-138.hdf5",
-    "Rover1039",
 )
 
 
@@ -136,12 +134,15 @@ def test_small_local_problems_are_solved_or_honestly_reported(problems):
         assert r.error == pytest.approx(err, rel=1e-8, abs=1e-14), name
         assert r.error_q == pytest.approx(err_q, rel=1e-8, abs=1e-14), name
         assert r.success == (r.status == "solved"), name
+        # the verdict is the unit-consistent measure, recomputed independently
+        scaled = contact_scaled_error(p.W, p.q, p.mu, p.dim, r.impulse)
+        assert r.scaled_error == pytest.approx(scaled, rel=1e-8, abs=1e-14), name
         if r.success:
-            assert err <= TOL, name
+            assert scaled <= TOL, name
             solved.add(name)
         else:
             assert r.status == "iteration_limit" and r.iterations == MAX_ITER, name
-            assert err > TOL, name
+            assert scaled > TOL, name
     missing = set(MUST_SOLVE) - solved
     assert not missing, missing
 
@@ -153,11 +154,42 @@ def test_problems_nsgs_must_solve_are_solved(problems, name):
     r = contact.solve(p.W, p.q, p.mu, p.dim, tol=TOL, max_iter=MAX_ITER)
     assert r.success and r.status == "solved", (name, r.message)
     err, _ = contact_error(p.W, p.q, p.mu, p.dim, r.impulse)
-    assert err <= TOL and r.error == pytest.approx(err, rel=1e-8, abs=1e-14), name
+    assert r.error == pytest.approx(err, rel=1e-8, abs=1e-14), name
+    assert contact_scaled_error(p.W, p.q, p.mu, p.dim, r.impulse) <= TOL, name
+
+
+def test_rover_nsgs_stall_is_not_reported_as_solved(problems):
+    """Rover1039 used to be "solved" by NSGS because the old verdict divided by
+    max(||q||, ||r||, ||u||) (error 2.6e-7 <= 1e-6) while error_q was 2.3e-5 and a contact
+    both pushed and separated (r_n u_n 8.6e-5): NSGS stalls there. The unit-consistent
+    measure says so; the robust mode solves it (complementarity 2e-8)."""
+    p = problems["Rover1039"]
+    r = contact.solve(p.W, p.q, p.mu, p.dim, tol=TOL, max_iter=MAX_ITER)
+    scaled = contact_scaled_error(p.W, p.q, p.mu, p.dim, r.impulse)
+    assert not r.success and scaled > 10 * TOL and r.error_q > 10 * TOL
+    s = contact.solve(p.W, p.q, p.mu, p.dim, tol=TOL, method="prox")
+    assert s.success and contact_scaled_error(p.W, p.q, p.mu, p.dim, s.impulse) <= TOL
+    assert s.max_complementarity < 1e-3 * r.max_complementarity
+
+
+def test_one_object_nsgs_stall_is_not_reported_as_solved(problems):
+    """OneObject-i1028-138 used to be "solved" by NSGS (error_q 5.9e-7 <= 1e-6): NSGS stalls
+    there (the same figures after 1e3 and 1e5 sweeps) with a contact off the law by 9.5e-6 of
+    its own scale (contact_gen.law_violation, independent of coulomb's measures). The
+    unit-consistent measure, taken contact by contact, says so; the robust mode solves it."""
+    from contact_gen import law_violation
+
+    p = problems["OneObject-i1028-138.hdf5"]
+    r = contact.solve(p.W, p.q, p.mu, p.dim, tol=TOL, max_iter=MAX_ITER)
+    assert not r.success and r.status == "iteration_limit"
+    assert law_violation(p.W, p.q, p.mu, p.dim, r.impulse) > 1e-6 >= r.error_q
+    s = contact.solve(p.W, p.q, p.mu, p.dim, tol=TOL, method="prox")
+    assert s.success and law_violation(p.W, p.q, p.mu, p.dim, s.impulse) <= 1e-6
 
 
 def test_iteration_limit_on_a_real_problem(problems):
-    p = problems["OneObject-i1028-138.hdf5"]
+    # (OneObject-i1028-138, used here before, is not solved by NSGS: see above)
+    p = problems["FrictionContactProblem00071"]
     r = contact.solve(p.W, p.q, p.mu, p.dim, tol=TOL, max_iter=1)
     assert not r.success
     assert r.status == "iteration_limit" and r.iterations == 1

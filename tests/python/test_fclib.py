@@ -34,6 +34,8 @@ spl = pytest.importorskip("scipy.sparse.linalg")
 
 TOL = 1e-8
 NOT_SOLVED = ("RockPile_tob1",)
+# solved at 1e-8 by the literature's error_q, not contact by contact (see the test below)
+NOT_SOLVED_PER_CONTACT = ("Capsules-i122-1617",)
 FINISHED_2D = "fc2d_granularflowonwall_02020_00213"
 ROLLING = "Chute-ndof-768-nc-4-3"
 
@@ -169,7 +171,6 @@ SOLVED = (
     "LMGC_100_PR_PerioBox-i00361-60-03000",
     "BoxesStack1-i100000-32",
     "local_problem_test",
-    "Capsules-i122-1617",
     "Capsules-i97-269",
     "KaplasTower-i1061-4",
     "OneObject-i100000-499",
@@ -177,7 +178,8 @@ SOLVED = (
 
 
 def test_solved_set_is_every_file_but_the_documented_ones(manifest):
-    assert set(SOLVED) | set(NOT_SOLVED) | {ROLLING, FINISHED_2D} == set(manifest)
+    everything = set(SOLVED) | set(NOT_SOLVED) | set(NOT_SOLVED_PER_CONTACT)
+    assert everything | {ROLLING, FINISHED_2D} == set(manifest)
 
 
 @pytest.mark.parametrize("name", SOLVED)
@@ -195,6 +197,22 @@ def test_robust_mode_solves_the_fclib_subset_at_1e_8(problems, name):
     assert r.cone_violation <= TOL * np.linalg.norm(p.q) * (1 + p.mu.max())
 
 
+def test_capsules_is_not_solved_contact_by_contact(problems):
+    """The robust mode used to report Capsules-i122-1617 solved (error_q 1.7e-9 <= 1e-8).
+    Contact by contact it is not: after 200 Newton steps contact 249 pushes (r_n 1.1e-3) while
+    separating at 1.55e-8 m/s, 1.3e-6 of the terms its velocity is summed from (the
+    independent check of the property suite, contact_gen.law_violation, finds 1.3e-6 > 1e-6).
+    The unit-consistent verdict says iteration_limit."""
+    from contact_gen import law_violation
+
+    p = problems["Capsules-i122-1617"]
+    W = p.W.toarray()
+    r = contact.solve(W, p.q, p.mu, p.dim, method="prox", tol=TOL)
+    assert not r.success and r.status == "iteration_limit", r.message
+    assert r.error_q <= TOL < r.scaled_error
+    assert law_violation(W, p.q, p.mu, p.dim, r.impulse) > 1e-6
+
+
 def test_rockpile_is_reported_honestly(problems):
     p = problems["RockPile_tob1"]
     W = p.W.toarray()
@@ -203,8 +221,9 @@ def test_rockpile_is_reported_honestly(problems):
     assert r.iterations <= 20
     _, err_q = contact_error(W, p.q, p.mu, p.dim, r.impulse)
     assert err_q > TOL and abs(err_q - r.error_q) <= 1e-9 * err_q + 1e-15
-    reported = float(re.search(r"error_q ([0-9.e+-]+)", r.message).group(1))
-    assert abs(reported - r.error_q) <= 0.01 * r.error_q
+    assert r.scaled_error > TOL
+    reported = float(re.search(r"scaled_error ([0-9.e+-]+)", r.message).group(1))
+    assert abs(reported - r.scaled_error) <= 0.01 * r.scaled_error
 
 
 def test_the_2d_file_is_indefinite_and_solved_by_the_lcp_finish(problems):

@@ -130,6 +130,7 @@ def test_internal_error_is_a_coulomb_error():
     assert issubclass(errors.InternalError, errors.CoulombError)
     assert issubclass(errors.InternalError, RuntimeError)
     assert set(errors.__all__) == {
+        "ArgumentTypeError",
         "CoulombError",
         "InternalError",
         "InvalidInputError",

@@ -1,12 +1,16 @@
 //! Solves every Siconos LCP test problem with Lemke (and enumeration where n <= 15) and prints
-//! one line each: `cargo run --release --example lcp_survey [DATA_DIR]`.
+//! one line each: `cargo run --release --example lcp_survey [DATA_DIR]` (default
+//! `$COULOMB_DATA/siconos-lcp`, else the shipped `tests/data/siconos-lcp`).
 use coulomb::io::siconos::read_siconos_lcp;
 use coulomb::lcp::{solve_enumerate, solve_lemke, EnumerateSettings, LcpRef, LemkeSettings};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let dir = std::env::args().nth(1).unwrap_or_else(|| {
-        concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/siconos-lcp").into()
-    });
+    let dir = std::env::args()
+        .nth(1)
+        .unwrap_or_else(|| match std::env::var("COULOMB_DATA") {
+            Ok(data) => format!("{data}/siconos-lcp"),
+            Err(_) => concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/siconos-lcp").into(),
+        });
     let mut paths: Vec<_> = std::fs::read_dir(&dir)?
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.extension().is_some_and(|x| x == "dat"))

@@ -1,0 +1,535 @@
+//! How far impulses are from solving a friction-contact problem, and the one rule for success.
+//!
+//! With `u = W r + q` recomputed from the original data, three residuals are reported:
+//!
+//! - `error`: De Saxce's natural map `||r - P_K(r - (u + mu ||u_t|| n))||` divided by
+//!   `max(||q||, ||r||, ||u||)`, and `error_q`: the same map divided by `||q||` (Acary et al.'s
+//!   FCLib figure). Both add a velocity to an impulse inside the projection, so their value, and
+//!   any verdict taken on them, changes when the units change: with `W -> (b/a) W`,
+//!   `q -> b q` (impulses `r -> a r`, velocities `u -> b u`) the map mixes `a r` with `b u`.
+//!   Scaling W by 1e-4 made them accept wrong answers; an answer of a problem with W of order
+//!   1e8 (light bodies) may be exact to rounding and still miss `error_q <= 1e-8`. They are
+//!   reported for comparison with peers, never used for the verdict.
+//! - `scaled_error`, the verdict's measure. Per contact, `rho_i = 1 / W_nn,i` (impulse per
+//!   unit velocity: the normal impulse that cancels a unit normal velocity of contact i alone;
+//!   a contact whose `W_nn,i` is not positive, or below 1e-12 times the mean positive one, takes
+//!   the mean's inverse; when no contact has one, `||r|| / ||q||`, or 1 when either is 0) turns
+//!   velocities into impulses, and two natural maps are taken in impulse units:
+//!
+//!   ```text
+//!   De Saxce (1991):      e_i = r_i - P_{K_i}( r_i - rho_i (u_i + mu_i ||u_{t,i}|| n) )
+//!   Alart-Curnier (1991): a_i = ( r_n - max(0, r_n - rho_i u_n),
+//!                                 r_t - P_{D(mu_i max(r_n, 0))}( r_t - rho_i u_t ) )
+//!   scaled_error = max_i max(||e_i||, ||a_i||) / max(||r_i||, rho_i ||t_i||),
+//!   t_i = (|W| |r| + |q|)_i
+//!   ```
+//!
+//!   Each contact is judged against its own impulse scale: its impulse, or the impulse
+//!   equivalent of the terms its velocity is summed from (`t_i`, as the LCP's scale-free
+//!   measure divides `w_i` by its terms). A global scale such as `max(||r||, ||rho q||)` lets
+//!   the heavy bodies' impulses hide a light body's contact: in a two-box stack at mass ratio
+//!   1e6 a light contact could keep a 1% velocity error under a 1e-8 verdict. Since `u_i` is
+//!   summed from those terms, its rounding is a few ulps of `t_i`, and the measure reaches
+//!   rounding level at a solution.
+//!
+//!   with `D(R)` the disk of radius R (the ellipse `(x_1 / mu_1)^2 + (x_2 / mu_2)^2 <= r_n^2`
+//!   for anisotropic friction). Both maps vanish exactly at the solutions. De Saxce's alone is
+//!   blind for a large mu: its normal argument `rho (u_n + mu ||u_t||)` lets `mu ||u_t||` hide
+//!   an approaching contact (`u_n < 0`), so with mu = 1e8 the answer r = 0 of a contact that
+//!   must push leaves it at 1e-8 of the data. Alart-Curnier's map takes Signorini's condition
+//!   (`min(r_n, rho u_n)`) and the sticking / sliding law (`r_t` in the disk of radius
+//!   `mu r_n`, `-u_t` in its normal cone) apart, each in impulse units, so a wrong answer
+//!   shows whatever mu is. Every term scales by `a` when units change, so `scaled_error` is
+//!   invariant. A contact with `r_i = 0` and `t_i = 0` has `u_i = 0` exactly and counts 0.
+//!
+//! Success everywhere (NSGS, the robust mode, the exact 2D polyhedral LCP, each stepper step)
+//! means `scaled_error <= tol` ([`ContactMeasures::passes`]), the solvers stop on that same
+//! test, and the rule matches the LCP's (`crate::lcp`, whose verdict also needs its scale-free
+//! measure). Norms are accumulated with a running scale (LAPACK's `dnrm2` scheme), so data of
+//! size 1e-200 or 1e300 neither underflows to an error of 0 nor overflows to infinity.
+
+use super::projection::{project_cone, project_ellipse, tangent_norm};
+use super::{ContactProblem, Delassus};
+use crate::error::{CoulombError, Result};
+
+/// How far impulses r are from solving the problem, from the original W, q, mu.
+///
+/// The verdict (`success`, [`Self::passes`]) is `scaled_error <= tol`, the one measure here
+/// that is invariant when impulse units and velocity units are changed independently
+/// (`W -> (b/a) W`, `q -> b q`, `r -> a r`); `error` and `error_q` are the literature's
+/// figures, reported so that answers compare with peers (see the [module notes](self) for why
+/// they cannot decide success).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactMeasures {
+    /// the natural-map residual on De Saxce's form,
+    /// `||r - P_K(r - (u + mu ||u_t|| n))|| / max(||q||, ||r||, ||u||)` (divided by 1 instead
+    /// when all three norms are below 1e-300); for a contact with anisotropic friction its
+    /// part of the residual is the elliptic-cone one of [`anisotropic_residual`]. It adds
+    /// velocities to impulses, so it changes with the units.
+    pub error: f64,
+    /// the same residual divided by `||q||` (by 1 when `||q|| < 1e-300`), as Acary et al.
+    /// report it.
+    pub error_q: f64,
+    /// the unit-consistent error that decides success: with `rho_i` the impulse per unit
+    /// velocity of contact i taken from W (`1 / W_nn,i`), the worst contact's larger of De
+    /// Saxce's natural map and Alart-Curnier's, both in impulse units, relative to the
+    /// contact's impulse scale (see the [module notes](self)).
+    pub scaled_error: f64,
+    /// `min_i r_{n,i}` (negative means infeasible); 0 without contacts.
+    pub min_normal_impulse: f64,
+    /// `max_i |r_{n,i} u_{n,i}|`.
+    pub max_complementarity: f64,
+    /// `max_i max(||r_{t,i}|| - mu_i r_{n,i}, 0)` (anisotropic contacts: see
+    /// [`anisotropic_residual`]).
+    pub cone_violation: f64,
+    /// `max_i max(0, r_{t,i} . u_{t,i})` over sliding contacts (`||u_t||` above 1e-12 times the
+    /// largest velocity): a sliding impulse must oppose the slip.
+    pub dissipation_violation: f64,
+}
+
+impl ContactMeasures {
+    /// The one success rule of every contact method: `scaled_error <= tol` (false for NaN).
+    #[inline]
+    pub fn passes(&self, tol: f64) -> bool {
+        self.scaled_error <= tol
+    }
+}
+
+/// below this a norm counts as zero when forming the literature's relative residuals.
+const TINY: f64 = 1e-300;
+
+/// A Euclidean norm accumulated without overflow or underflow: `||x|| = scale sqrt(ssq)` with
+/// `scale` the largest magnitude seen (the scaled sum of squares of LAPACK's `dnrm2`). NaN
+/// and infinity propagate.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Norm2 {
+    scale: f64,
+    ssq: f64,
+    nan: bool,
+    inf: bool,
+}
+
+impl Norm2 {
+    /// adds `x^2`.
+    #[inline]
+    pub(crate) fn add(&mut self, x: f64) {
+        let a = x.abs();
+        if a.is_nan() {
+            self.nan = true;
+        } else if a == f64::INFINITY {
+            self.inf = true;
+        } else if a > self.scale {
+            let t = self.scale / a;
+            self.ssq = 1.0 + self.ssq * t * t;
+            self.scale = a;
+        } else if a > 0.0 {
+            let t = a / self.scale;
+            self.ssq += t * t;
+        }
+    }
+
+    /// adds every entry of `x`.
+    pub(crate) fn add_all(&mut self, x: &[f64]) {
+        for &v in x {
+            self.add(v);
+        }
+    }
+
+    /// the norm.
+    pub(crate) fn value(&self) -> f64 {
+        if self.nan {
+            f64::NAN
+        } else if self.inf {
+            f64::INFINITY
+        } else {
+            self.scale * self.ssq.sqrt()
+        }
+    }
+}
+
+/// `||x||_2` without overflow or underflow.
+pub(crate) fn norm2(x: &[f64]) -> f64 {
+    let mut n = Norm2::default();
+    n.add_all(x);
+    n.value()
+}
+
+/// `W_nn` of contact i (the first entry of its diagonal block; 0 when the block is not
+/// stored).
+#[inline]
+pub(crate) fn normal_diagonal(problem: &ContactProblem<'_>, i: usize) -> f64 {
+    let d = problem.dim;
+    match problem.storage() {
+        Delassus::Dense(w) => w[(i * d) * problem.size() + i * d],
+        Delassus::BlockSparse(s) => s.block(i, i).map_or(0.0, |t| t[0]),
+    }
+}
+
+/// The per-contact scales `rho_i` (impulse per unit velocity) of the unit-consistent measure,
+/// as a function of the contact: `1 / W_nn,i`, or the inverse of the mean positive `W_nn` for
+/// a contact whose own is not positive or below 1e-12 times that mean, or `free` when no
+/// contact has a positive `W_nn`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct ImpulseScale {
+    mean: f64,
+    free: f64,
+}
+
+impl ImpulseScale {
+    /// the mean positive `W_nn` of `problem` (computed once, O(nc)); `free` is the scale of a
+    /// problem without any positive `W_nn`.
+    pub(crate) fn of(problem: &ContactProblem<'_>, free: f64) -> Self {
+        let nc = problem.nc;
+        let (mut sum, mut count) = (0.0, 0usize);
+        for i in 0..nc {
+            let d = normal_diagonal(problem, i);
+            if d > 0.0 {
+                // divided first: no overflow for entries near f64::MAX
+                sum += d / nc as f64;
+                count += 1;
+            }
+        }
+        let mean = if count > 0 {
+            sum * (nc as f64 / count as f64)
+        } else {
+            0.0
+        };
+        Self { mean, free }
+    }
+
+    /// the mean positive `W_nn` (0 when no contact has one).
+    pub(crate) fn mean(&self) -> f64 {
+        self.mean
+    }
+
+    /// `rho_i`.
+    #[inline]
+    pub(crate) fn rho(&self, problem: &ContactProblem<'_>, i: usize) -> f64 {
+        if self.mean.is_nan() || self.mean <= 0.0 {
+            return self.free;
+        }
+        let d = normal_diagonal(problem, i);
+        let v = if d > 1e-12 * self.mean { d } else { self.mean };
+        let rho = 1.0 / v;
+        if rho.is_finite() {
+            rho
+        } else {
+            f64::MAX
+        }
+    }
+}
+
+/// `u = W r + q` and the measures of r (see [`ContactMeasures`]); r must have `dim nc`
+/// entries.
+pub fn measure(problem: &ContactProblem<'_>, r: &[f64]) -> Result<(Vec<f64>, ContactMeasures)> {
+    if r.len() != problem.size() {
+        return Err(CoulombError::Shape(format!(
+            "r has length {}, expected {}",
+            r.len(),
+            problem.size()
+        )));
+    }
+    let mut u = vec![0.0; problem.size()];
+    let m = measure_into(problem, r, &mut u);
+    Ok((u, m))
+}
+
+/// The two natural maps of one contact in impulse units (see the module notes): De Saxce's
+/// `e` and Alart-Curnier's `a`, for the contact's impulse `r`, velocity `u`, scale `rho`.
+fn scaled_residuals(
+    problem: &ContactProblem<'_>,
+    i: usize,
+    rho: f64,
+    r: &[f64],
+    u: &[f64],
+) -> ([f64; 3], [f64; 3]) {
+    let dim = problem.dim;
+    let mu = problem.mu[i];
+    let mut su = [0.0; 3];
+    for k in 0..dim {
+        su[k] = rho * u[k];
+    }
+    let mut a = [0.0; 3];
+    // Signorini: r_n - max(0, r_n - rho u_n)
+    a[0] = r[0] - (r[0] - su[0]).max(0.0);
+    let rn = r[0].max(0.0);
+    let e = match problem.anisotropy(i) {
+        None => {
+            let mut v = [0.0; 3];
+            v[0] = r[0] - (su[0] + mu * tangent_norm(&su[1..dim]));
+            for k in 1..dim {
+                v[k] = r[k] - su[k];
+            }
+            project_cone(&mut v[..dim], mu);
+            let mut e = [0.0; 3];
+            for k in 0..dim {
+                e[k] = r[k] - v[k];
+            }
+            // Coulomb with the normal impulse frozen: projection on the disk of radius mu r_n
+            let radius = mu * rn;
+            let mut x = [0.0; 2];
+            for k in 1..dim {
+                x[k - 1] = r[k] - su[k];
+            }
+            let s = x[0].hypot(x[1]);
+            let f = if s > radius { radius / s } else { 1.0 };
+            for k in 1..dim {
+                a[k] = r[k] - f * x[k - 1];
+            }
+            e
+        }
+        Some(pair) => {
+            let (e, _) = anisotropic_residual(pair, r, &su[..dim]);
+            let x = [r[1] - su[1], r[2] - su[2]];
+            let p = project_ellipse(x, pair[0], pair[1], rn);
+            a[1] = r[1] - p[0];
+            a[2] = r[2] - p[1];
+            e
+        }
+    };
+    (e, a)
+}
+
+/// `u = W r + q` into `u` and the measures of r, without allocating.
+pub(crate) fn measure_into(
+    problem: &ContactProblem<'_>,
+    r: &[f64],
+    u: &mut [f64],
+) -> ContactMeasures {
+    let dim = problem.dim;
+    let rnorm = norm2(r);
+    let qnorm = norm2(problem.q);
+    let free = if rnorm > 0.0 && qnorm > 0.0 && (rnorm / qnorm).is_finite() {
+        rnorm / qnorm
+    } else {
+        1.0
+    };
+    let scales = ImpulseScale::of(problem, free);
+    let mut res = Norm2::default();
+    let mut scaled: f64 = 0.0;
+    let mut min_n = if problem.nc == 0 { 0.0 } else { f64::INFINITY };
+    let mut comp: f64 = 0.0;
+    let mut cone: f64 = 0.0;
+    for i in 0..problem.nc {
+        let o = i * dim;
+        let mu = problem.mu[i];
+        let ri = &r[o..o + dim];
+        let qi = &problem.q[o..o + dim];
+        // u_i and the magnitudes of its terms, (|W| |r| + |q|)_i
+        let (wr, mut terms) = problem.block_row_terms(i, r);
+        for k in 0..dim {
+            u[o + k] = wr[k] + qi[k];
+            terms[k] += qi[k].abs();
+        }
+        let ui = &u[o..o + dim];
+        // the literature's map (velocities added to impulses as they are)
+        let (e1, viol) = match problem.anisotropy(i) {
+            None => {
+                let ut_norm = tangent_norm(&ui[1..]);
+                // v = r - (u + mu ||u_t|| n), residual r - P_K(v)
+                let mut v = [0.0; 3];
+                v[0] = ri[0] - (ui[0] + mu * ut_norm);
+                for k in 1..dim {
+                    v[k] = ri[k] - ui[k];
+                }
+                project_cone(&mut v[..dim], mu);
+                let mut e = [0.0; 3];
+                for k in 0..dim {
+                    e[k] = ri[k] - v[k];
+                }
+                (e, tangent_norm(&ri[1..]) - mu * ri[0])
+            }
+            Some(pair) => anisotropic_residual(pair, ri, ui),
+        };
+        res.add_all(&e1[..dim]);
+        // the unit-consistent maps, relative to the contact's own impulse scale
+        let rho = scales.rho(problem, i);
+        let (e, a) = scaled_residuals(problem, i, rho, ri, ui);
+        let size = norm2(ri).max(rho * norm2(&terms[..dim]));
+        let err = norm2(&e[..dim]).max(norm2(&a[..dim]));
+        // size = 0 means r_i = 0 and every term of u_i is 0: both maps are exactly 0 there
+        let rel = if size > 0.0 { err / size } else { err };
+        // NaN propagates (f64::max would drop it)
+        scaled = if rel.is_nan() || rel > scaled {
+            rel
+        } else {
+            scaled
+        };
+        min_n = min_n.min(ri[0]);
+        comp = comp.max((ri[0] * ui[0]).abs());
+        cone = cone.max(viol);
+    }
+    let unorm = norm2(u);
+    let vscale = u.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let mut diss: f64 = 0.0;
+    for (ri, ui) in r.chunks_exact(dim).zip(u.chunks_exact(dim)) {
+        if tangent_norm(&ui[1..]) > 1e-12 * vscale {
+            let dot: f64 = (1..dim).map(|k| ri[k] * ui[k]).sum();
+            diss = diss.max(dot);
+        }
+    }
+    let res = res.value();
+    let denom = qnorm.max(rnorm).max(unorm);
+    let denom = if denom < TINY { 1.0 } else { denom };
+    let denom_q = if qnorm < TINY { 1.0 } else { qnorm };
+    ContactMeasures {
+        error: res / denom,
+        error_q: res / denom_q,
+        scaled_error: scaled,
+        min_normal_impulse: min_n,
+        max_complementarity: comp,
+        cone_violation: cone.max(0.0),
+        dissipation_violation: diss.max(0.0),
+    }
+}
+
+/// The natural-map residual of one contact with elliptic friction `(mu_1, mu_2)` (3D), and its
+/// cone violation.
+///
+/// With `m = max(mu_1, mu_2)` and `B = diag(1, mu_1 / m, mu_2 / m)`, the change of variables
+/// `r = B r^`, `u^ = B u` maps the elliptic cone `(r_t1 / mu_1)^2 + (r_t2 / mu_2)^2 <= r_n^2` onto
+/// the isotropic cone `K_m = { ||r^_t|| <= m r^_n }` and keeps the power `r . u = r^ . u^`, so
+/// Coulomb's law with maximal dissipation becomes the isotropic law in the hatted variables
+/// (De Saxce's modified velocity `u^ + m ||u^_t|| n`, where `m ||u^_t|| =
+/// sqrt((mu_1 u_t1)^2 + (mu_2 u_t2)^2)` is the support function of the ellipse, the dissipation
+/// rate per unit normal impulse). The residual is mapped back to impulse units by B:
+///
+/// ```text
+///     e = r - B P_{K_m}( B^+ r - (u^ + m ||u^_t|| n) ),     u^ = B u,
+/// ```
+///
+/// with `B^+` the pseudo-inverse (a tangent with `mu_k = 0` gets `r^_k = 0`, and then
+/// `e_k = r_k`: the impulse must vanish along it). B is invertible on the cone's span, so
+/// `e = 0` exactly at a solution; for `mu_1 = mu_2` it is `B = I` and e is the isotropic
+/// residual. The cone violation is `max(||B^+ r_t|| - m r_n, |r_k| for mu_k = 0)`.
+pub(crate) fn anisotropic_residual(pair: [f64; 2], r: &[f64], u: &[f64]) -> ([f64; 3], f64) {
+    let m = pair[0].max(pair[1]);
+    if m <= 0.0 {
+        // frictionless: the half-line
+        let mut v = [r[0] - u[0], r[1] - u[1], r[2] - u[2]];
+        project_cone(&mut v, 0.0);
+        let e = [r[0] - v[0], r[1] - v[1], r[2] - v[2]];
+        return (e, r[1].abs().max(r[2].abs()));
+    }
+    let b = [pair[0] / m, pair[1] / m];
+    let mut rh = [r[0], 0.0, 0.0];
+    let mut uh = [u[0], 0.0, 0.0];
+    let mut flat: f64 = 0.0;
+    for k in 0..2 {
+        if b[k] > 0.0 {
+            rh[1 + k] = r[1 + k] / b[k];
+            uh[1 + k] = u[1 + k] * b[k];
+        } else {
+            flat = flat.max(r[1 + k].abs());
+        }
+    }
+    let uht = uh[1].hypot(uh[2]);
+    let mut v = [rh[0] - (uh[0] + m * uht), rh[1] - uh[1], rh[2] - uh[2]];
+    project_cone(&mut v, m);
+    let e = [r[0] - v[0], r[1] - b[0] * v[1], r[2] - b[1] * v[2]];
+    (e, (rh[1].hypot(rh[2]) - m * r[0]).max(flat))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact::ContactStatus;
+
+    #[test]
+    fn the_scaled_error_is_invariant_under_units_and_sees_a_huge_mu() {
+        let mut rng = crate::testing::SplitMix64::new(3);
+        for case in 0..300 {
+            let dim = 2 + case % 2;
+            let nc = 1 + case % 4;
+            let n = dim * nc;
+            let g: Vec<f64> = (0..n * n).map(|_| rng.normal()).collect();
+            let mut w = vec![0.0; n * n];
+            for a in 0..n {
+                for b in 0..n {
+                    w[a * n + b] = (0..n).map(|k| g[k * n + a] * g[k * n + b]).sum();
+                }
+            }
+            let q: Vec<f64> = (0..n).map(|_| rng.normal()).collect();
+            let r: Vec<f64> = (0..n).map(|_| rng.normal()).collect();
+            let mu: Vec<f64> = (0..nc)
+                .map(|_| [0.0, 0.3, 2.0, 1e8][rng.below(4)])
+                .collect();
+            let p = ContactProblem::new(dim, &w, &q, &mu).unwrap();
+            let (_, m) = measure(&p, &r).unwrap();
+            for (a, b) in [(1e-8, 1e8), (1e8, 1.0), (1e-200, 1e-200), (1.0, 1e300)] {
+                let ws: Vec<f64> = w.iter().map(|v| v * (b / a)).collect();
+                let qs: Vec<f64> = q.iter().map(|v| v * b).collect();
+                let rs: Vec<f64> = r.iter().map(|v| v * a).collect();
+                let ps = ContactProblem::new(dim, &ws, &qs, &mu).unwrap();
+                let (_, ms) = measure(&ps, &rs).unwrap();
+                assert!(
+                    (ms.scaled_error - m.scaled_error).abs() <= 1e-12 * m.scaled_error,
+                    "case {case} units ({a}, {b}): {} vs {}",
+                    ms.scaled_error,
+                    m.scaled_error
+                );
+            }
+        }
+        // r = 0 for a contact that must push: De Saxce's map alone is 1e-8 of the data with
+        // mu = 1e8; the unit-consistent measure sees it (Alart-Curnier's normal part)
+        let w = [0.5, 0.0, 0.0, 0.5];
+        let q = [-3.0, 1.0];
+        for mu in [1e8, 1e12] {
+            let mus = [mu];
+            let p = ContactProblem::new(2, &w, &q, &mus).unwrap();
+            let (_, m) = measure(&p, &[0.0, 0.0]).unwrap();
+            // Signorini's part: |min(r_n, rho u_n)| = 6 against rho ||(|q|)|| = 2 sqrt(10)
+            let expected = 6.0 / (2.0 * 10f64.sqrt());
+            assert!(m.error < 1e-7, "{m:?}");
+            assert!((m.scaled_error - expected).abs() < 1e-15, "{m:?}");
+            let (_, m) = measure(&p, &[6.0, -2.0]).unwrap();
+            assert_eq!(m.scaled_error, 0.0);
+        }
+    }
+
+    #[test]
+    fn norms_neither_underflow_nor_overflow() {
+        for s in [1e-300, 1e-200, 1.0, 1e200, 1e300] {
+            let x = [3.0 * s, 4.0 * s];
+            assert!((norm2(&x) - 5.0 * s).abs() <= 1e-15 * 5.0 * s, "{s}");
+        }
+        assert!(norm2(&[f64::NAN, 1.0]).is_nan());
+        assert_eq!(norm2(&[f64::INFINITY, 1.0]), f64::INFINITY);
+        assert_eq!(norm2(&[0.0, -0.0]), 0.0);
+        // r = 0 for the seed's step at 1e-200: measured as at scale 1, not as 0
+        let (w, q) = ([0.5e-200, 0.0, 0.0, 0.5e-200], [-3e-200, 1e-200]);
+        let p = ContactProblem::new(2, &w, &q, &[0.2]).unwrap();
+        let (_, m) = measure(&p, &[0.0, 0.0]).unwrap();
+        assert!(
+            (m.scaled_error - 6.0 / (2.0 * 10f64.sqrt())).abs() < 1e-15,
+            "{m:?}"
+        );
+        assert!(m.error_q > 0.5, "{m:?}");
+    }
+
+    #[test]
+    fn measures_of_the_seed_answer_and_of_zero() {
+        let w = [0.5, 0.0, 0.0, 0.5];
+        let q = [-3.0, 1.0];
+        let p = ContactProblem::new(2, &w, &q, &[0.2]).unwrap();
+        let (u, m) = measure(&p, &[6.0, -1.2]).unwrap();
+        assert!((u[0]).abs() < 1e-15 && (u[1] - 0.4).abs() < 1e-15);
+        assert!(m.error < 1e-15, "{m:?}");
+        assert_eq!(m.dissipation_violation, 0.0);
+        // r = 0: u = q, residual r - P_K(-(q + mu |q_t| n)) = -P_K((2.8, -1)), outside K and
+        // its polar: n' = (2.8 + 0.2) / 1.04, |t'| = 0.2 n', norm 3 / sqrt(1.04)
+        let (_, m) = measure(&p, &[0.0, 0.0]).unwrap();
+        let expected = 3.0 / 1.04f64.sqrt() / 10f64.sqrt();
+        assert!(
+            (m.error - expected).abs() < 1e-14,
+            "{} vs {expected}",
+            m.error
+        );
+        assert_eq!(m.error, m.error_q);
+        // a sliding impulse along the slip is flagged
+        let (_, m) = measure(&p, &[6.0, 1.2]).unwrap();
+        assert!(m.dissipation_violation > 1.0);
+        assert!(measure(&p, &[1.0]).is_err());
+        assert_eq!(ContactStatus::IterationLimit.as_str(), "iteration_limit");
+    }
+}

@@ -1,0 +1,100 @@
+"""Property suite of coulomb.contact.solve: every reported success is checked by an
+independent test of Coulomb's law (contact_gen.law_violation, written from the law, not from
+coulomb's measures), on generated problems of known classes (planted solutions: separating,
+sticking and sliding contacts; random problems that may have no solution), both dims, units
+10^-8..10^8 for impulses and velocities independently, mu 0..1e12.
+
+Profiles: the default is short (CI). ``COULOMB_PROPERTIES=long`` runs the long one (see
+docs/properties.md for its counts and the command).
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import pytest
+from contact_gen import (
+    FALSE,
+    METHODS,
+    MODERATE_MU,
+    TOL,
+    campaign,
+    generate,
+    law_violation,
+    solve,
+)
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+LONG = os.environ.get("COULOMB_PROPERTIES") == "long"
+SETTINGS = settings(max_examples=1000 if LONG else 25, deadline=None, derandomize=not LONG,
+                    suppress_health_check=[HealthCheck.too_slow])
+UNITS = st.integers(-8, 8)
+
+
+@SETTINGS
+@given(st.integers(0, 2**31), st.sampled_from([2, 3]), st.booleans(), UNITS, UNITS,
+       st.sampled_from(METHODS))
+def test_every_success_satisfies_the_law(seed, dim, planted, ka, kb, method):
+    p = generate(seed, dim, planted, ka, kb)
+    r = solve(p, method)
+    assert r.success == (r.status == "solved")
+    if r.success:
+        v = law_violation(p.W, p.q, p.mu, dim, r.impulse, polygon=method == "lemke" and dim == 3)
+        assert v <= FALSE, (r.message, v)
+
+
+@SETTINGS
+@given(st.integers(0, 2**31), st.sampled_from([2, 3]), UNITS, UNITS, st.sampled_from(METHODS))
+def test_status_is_invariant_under_units(seed, dim, ka, kb, method):
+    # Planted problems (a solution exists) with mu up to 10. Beyond, a problem is conditioned
+    # like mu, and on problems without a solution an iterative method's path is chaotic: a
+    # verdict near the tolerance may then flip with the rounding of the scaled data (counted
+    # by the campaign, docs/properties.md), never into a false success.
+    # The robust mode in 3D is excluded: its stall detection and restarts make its path
+    # sensitive to rounding on singular W (3 status changes in 200 such problems,
+    # docs/properties.md); its successes are still checked above.
+    if method == "prox" and dim == 3:
+        return
+    base = generate(seed, dim, True, mu_choices=MODERATE_MU)
+    other = generate(seed, dim, True, ka, kb, mu_choices=MODERATE_MU)
+    r, s = solve(base, method), solve(other, method)
+    assert (r.success, r.status) == (s.success, s.status), (r.message, s.message)
+    unique = np.linalg.cond(base.W) < 1e6 and base.mu.max() <= 0.5
+    if r.success and unique:
+        # the answer scales, to the tolerance's precision (the solves run on differently
+        # rounded data), relative to the problem's impulse scale
+        diag = float(np.abs(np.diag(base.W)).max())
+        scale = max(float(np.abs(r.impulse).max()), float(np.abs(base.q).max()) / diag)
+        assert np.abs(s.impulse / 10.0**ka - r.impulse).max() <= 1e-6 * scale
+
+
+@pytest.mark.parametrize("k", [-600, -40, -3, 5, 90, 700])
+@pytest.mark.parametrize("method", METHODS)
+def test_power_of_two_units_scale_the_answer_exactly(method, k):
+    # impulses times 2^k, velocities unchanged: the solver sees the same normalized problem
+    p = generate(7, 2, True)
+    r = solve(p, method)
+    s = solve(generate(7, 2, True) if k == 0 else type(p)(p.W * 2.0**-k, p.q, p.mu, 2, True,
+                                                       None), method)
+    assert (r.status, r.iterations) == (s.status, s.iterations)
+    np.testing.assert_array_equal(s.impulse, r.impulse * 2.0**k)
+
+
+def test_campaign_has_no_false_success_and_solves_planted_problems():
+    counts = campaign(300 if LONG else 30)
+    for method, c in counts.items():
+        assert c.false_successes == 0, (method, c)
+        # planted, mu up to 10: one in 100 at most (long campaign: 1, 2 and 1 in 581, see
+        # docs/properties.md; the robust mode's 3D path is sensitive to rounding)
+        assert c.status_changes <= 1 + 0.01 * (c.cases - c.hard_cases), (method, c)
+    # planted problems (a solution exists) with mu up to 10: Lemke's pivoting (exact in 2D)
+    # and the robust mode solve them (long campaign: 99.5% and 98%, docs/properties.md); with
+    # mu up to 1e12 as well, 91% and 82%; NSGS may stall on singular W
+    lemke, prox = counts["lemke"], counts["prox"]
+    assert lemke.planted_moderate_successes >= 0.97 * lemke.planted_moderate, lemke
+    assert prox.planted_moderate_successes >= 0.9 * prox.planted_moderate, prox
+    assert lemke.planted_successes >= 0.85 * lemke.planted, lemke
+    assert prox.planted_successes >= 0.75 * prox.planted, prox
+    assert TOL == 1e-8

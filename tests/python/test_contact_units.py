@@ -1,0 +1,140 @@
+"""Regression tests of issue 11's reproductions: ``success`` means solved in every unit
+system (the unit-consistent measure decides, for every method), extreme scales and friction
+coefficients, and the stepper's verdict agreeing with Trajectory.check()."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from contact_gen import law_violation
+from coulomb import contact, lcp
+from helpers import contact_scaled_error
+
+METHODS = ("nsgs", "prox", "lemke")
+
+
+@pytest.fixture(scope="module")
+def fclib_dir(data_dir: Path) -> Path:
+    path = data_dir / "fclib"
+    if not path.is_dir():
+        pytest.skip(f"fclib data not found at {path}")
+    return path
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_a_problem_without_solution_at_small_w_is_not_solved(method):
+    # W = 1e-5 [[1, 4], [4, 16]] (rank 1), q = (-0.15, 0.4), mu = 2.4: no solution. The old
+    # verdict divided by max(||q||, ||r||, ||u||) and NSGS reported success (error 9.9e-9,
+    # error_q 0.585); with W x 100 it honestly said iteration_limit.
+    W = 1e-5 * np.array([[1.0, 4.0], [4.0, 16.0]])
+    q = [-0.15, 0.4]
+    for scale in (1.0, 100.0):
+        r = contact.solve(W * scale, q, 2.4, dim=2, method=method)
+        assert not r.success, r.message
+        assert contact_scaled_error(W * scale, q, [2.4], 2, r.impulse) > 1e-8
+        assert r.scaled_error > 1e-8
+
+
+def test_perio_box_nsgs_does_not_stop_on_a_measure_the_verdict_rejects(fclib_dir):
+    # LMGC_100_PR_PerioBox-i00361-60-03000: NSGS said "solved in 150 sweeps" with error_q
+    # 5.2e-4, max_complementarity 16 and dissipation_violation 2.94
+    from coulomb.io import read_fclib
+
+    name = "LMGC_100_PR_PerioBox-i00361-60-03000.hdf5"
+    p = read_fclib(fclib_dir / "Local/LMGC90/100_PR_PerioBox" / name)
+    W = p.W.toarray()
+    r = contact.solve(p.W, p.q, p.mu, p.dim, max_iter=5000)
+    scaled = contact_scaled_error(W, p.q, p.mu, p.dim, r.impulse)
+    assert r.scaled_error == pytest.approx(scaled, rel=1e-6)
+    assert r.success == (scaled <= 1e-8)
+    if r.success:
+        assert law_violation(W, p.q, p.mu, p.dim, r.impulse) <= 1e-6
+        assert r.error_q < 1e-6 and r.dissipation_violation < 1e-2
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("scale", [1e-10, 1e-200, 1e300])
+def test_the_polyhedral_path_keeps_friction_at_any_scale(dim, scale):
+    # the seed's inelastic step scaled by 1e-10 gave r = (6, 0) with success: friction dropped
+    W = np.eye(dim) / 2 * scale
+    q = np.array([-3.0, 1.0, 0.0][:dim]) * scale
+    r = contact.solve(W, q, 0.2, dim=dim, method="lemke", facets=2 if dim == 2 else 4)
+    assert r.success, r.message
+    np.testing.assert_allclose(r.impulse[0], [6.0, -1.2, 0.0][:dim], rtol=1e-12, atol=1e-12)
+
+
+@pytest.mark.parametrize("method", METHODS)
+@pytest.mark.parametrize("mu", [1e8, 1e12])
+def test_a_sticking_contact_with_a_huge_mu_still_pushes(method, mu):
+    # r = 0 nearly zeroes De Saxce's map when mu ||u_t|| hides u_n < 0: NSGS and prox
+    # returned r = 0 with success
+    r = contact.solve(np.eye(2) / 2, [-3.0, 1.0], mu, dim=2, method=method)
+    assert r.success, r.message
+    np.testing.assert_allclose(r.impulse[0], [6.0, -2.0], rtol=1e-9)
+
+
+@pytest.mark.parametrize("method", METHODS)
+@pytest.mark.parametrize("scale", [1e-200, 1e-20, 1e300])
+def test_extreme_scales_are_solved_not_reported_as_error_zero(method, scale):
+    # W, q x1e-200 gave r = 0 with error 0 (NSGS, prox), x1e300 NSGS a NaN error
+    W, q = np.eye(2) / 2 * scale, np.array([-3.0, 1.0]) * scale
+    r = contact.solve(W, q, 0.2, dim=2, method=method)
+    assert r.success, r.message
+    np.testing.assert_allclose(r.impulse[0], [6.0, -1.2], rtol=1e-8)
+    assert np.isfinite([r.error, r.error_q, r.scaled_error]).all()
+    # a wrong answer is measured as wrong at any scale
+    wrong = contact.solve(W, q, 0.2, dim=2, method="nsgs", max_iter=1, initial=[[3.0, 0.0]],
+                          relaxation=0.5)
+    assert not wrong.success and wrong.scaled_error > 0.1
+
+
+@pytest.mark.parametrize("method", ["lemke", "enumerate", "pgs"])
+@pytest.mark.parametrize("scale", [1e-200, 1e200, 1e300])
+def test_lcp_measures_do_not_overflow_or_underflow(method, scale):
+    rng = np.random.default_rng(3)
+    A = rng.standard_normal((6, 6))
+    M = A @ A.T + 6 * np.eye(6)
+    q = rng.standard_normal(6)
+    ref = lcp.solve(M, q, method=method)
+    r = lcp.solve(M * scale, q * scale, method=method)
+    assert np.isfinite(r.error) and r.status == ref.status == "solved", r.message
+    np.testing.assert_allclose(r.z, ref.z, rtol=1e-9, atol=1e-12)
+
+
+def _two_box_stack(ratio: float, heavy_on_top: bool):
+    """A box on a box on the floor, one `ratio` times heavier (the extremes suite's scene)."""
+    from coulomb import extremes as ex
+    from coulomb.model import Model
+
+    b = 0.05
+    m_top, m_bottom = (ratio, 1.0) if heavy_on_top else (1.0, ratio)
+    a_bottom, a_top = 0.2, 0.1
+    j_bottom = m_bottom * (4 * a_bottom**2 + 4 * b * b) / 12
+    j_top = m_top * (4 * a_top**2 + 4 * b * b) / 12
+    mass = np.diag([m_bottom, m_bottom, j_bottom, m_top, m_top, j_top])
+    gravity = np.array([0.0, -ex.G0 * m_bottom, 0.0, 0.0, -ex.G0 * m_top, 0.0])
+    return Model(2, mass, q0=[0.0, b, 0.0, 0.03, 3 * b, 0.0],
+                 force=lambda q, v, t, g=gravity: g,
+                 contacts=ex._box_corner_gaps(a_bottom, a_top, b),
+                 potential=lambda q, g=gravity: float(-(g @ q)))
+
+
+@pytest.mark.parametrize("heavy_on_top", [False, True])
+def test_the_stepper_verdict_and_check_agree_on_a_stack_at_mass_ratio_1e6(heavy_on_top):
+    # every step was reported solved while check() flagged complementarity products of
+    # 2.4e-5 and 3.1e-5: the solver's verdict (a global relative residual) and check() (a
+    # product scaled by the largest impulse) used different measures
+    tr = _two_box_stack(1e6, heavy_on_top).simulate(0.1, 1e-3)
+    c = tr.check()
+    solved = np.array([s == "solved" for s in tr.solver_status])
+    # one rule, one measure: a step is solved exactly when its scaled_error passes tol (the
+    # Lemke fallback's tolerance is max(tol, 1e-9)), and check() judges by that rule
+    tol = np.where(tr.fallback, max(tr.tol, 1e-9), tr.tol)
+    np.testing.assert_array_equal(solved, tr.solver_scaled_error <= tol)
+    assert solved.all() and c.ok, c.violations
+    if not heavy_on_top:
+        # the light box on top: its contacts are judged at their own scale, so the products
+        # fall to rounding (2.4e-5 before)
+        assert float(np.max(tr.complementarity)) < 1e-8
