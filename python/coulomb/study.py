@@ -28,7 +28,7 @@ import time
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from concurrent.futures import Executor
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
@@ -347,7 +347,7 @@ def sweep(
         if reference is not None:
             rec.update(_errors(out, reference))
         records.append(rec)
-    return Study(records, settings_keys, reference, name or getattr(run, "__name__", "study"))
+    return Study(records, settings_keys, reference, name or str(getattr(run, "__name__", "study")))
 
 
 # ---- presets: runs importable by any worker -------------------------------------------------
@@ -372,7 +372,9 @@ def regularized_ramp(
     return {"creep": float(res.s[-1] - s_exact[0]), "nfev": res.nfev, "njev": res.njev}
 
 
-def contact_tolerance(tol: float = 1e-8, method: str = "nsgs", facets: int = 8) -> dict[str, float]:
+def contact_tolerance(
+    tol: float = 1e-8, method: Literal["nsgs", "lemke", "prox"] = "nsgs", facets: int = 8
+) -> dict[str, float]:
     """The seed's oblique inelastic impact in 3D (m = 2, v = (-3, 1, 0), mu = 0.2) with slip
     at 30 deg off the first tangent, solved at tolerance ``tol``: returns the post-step slip
     speed ``u_t`` (exactly 0.4) and the solver's work."""
@@ -439,7 +441,7 @@ def nsgs_tolerance(
 
 def ramp(
     h: float = 1e-3,
-    solver: str = "nsgs",
+    solver: Literal["nsgs", "lemke"] = "nsgs",
     tol: float | None = None,
     facets: int | None = None,
     warm_start: bool = True,
