@@ -48,6 +48,7 @@ from . import (
 )
 from ._core import __version__, memory_budget, set_memory_budget
 from ._result import Result
+from ._status import Status
 from .contact import ContactResult
 from .lcp import LcpResult
 from .model import (
@@ -84,6 +85,7 @@ __all__ = [
     "Scene",
     "Segment",
     "Sphere",
+    "Status",
     "Trajectory",
     "__version__",
     "contact",

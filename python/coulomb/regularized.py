@@ -28,6 +28,7 @@ import numpy as np
 
 from ._extras import require
 from ._result import Result
+from ._status import Status
 from .errors import InvalidParameterError, NonFiniteError
 
 __all__ = ["RegularizedResult", "coulomb_ramp", "creep_velocity", "simulate_ramp"]
@@ -154,7 +155,7 @@ def simulate_ramp(
         nlu=int(sol.nlu),
         solve_time=elapsed,
         success=bool(sol.success),
-        status="solved" if sol.success else "failed",
+        status=Status.SOLVED if sol.success else Status.FAILED,
         message=str(sol.message),
         method=method,
         eps=eps,
