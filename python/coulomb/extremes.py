@@ -216,7 +216,7 @@ def _mass_ratio_boxes(ratios: list[float]) -> Iterator[ExtremeCase]:
 
 
 def _friction(mus: list[float]) -> Iterator[ExtremeCase]:
-    """The seed's ramp (20 deg, v0 = 1 m/s, h = 1 ms) from frictionless to mu = 100: the
+    """The chapter's ramp (20 deg, v0 = 1 m/s, h = 1 ms) from frictionless to mu = 100: the
     distance at t = 2 s against the exact Coulomb answer."""
     th = math.radians(20.0)
     h = 1e-3
@@ -315,7 +315,7 @@ def _redundant(counts: list[int]) -> Iterator[ExtremeCase]:
 
 
 def _units(factors: list[float]) -> Iterator[ExtremeCase]:
-    """The seed's ramp with lengths in other units (positions, speeds and g scaled by the
+    """The chapter's ramp with lengths in other units (positions, speeds and g scaled by the
     factor): the stop distance scales by the same factor."""
     th = math.radians(20.0)
 

@@ -1,7 +1,7 @@
 """Linear complementarity problems: find z with ``0 <= z ⊥ w = M z + q >= 0``.
 
 >>> import numpy as np, coulomb
->>> r = coulomb.lcp.solve([[2.0]], [-6.0])      # the seed's w = 2z - 6
+>>> r = coulomb.lcp.solve([[2.0]], [-6.0])      # the chapter's w = 2z - 6
 >>> float(r.z[0]), float(r.w[0]), r.status
 (3.0, 0.0, Status.SOLVED)
 >>> coulomb.lcp.solve([[-1.0]], [-1.0]).status  # w = -z - 1 has no solution
