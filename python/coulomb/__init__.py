@@ -12,14 +12,14 @@ contact
     the polyhedral-cone LCP by Lemke, the robust mode (``method="prox"``), and the assembly of
     W = G^T M^-1 G.
 model
-    Scenes (bodies, contact shapes, half-spaces, pairs) and ``Scene.simulate``: the seed's
-    impulse time stepper, run in Rust.
+    Scenes (bodies, contact shapes, half-spaces, pairs) and ``Scene.simulate``: Stewart's
+    impulse time stepper (Stewart 2000; Stewart and Trinkle 1996), run in Rust.
 trajectory
-    The simulation result with the seed's per-step checks (``Trajectory.check``) and plots.
+    The simulation result with its per-step checks (``Trajectory.check``) and plots.
 io
     Readers for benchmark problem files (Siconos LCP and friction contact, FCLib HDF5).
 painleve
-    Painleve's sliding rod: the seed's A(theta), b and which smooth contact modes exist.
+    Painleve's sliding rod: A(theta), b and which smooth contact modes exist.
 regularized
     The tanh-smoothed friction law on a ramp (stiff ODE), to compare with exact Coulomb friction.
 extremes
@@ -29,7 +29,12 @@ study
 errors
     The exceptions raised for bad input.
 validate
-    Reproduces the reference figures of the seed chapter (``coulomb validate``).
+    Reproduces the reference figures of the chapter (``coulomb validate``).
+
+The physics follows D. E. Stewart, "Rigid-Body Dynamics with Friction and Impact", SIAM Review
+42(1), 2000, as taught in Satici, *Kinematics and Machine Dynamics*, ch. 11 ("the chapter" in
+these docs: its worked examples are the scalar LCPs, the inelastic contact step, Painleve's rod,
+the ramp and the floor impact).
 """
 
 from __future__ import annotations
@@ -48,6 +53,7 @@ from . import (
 )
 from ._core import __version__, memory_budget, set_memory_budget
 from ._result import Result
+from ._status import Status
 from .contact import ContactResult
 from .lcp import LcpResult
 from .model import (
@@ -84,6 +90,7 @@ __all__ = [
     "Scene",
     "Segment",
     "Sphere",
+    "Status",
     "Trajectory",
     "__version__",
     "contact",

@@ -6,13 +6,14 @@ r"""From a mechanism to its contact problem (re-exported by :mod:`coulomb.contac
 
 M is the symmetric positive definite mass matrix (``ndof x ndof``), G the transposed contact
 Jacobian (``ndof x dim nc``: column k is the generalized direction of contact component k,
-normal first per contact; ../shared/DESIGN.md), ``v_free`` the velocity reached without
+normal first per contact, then its tangents), ``v_free`` the velocity reached without
 contact impulses and r the impulses. M is factored in Rust by Cholesky: block by block when it
 is block diagonal with blocks of at most 256 dofs (rigid bodies, diagonal masses; the blocks
 are found from the sparsity pattern), otherwise by faer's sparse Cholesky.
 
 >>> import numpy as np, coulomb
->>> # the seed's inelastic step: a particle of mass 2, free velocity (-3, 1) in the contact frame
+>>> # the chapter's inelastic step: a particle of mass 2, free velocity (-3, 1) in the contact
+>>> # frame
 >>> W, q = coulomb.contact.assemble(2 * np.eye(2), np.eye(2), [-3.0, 1.0])
 >>> W.round(12).tolist(), q.tolist()
 ([[0.5, 0.0], [0.0, 0.5]], [-3.0, 1.0])

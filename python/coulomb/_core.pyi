@@ -1,75 +1,191 @@
-"""Type stub of the Rust extension ``coulomb._core``."""
+"""Type stub of the Rust extension ``coulomb._core`` (the bindings in ``rust/python/``).
 
-from typing import Any
+Checked against the built extension by ``python -m mypy.stubtest coulomb._core``. The functions
+return plain dicts; their keys and value types are the ``TypedDict`` classes below (stub-only,
+hence private names).
+"""
+
+import os
+from typing import Any, Literal, TypedDict
 
 import numpy as np
 from numpy.typing import NDArray
 
+__all__ = [
+    "__version__",
+    "contact_assemble",
+    "contact_post_velocity",
+    "contact_solve",
+    "lcp_measures",
+    "lcp_solve",
+    "memory_budget",
+    "read_siconos_fc",
+    "read_siconos_lcp",
+    "set_memory_budget",
+    "simd_level",
+    "step_simulate",
+]
+
 __version__: str
 
+_F64 = NDArray[np.float64]
+_I64 = NDArray[np.int64]
+_Path = str | os.PathLike[str]
+
+_LcpStatusName = Literal[
+    "solved", "ray_termination", "pivot_limit", "iteration_limit", "numerical_failure",
+    "no_solution",
+]
+_ContactStatusName = Literal["solved", "iteration_limit", "numerical_failure"]
+_StepStatusName = _ContactStatusName | Literal["no_contact"]
+
+class _LcpMeasuresDict(TypedDict):
+    """``lcp_measures``: the error measures of a given z on (M, q)."""
+
+    w: _F64
+    error: float
+    scaled_error: float
+    min_z: float
+    min_w: float
+    max_complementarity: float
+
+class _LcpSolveDict(_LcpMeasuresDict):
+    """``lcp_solve``: the answer, how the solve ended and its error measures."""
+
+    success: bool
+    status: _LcpStatusName
+    message: str
+    z: _F64
+    pivots: int
+    iterations: int
+    basis: _I64
+    warm_start: Literal["none", "accepted", "rejected"]
+    pivots_saved: int
+    polished: bool
+    restarts: int
+    solutions: _F64
+    solve_time: float
+
+class _ContactSolveDict(TypedDict):
+    """``contact_solve``: impulses and velocities as (nc, dim) arrays and the error measures."""
+
+    impulse: _F64
+    velocity: _F64
+    success: bool
+    status: _ContactStatusName
+    message: str
+    iterations: int
+    error: float
+    error_q: float
+    scaled_error: float
+    min_normal_impulse: float
+    max_complementarity: float
+    cone_violation: float
+    dissipation_violation: float
+    solve_time: float
+
+class _SiconosLocalFcDict(TypedDict):
+    """``read_siconos_fc`` of a local (``FC2D``/``FC3D``) problem."""
+
+    kind: Literal["local"]
+    dim: int
+    nc: int
+    W: _F64
+    q: _F64
+    mu: _F64
+
+class _SiconosGlobalFcDict(TypedDict):
+    """``read_siconos_fc`` of a global (``GFC3D``) problem."""
+
+    kind: Literal["global"]
+    dim: int
+    nc: int
+    M: _F64
+    H: _F64
+    q: _F64
+    b: _F64
+    mu: _F64
+
+class _StepSimulateDict(TypedDict):
+    """``step_simulate``: the recorded trajectory, one row per recorded step."""
+
+    dim: int
+    t: _F64
+    q: _F64
+    v: _F64
+    kinetic_energy: _F64
+    potential_energy: _F64
+    min_gap: _F64
+    negative_gaps: _I64
+    active: _I64
+    status: list[_StepStatusName]
+    error: _F64
+    scaled_error: _F64
+    iterations: _I64
+    momentum_residual: _F64
+    min_normal_impulse: _F64
+    cone_violation: _F64
+    complementarity: _F64
+    resumed: NDArray[np.bool_]
+    fallback: NDArray[np.bool_]
+    projection: _F64
+    contact_step: _I64
+    contact_id: _I64
+    contact_impulse: _F64
+    contact_velocity: _F64
+    contact_approach: _F64
+    contact_gap: _F64
+    contact_closed: NDArray[np.bool_]
+    stopped: str | None
+    solve_time: float
+
 def lcp_solve(
-    m: NDArray[np.float64],
-    q: NDArray[np.float64],
+    m: _F64,
+    q: _F64,
     method: str,
     tol: float,
     max_pivots: int | None = None,
-    covering_vector: NDArray[np.float64] | None = None,
+    covering_vector: _F64 | None = None,
     warm_start: list[int] | None = None,
     polish: bool = True,
     restarts: int = 2,
     max_iter: int = 10000,
     relaxation: float = 1.0,
-    initial: NDArray[np.float64] | None = None,
+    initial: _F64 | None = None,
     engine: str = "auto",
-) -> dict[str, Any]: ...
-def lcp_measures(
-    m: NDArray[np.float64], q: NDArray[np.float64], z: NDArray[np.float64]
-) -> dict[str, Any]: ...
-def read_siconos_lcp(path: str) -> tuple[NDArray[np.float64], NDArray[np.float64]]: ...
+) -> _LcpSolveDict: ...
+def lcp_measures(m: _F64, q: _F64, z: _F64) -> _LcpMeasuresDict: ...
+def read_siconos_lcp(path: _Path) -> tuple[_F64, _F64]: ...
 def contact_solve(
-    w: NDArray[np.float64] | None,
-    q: NDArray[np.float64],
-    mu: NDArray[np.float64],
+    w: _F64 | None,
+    q: _F64,
+    mu: _F64,
     dim: int,
     method: str,
     tol: float,
     max_iter: int | None = None,
     relaxation: float = 1.0,
-    initial: NDArray[np.float64] | None = None,
+    initial: _F64 | None = None,
     facets: int | None = None,
-    w_csr: tuple[
-        int, NDArray[np.int32 | np.int64], NDArray[np.int32 | np.int64], NDArray[np.float64]
-    ]
+    w_csr: tuple[int, NDArray[np.int32 | np.int64], NDArray[np.int32 | np.int64], _F64]
     | None = None,
-    mu_pair: NDArray[np.float64] | None = None,
+    mu_pair: _F64 | None = None,
     eta: float | None = None,
     order: str = "forward",
     permutation: list[int] | None = None,
-) -> dict[str, Any]: ...
-def read_siconos_fc(path: str) -> dict[str, Any]: ...
-def contact_solve_prox(
-    w: NDArray[np.float64],
-    q: NDArray[np.float64],
-    mu: NDArray[np.float64],
-    dim: int,
-    tol: float,
-    max_iter: int | None = None,
-    eta: float = 0.1,
-    initial: NDArray[np.float64] | None = None,
-) -> dict[str, Any]: ...
+) -> _ContactSolveDict: ...
+def read_siconos_fc(path: _Path) -> _SiconosLocalFcDict | _SiconosGlobalFcDict: ...
 
-_Triplets = tuple[int, int, NDArray[np.int64], NDArray[np.int64], NDArray[np.float64]]
+_Triplets = tuple[int, int, _I64, _I64, _F64]
 
 def contact_assemble(
     m: _Triplets,
     g: _Triplets,
-    v_free: NDArray[np.float64] | None = None,
-    force: NDArray[np.float64] | None = None,
-    extra: NDArray[np.float64] | None = None,
-) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]: ...
-def contact_post_velocity(
-    m: _Triplets, g: _Triplets, v_free: NDArray[np.float64], r: NDArray[np.float64]
-) -> NDArray[np.float64]: ...
+    v_free: _F64 | None = None,
+    force: _F64 | None = None,
+    extra: _F64 | None = None,
+) -> tuple[_F64, _F64, _F64]: ...
+def contact_post_velocity(m: _Triplets, g: _Triplets, v_free: _F64, r: _F64) -> _F64: ...
 def simd_level() -> str: ...
 def memory_budget() -> int: ...
 def set_memory_budget(bytes: int) -> int: ...
@@ -90,4 +206,4 @@ def step_simulate(
     restitution: str = "newton",
     record_every: int = 1,
     locate_impacts: bool = False,
-) -> dict[str, Any]: ...
+) -> _StepSimulateDict: ...

@@ -1,4 +1,5 @@
-"""The seed's figures reproduced by the impulse time stepper, as rows for ``coulomb validate``:
+"""The chapter's figures (Stewart 2000, as taught in Satici ch. 11) reproduced by the impulse
+time stepper, as rows for ``coulomb validate``:
 ``(case, quantity, expected, computed, tolerance)``."""
 
 from __future__ import annotations

@@ -93,7 +93,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--version", action="version", version=f"coulomb {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
 
-    v = sub.add_parser("validate", help="reproduce the seed's figures and print them")
+    v = sub.add_parser(
+        "validate", help="reproduce the worked figures of Stewart (2000) and print them"
+    )
     v.add_argument("--data", type=Path, default=None, help="benchmark data folder")
     v.add_argument("--json", action="store_true", help="print the rows as JSON")
     v.set_defaults(func=_validate)

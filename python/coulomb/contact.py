@@ -123,6 +123,7 @@ from numpy.typing import ArrayLike, NDArray
 from . import _core, _validate
 from ._assembly import assemble, post_velocity
 from ._result import Result
+from ._status import Status
 from .errors import InvalidInputError, InvalidParameterError, NonFiniteError, ShapeError
 from .lcp import _as_array
 
@@ -327,7 +328,7 @@ def solve(
         order=order_name,
         permutation=permutation,
     )
-    return ContactResult(out)
+    return ContactResult(out, status=Status(out["status"]))
 
 
 def _order(order: object, nc: int, method: str) -> tuple[str, list[int] | None]:

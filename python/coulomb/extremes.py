@@ -130,7 +130,17 @@ def _mass_ratio(ratios: list[float]) -> Iterator[ExtremeCase]:
             )
 
 
-def _box_corner_gaps(a_bottom: float, a_top: float, b: float):
+def _point_contact(point: Callable[[np.ndarray], np.ndarray], height: float) -> GapContact:
+    """The contact (mu = 0.5) of the point ``point(q)`` with the line ``y = height`` of the
+    frame the point is given in: gap along y, tangential position along x."""
+    return GapContact(
+        gap=lambda q: float(point(q)[1] - height),
+        tangent_position=lambda q: [float(point(q)[0])],
+        mu=0.5,
+    )
+
+
+def _box_corner_gaps(a_bottom: float, a_top: float, b: float) -> list[GapContact]:
     """Gap contacts of a planar box (q[3:6]) resting on another (q[0:3]) resting on the floor,
     written in generalized coordinates: each bottom corner of the lower box against the floor,
     each bottom corner of the upper box against the lower box's top face (gap and tangential
@@ -143,13 +153,11 @@ def _box_corner_gaps(a_bottom: float, a_top: float, b: float):
 
     contacts = []
     for sx in (-1.0, 1.0):
-        contacts.append(
-            GapContact(
-                gap=lambda q, sx=sx: float(corner(q, 0, sx, a_bottom)[1]),
-                tangent_position=lambda q, sx=sx: [float(corner(q, 0, sx, a_bottom)[0])],
-                mu=0.5,
-            )
-        )
+
+        def bottom(q: np.ndarray, sx: float = sx) -> np.ndarray:
+            return corner(q, 0, sx, a_bottom)
+
+        contacts.append(_point_contact(bottom, 0.0))
 
         def local(q: np.ndarray, sx: float = sx) -> np.ndarray:
             p = corner(q, 1, sx, a_top)
@@ -158,14 +166,18 @@ def _box_corner_gaps(a_bottom: float, a_top: float, b: float):
             d = p - np.array([x, y])
             return np.array([c * d[0] + s * d[1], -s * d[0] + c * d[1]])
 
-        contacts.append(
-            GapContact(
-                gap=lambda q, local=local: float(local(q)[1] - b),
-                tangent_position=lambda q, local=local: [float(local(q)[0])],
-                mu=0.5,
-            )
-        )
+        contacts.append(_point_contact(local, b))
     return contacts
+
+
+def _constant_force(g: np.ndarray) -> Callable[[np.ndarray, np.ndarray, float], np.ndarray]:
+    """The generalized force ``f(q, v, t) = g``."""
+    return lambda q, v, t: g
+
+
+def _linear_potential(g: np.ndarray) -> Callable[[np.ndarray], float]:
+    """The potential ``-g . q`` of the constant generalized force g."""
+    return lambda q: float(-(g @ q))
 
 
 def _mass_ratio_boxes(ratios: list[float]) -> Iterator[ExtremeCase]:
@@ -185,9 +197,9 @@ def _mass_ratio_boxes(ratios: list[float]) -> Iterator[ExtremeCase]:
                 2,
                 mass,
                 q0=[0.0, b, 0.0, 0.03, 3 * b, 0.0],
-                force=lambda q, v, t, g=gravity: g,
+                force=_constant_force(gravity),
                 contacts=_box_corner_gaps(a_bottom, a_top, b),
-                potential=lambda q, g=gravity: float(-(g @ q)),
+                potential=_linear_potential(gravity),
             )
             tr = model.simulate(0.5, 1e-3)
             drift = float(np.max(np.abs(tr.q - tr.q[0])))
@@ -204,7 +216,7 @@ def _mass_ratio_boxes(ratios: list[float]) -> Iterator[ExtremeCase]:
 
 
 def _friction(mus: list[float]) -> Iterator[ExtremeCase]:
-    """The seed's ramp (20 deg, v0 = 1 m/s, h = 1 ms) from frictionless to mu = 100: the
+    """The chapter's ramp (20 deg, v0 = 1 m/s, h = 1 ms) from frictionless to mu = 100: the
     distance at t = 2 s against the exact Coulomb answer."""
     th = math.radians(20.0)
     h = 1e-3
@@ -303,7 +315,7 @@ def _redundant(counts: list[int]) -> Iterator[ExtremeCase]:
 
 
 def _units(factors: list[float]) -> Iterator[ExtremeCase]:
-    """The seed's ramp with lengths in other units (positions, speeds and g scaled by the
+    """The chapter's ramp with lengths in other units (positions, speeds and g scaled by the
     factor): the stop distance scales by the same factor."""
     th = math.radians(20.0)
 

@@ -1,11 +1,11 @@
 """Linear complementarity problems: find z with ``0 <= z ⊥ w = M z + q >= 0``.
 
 >>> import numpy as np, coulomb
->>> r = coulomb.lcp.solve([[2.0]], [-6.0])      # the seed's w = 2z - 6
+>>> r = coulomb.lcp.solve([[2.0]], [-6.0])      # the chapter's w = 2z - 6
 >>> float(r.z[0]), float(r.w[0]), r.status
-(3.0, 0.0, 'solved')
+(3.0, 0.0, Status.SOLVED)
 >>> coulomb.lcp.solve([[-1.0]], [-1.0]).status  # w = -z - 1 has no solution
-'ray_termination'
+Status.RAY_TERMINATION
 
 Methods:
 
@@ -36,6 +36,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _core, _validate
 from ._result import Result
+from ._status import Status
 from .errors import ArgumentTypeError, InvalidParameterError, ShapeError
 
 __all__ = ["LcpResult", "check", "solve"]
@@ -58,9 +59,10 @@ class LcpResult(Result):
         The solution and ``w = M z + q`` recomputed from the original data.
     success : bool
         True only if the answer passes ``tol`` on the original data.
-    status : str
-        ``"solved"``, ``"ray_termination"``, ``"pivot_limit"``, ``"iteration_limit"``,
-        ``"numerical_failure"`` or ``"no_solution"`` (enumeration).
+    status : Status
+        ``Status.SOLVED``, ``RAY_TERMINATION``, ``PIVOT_LIMIT``, ``ITERATION_LIMIT``,
+        ``NUMERICAL_FAILURE`` or ``NO_SOLUTION`` (enumeration); each equals its string
+        (``r.status == "solved"``).
     message : str
         One line for a person.
     error : float
@@ -91,7 +93,7 @@ class LcpResult(Result):
     z: NDArray[np.float64]
     w: NDArray[np.float64]
     success: bool
-    status: str
+    status: Status
     message: str
     error: float
     scaled_error: float
@@ -248,7 +250,7 @@ def solve(
         basis = None if warm_start is None else _basis_indices(warm_start, n)
         out = _core.lcp_solve(Ma, qa, method, tol, max_piv, cover, basis, do_polish,
                               n_restarts, 10_000, 1.0, None, eng)
-        return LcpResult(out)
+        return LcpResult(out, status=Status(out["status"]))
     _validate.choice("method", method, _METHODS)
     _validate.unused("method", method, max_pivots=max_pivots, covering_vector=covering_vector,
                      warm_start=warm_start, polish=polish, restarts=restarts, engine=engine)
@@ -261,7 +263,7 @@ def solve(
     init = None if initial is None else _validate.finite_array(initial, "initial", 1)
     out = _core.lcp_solve(Ma, qa, method, tol, None, None, None, True, 2, sweeps, omega,
                           init, "auto")
-    return LcpResult(out)
+    return LcpResult(out, status=Status(out["status"]))
 
 
 def check(M: ArrayLike, q: ArrayLike, z: ArrayLike) -> Result:

@@ -1,7 +1,8 @@
 """Painleve's problem: which smooth contact modes a sliding rod admits.
 
-The seed's rod (section "Painleve's problem: a sliding rod") leans up and to the right from its
-lower end, which touches the floor. The angle ``theta`` is measured from the horizontal, the rod
+The rod of Satici, *Kinematics and Machine Dynamics*, ch. 11 (section "Painleve's problem: a
+sliding rod", after Stewart 2000) leans up and to the right from its lower end, which touches
+the floor. The angle ``theta`` is measured from the horizontal, the rod
 has mass ``m``, length ``l`` and central inertia ``J``. With a contact force ``(F, N)`` (tangential,
 normal) at the lower end,
 
@@ -14,13 +15,13 @@ and the contact point ``(x_c, y_c) = (x - (l/2) cos(theta), y - (l/2) sin(theta)
     b = (l/2) sin(theta) theta'^2 - g0,       c = (l/2) cos(theta) theta'^2,
 
 where ``g = y_c`` is the gap. Sliding in the direction ``s = sign(x_c')`` sets ``F = -s mu N``,
-so ``g'' = A N + b`` with the seed's
+so ``g'' = A N + b`` with
 
     A = 1/m + k cos(theta) (cos(theta) + s mu sin(theta))
 
 (for sliding to the left, s = -1: ``A = 1/m - (l^2/4J) cos(theta) (mu sin(theta) - cos(theta))``).
 At a closed contact with zero normal velocity the smooth modes must satisfy
-``0 <= g'' perp N >= 0``. If ``A < 0`` and ``b < 0`` no mode exists (the seed's figures:
+``0 <= g'' perp N >= 0``. If ``A < 0`` and ``b < 0`` no mode exists (the chapter's figures:
 ``A = -0.5``, ``b = -9.81`` for m = 1, l = 1, J = 1/12, mu = 2, theta = 45 deg), and if
 ``A < 0 < b`` two exist: the force-level model fails, and an impulse (a jam) is needed. The
 impulse time stepper of :mod:`coulomb` resolves both cases; this module tells a user which case
@@ -46,7 +47,7 @@ STANDARD_GRAVITY = 9.81
 class PainleveAnalysis(Result):
     """The smooth contact modes a rod state admits.
 
-    Fields: ``A`` (the seed's A for the sliding direction, or NaN when the contact point does not
+    Fields: ``A`` (the A above for the sliding direction, or NaN when the contact point does not
     slide), ``b``, ``slip`` (the contact point's tangential velocity), ``modes`` (a dict from each
     consistent mode, ``"lift-off"``, ``"stick"``, ``"slide-left"``, ``"slide-right"``, to its
     ``(N, F)``), ``consistent`` (at least one mode), ``unique`` (exactly one), ``message``.
@@ -95,7 +96,8 @@ class PainleveRod:
         return np.array([[inv_m + k * c * c, -k * s * c], [-k * s * c, inv_m + k * s * s]])
 
     def A(self, theta: float, slip_direction: int = -1) -> float:
-        """The seed's ``A(theta)`` for sliding in ``slip_direction`` (-1: left, +1: right)."""
+        """``A(theta)`` (module docstring) for sliding in ``slip_direction`` (-1: left, +1:
+        right)."""
         if slip_direction not in (-1, 1):
             raise InvalidParameterError(f"slip_direction must be -1 or +1, got {slip_direction}")
         k = self.l**2 / (4.0 * self.inertia)
@@ -103,7 +105,7 @@ class PainleveRod:
         return 1.0 / self.m + k * c * (c + slip_direction * self.mu * s)
 
     def b(self, theta: float, theta_dot: float = 0.0) -> float:
-        """The seed's ``b(theta, theta')``: the gap's acceleration with no contact force."""
+        """``b(theta, theta')``: the gap's acceleration with no contact force."""
         return 0.5 * self.l * math.sin(theta) * theta_dot**2 - self.g0
 
     def c(self, theta: float, theta_dot: float = 0.0) -> float:

@@ -1,6 +1,7 @@
 """Regularized (smoothed) friction on a ramp, integrated by a stiff ODE solver, for comparison.
 
-The seed (section "Smoothing changes the sticking behavior") replaces the set-valued law
+Satici, *Kinematics and Machine Dynamics*, ch. 11 (section "Smoothing changes the sticking
+behavior"), following Stewart (2000), replaces the set-valued law
 ``m v' in F_t - mu N Sign(v)`` by the smooth curve
 
     f_t = -mu N tanh(v / eps).
@@ -28,6 +29,7 @@ import numpy as np
 
 from ._extras import require
 from ._result import Result
+from ._status import Status
 from .errors import InvalidParameterError, NonFiniteError
 
 __all__ = ["RegularizedResult", "coulomb_ramp", "creep_velocity", "simulate_ramp"]
@@ -76,7 +78,7 @@ def coulomb_ramp(
     """The exact Coulomb answer ``(s(t), v(t))`` for a block sent down the ramp at ``v0 >= 0``.
 
     Sliding decelerates at ``a = g0 (mu cos(theta) - sin(theta))``; when ``a > 0`` the block stops
-    at ``t* = v0 / a``, ``s* = v0^2 / (2 a)`` and sticks for ever (the seed's ramp: 0.3321 m/s^2,
+    at ``t* = v0 / a``, ``s* = v0^2 / (2 a)`` and sticks for ever (the chapter's ramp: 0.3321 m/s^2,
     3.011 s, 1.505 m for theta = 20 deg, mu = 0.4, v0 = 1 m/s).
     """
     theta = _check("theta", theta)
@@ -154,7 +156,7 @@ def simulate_ramp(
         nlu=int(sol.nlu),
         solve_time=elapsed,
         success=bool(sol.success),
-        status="solved" if sol.success else "failed",
+        status=Status.SOLVED if sol.success else Status.FAILED,
         message=str(sol.message),
         method=method,
         eps=eps,

@@ -28,7 +28,7 @@ import time
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from concurrent.futures import Executor
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
@@ -347,7 +347,7 @@ def sweep(
         if reference is not None:
             rec.update(_errors(out, reference))
         records.append(rec)
-    return Study(records, settings_keys, reference, name or getattr(run, "__name__", "study"))
+    return Study(records, settings_keys, reference, name or str(getattr(run, "__name__", "study")))
 
 
 # ---- presets: runs importable by any worker -------------------------------------------------
@@ -362,7 +362,7 @@ def regularized_ramp(
     v0: float = 1.0,
     t_end: float = 10.0,
 ) -> dict[str, float]:
-    """The seed's ramp under the tanh-smoothed law: ``creep`` is how far past the exact Coulomb
+    """The chapter's ramp under the tanh-smoothed law: ``creep`` is how far past the exact Coulomb
     stop (1.505 m) the block has gone at ``t_end``; ``nfev`` the ODE solver's cost."""
     from .regularized import coulomb_ramp, simulate_ramp
 
@@ -372,8 +372,10 @@ def regularized_ramp(
     return {"creep": float(res.s[-1] - s_exact[0]), "nfev": res.nfev, "njev": res.njev}
 
 
-def contact_tolerance(tol: float = 1e-8, method: str = "nsgs", facets: int = 8) -> dict[str, float]:
-    """The seed's oblique inelastic impact in 3D (m = 2, v = (-3, 1, 0), mu = 0.2) with slip
+def contact_tolerance(
+    tol: float = 1e-8, method: Literal["nsgs", "lemke", "prox"] = "nsgs", facets: int = 8
+) -> dict[str, float]:
+    """The chapter's oblique inelastic impact in 3D (m = 2, v = (-3, 1, 0), mu = 0.2) with slip
     at 30 deg off the first tangent, solved at tolerance ``tol``: returns the post-step slip
     speed ``u_t`` (exactly 0.4) and the solver's work."""
     from . import contact
@@ -439,7 +441,7 @@ def nsgs_tolerance(
 
 def ramp(
     h: float = 1e-3,
-    solver: str = "nsgs",
+    solver: Literal["nsgs", "lemke"] = "nsgs",
     tol: float | None = None,
     facets: int | None = None,
     warm_start: bool = True,
@@ -447,7 +449,7 @@ def ramp(
     drift: str = "none",
     t_end: float = 4.0,
 ) -> dict[str, Any]:
-    """The seed's ramp (20 deg, mu = 0.4, v0 = 1 m/s down the slope) stepped at ``h``:
+    """The chapter's ramp (20 deg, mu = 0.4, v0 = 1 m/s down the slope) stepped at ``h``:
     ``stop_distance`` (exact 1.5053 m), ``stop_time`` (exact 3.0112 s), ``creep`` (motion after
     the stop; exact 0) and the stepper's work. Every setting a user trades is an argument:
     step, solver, tolerance, facets, warm start, iteration limit, drift correction."""
@@ -482,7 +484,7 @@ def ramp(
 
 
 def painleve_jam(h: float = 1e-3, solver: str = "nsgs") -> dict[str, Any]:
-    """The seed's Painleve rod (m = 1, l = 1, J = 1/12, mu = 2, 45 deg, end sliding left at
+    """The chapter's Painleve rod (m = 1, l = 1, J = 1/12, mu = 2, 45 deg, end sliding left at
     1 m/s): the first step's impulse, which jams the end. Its limit as h -> 0 stops the end
     exactly: ``P_n = 0.375``, ``P_t = 0.625`` N s."""
     from .model import HalfSpace, RigidBody2D, Scene, Segment
@@ -507,7 +509,7 @@ def painleve_jam(h: float = 1e-3, solver: str = "nsgs") -> dict[str, Any]:
 
 
 def floor_impact(h: float = 1e-3, phase: float = 0.3, speed: float = 3.0) -> dict[str, Any]:
-    """The seed's floor impact (m = 0.5 kg, e = 0.6) at ``speed`` m/s, the impact falling
+    """The chapter's floor impact (m = 0.5 kg, e = 0.6) at ``speed`` m/s, the impact falling
     ``phase`` of the way into a step: the rebound (exact: ``0.6 speed``) and impulse (exact:
     ``0.8 speed`` N s)."""
     from .model import HalfSpace, Particle, Point, Scene
@@ -534,7 +536,7 @@ PRESETS: dict[str, dict[str, Any]] = {
         "grid": {"method": ["lemke"], "facets": [4, 8, 16, 32, 64, 128]},
         "reference": {"u_t": 0.4},
         "order": "facets",
-        "about": "polyhedral cone on the seed's oblique impact: slip error against facets",
+        "about": "polyhedral cone on the chapter's oblique impact: slip error against facets",
     },
     "nsgs-tolerance": {
         "run": nsgs_tolerance,
@@ -553,14 +555,14 @@ PRESETS: dict[str, dict[str, Any]] = {
         },
         "order": "h",
         "order_where": {"solver": "nsgs"},
-        "about": "the seed's ramp: stop-distance error against step size and solver",
+        "about": "the chapter's ramp: stop-distance error against step size and solver",
     },
     "impact-h": {
         "run": floor_impact,
         "grid": {"h": [1e-1, 1e-2, 1e-3, 1e-4, 1e-5], "phase": [0.0, 0.3, 0.9]},
         "reference": {"rebound": 1.8, "impulse": 2.4},
         "order": "h",
-        "about": "the seed's floor impact (e = 0.6): rebound and impulse against step size and "
+        "about": "the chapter's floor impact (e = 0.6): rebound and impulse against step size and "
         "where in the step the impact falls (exact at every h)",
     },
     "painleve-h": {
@@ -576,7 +578,7 @@ PRESETS: dict[str, dict[str, Any]] = {
         "reference": {"creep": 0.0},
         "order": "eps",
         "order_where": {"method": "Radau"},
-        "about": "tanh-smoothed friction on the seed's ramp: creep against eps, ODE cost",
+        "about": "tanh-smoothed friction on the chapter's ramp: creep against eps, ODE cost",
         # (module, extra): checked before the study starts
         "needs": [("scipy.integrate", "ode")],
     },

@@ -1,4 +1,4 @@
-"""Reproduce the reference figures of the seed chapter and report each against its value.
+"""Reproduce the reference figures of the chapter and report each against its value.
 
 ``coulomb validate`` prints the table; :func:`run` returns its rows. Each row compares a
 figure computed by coulomb with the figure the chapter states (Satici, *Kinematics and Machine
@@ -41,7 +41,7 @@ def _text(case: str, quantity: str, expected: str, computed: str) -> Row:
     return Row(case, quantity, expected, computed, None, expected == computed)
 
 
-def _seed_rows() -> Iterator[Row]:
+def _lcp_rows() -> Iterator[Row]:
     case = "scalar LCP w = 2z - 6"
     r = lcp.solve([[2.0]], [-6.0])
     yield _num(case, "z", 3.0, float(r.z[0]), 1e-12)
@@ -54,7 +54,7 @@ def _seed_rows() -> Iterator[Row]:
 
 
 def _contact_rows() -> Iterator[Row]:
-    # the seed's inelastic contact step: a 2 kg particle hits a fixed floor with e = 0,
+    # the chapter's inelastic contact step: a 2 kg particle hits a fixed floor with e = 0,
     # v_n^- = -3 m/s, v_t^- = 1 m/s, mu = 0.2; W = I/m and q = v^- (no free-flight term)
     m = 2.0
     for dim, q in ((2, [-3.0, 1.0]), (3, [-3.0, 1.0, 0.0])):
@@ -69,7 +69,7 @@ def _contact_rows() -> Iterator[Row]:
 
 
 def _painleve_rows() -> Iterator[Row]:
-    # the seed's rod: m = 1 kg, l = 1 m, J = 1/12 kg m^2, mu = 2, theta = 45 deg, sliding left
+    # the chapter's rod: m = 1 kg, l = 1 m, J = 1/12 kg m^2, mu = 2, theta = 45 deg, sliding left
     case = "Painleve rod, theta = 45 deg"
     rod = PainleveRod(m=1.0, l=1.0, J=1.0 / 12.0, mu=2.0)
     res = rod.analyze(np.radians(45.0), 0.0, slip=-1.0)
@@ -126,8 +126,8 @@ def _data_rows(data: Path) -> Iterator[Row]:
 
 
 def run(data: Path | None = None, progress: Callable[[str], None] | None = None) -> list[Row]:
-    """Every row: the seed's figures, then (if the benchmark data is found) the data set's."""
-    rows = [*_seed_rows(), *_contact_rows(), *_painleve_rows(), *_stepper_rows()]
+    """Every row: the chapter's figures, then (if the benchmark data is found) the data set's."""
+    rows = [*_lcp_rows(), *_contact_rows(), *_painleve_rows(), *_stepper_rows()]
     data = data or default_data_dir()
     if data is not None:
         if progress:

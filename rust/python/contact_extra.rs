@@ -1,67 +1,15 @@
-//! Bindings of the robust contact mode (`contact_solve_prox`) and of the assembly of a contact
-//! problem from a mechanism (`contact_assemble`, `contact_post_velocity`). Same conventions as
-//! the parent module: arrays converted and checked, the GIL released on long work, every error
-//! kind its own Python exception.
+//! Bindings of the assembly of a contact problem from a mechanism (`contact_assemble`,
+//! `contact_post_velocity`). Same conventions as the parent module: arrays converted and
+//! checked, the GIL released on long work, every error kind its own Python exception.
 
 use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
 
-use super::{contact_dict, guarded, slice1, slice2, to_py};
+use super::{guarded, slice1, to_py};
 use crate::contact::assembly::{self, FreeMotion, MassFactor, Triplets};
-use crate::contact::prox::{solve_prox, ProxSettings};
-use crate::contact::ContactProblem;
 use crate::error::CoulombError;
-
-/// Solves the friction-contact problem by the robust mode (proximal-point semismooth Newton,
-/// `crate::contact::prox`). The Python wrapper `coulomb.contact.solve(method="prox")` documents
-/// the arguments.
-#[pyfunction]
-#[pyo3(signature = (w, q, mu, dim, tol, max_iter=None, eta=0.1, initial=None))]
-#[allow(clippy::too_many_arguments)]
-fn contact_solve_prox<'py>(
-    py: Python<'py>,
-    w: PyReadonlyArray2<'py, f64>,
-    q: PyReadonlyArray1<'py, f64>,
-    mu: PyReadonlyArray1<'py, f64>,
-    dim: usize,
-    tol: f64,
-    max_iter: Option<usize>,
-    eta: f64,
-    initial: Option<PyReadonlyArray1<'py, f64>>,
-) -> PyResult<Bound<'py, PyDict>> {
-    let shape = w.shape();
-    if shape[0] != shape[1] {
-        return Err(to_py(
-            py,
-            CoulombError::Shape(format!("W must be square, got {} x {}", shape[0], shape[1])),
-        ));
-    }
-    let n = shape[0];
-    let ws = slice2(py, "W", &w)?;
-    let qs = slice1(py, "q", &q)?;
-    let mus = slice1(py, "mu", &mu)?;
-    let init = match &initial {
-        Some(c) => Some(slice1(py, "initial", c)?.to_vec()),
-        None => None,
-    };
-    let settings = ProxSettings {
-        tol,
-        max_iter: max_iter.unwrap_or(ProxSettings::default().max_iter),
-        eta,
-        initial: init,
-    };
-    // a Newton step costs a factorization: release the GIL from small sizes on
-    let (solution, nc, seconds) = guarded(py, n * n * 16, || {
-        let start = std::time::Instant::now();
-        let problem = ContactProblem::new(dim, ws, qs, mus)?;
-        let s = solve_prox(&problem, &settings)?;
-        Ok((s, problem.nc, start.elapsed().as_secs_f64()))
-    })?;
-    contact_dict(py, solution, nc, dim, seconds)
-}
 
 /// int64 indices as usize, refusing negative ones.
 fn indices(py: Python<'_>, name: &str, a: &PyReadonlyArray1<'_, i64>) -> PyResult<Vec<usize>> {
@@ -212,7 +160,6 @@ fn contact_post_velocity<'py>(
 
 /// adds this file's functions to `coulomb._core`.
 pub(super) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(contact_solve_prox, m)?)?;
     m.add_function(wrap_pyfunction!(contact_assemble, m)?)?;
     m.add_function(wrap_pyfunction!(contact_post_velocity, m)?)?;
     Ok(())

@@ -98,7 +98,7 @@ def test_solve_lcp_prints_the_result(tmp_path, siconos_lcp_dir):
     assert p.returncode == 0, p.stderr
     assert "lcp_deudeu: n = 2" in p.stdout
     assert "success: True" in p.stdout
-    assert "status: 'solved'" in p.stdout
+    assert "status: Status.SOLVED" in p.stdout
 
 
 def test_solve_lcp_own_file(tmp_path):
@@ -116,7 +116,7 @@ def test_solve_lcp_without_solution_exits_2(tmp_path):
     path.write_text("1\n0\n1\n1\n1 1\n-1\n-1\n")  # the seed's w = -z - 1
     p = run(["solve-lcp", str(path)], tmp_path)
     assert p.returncode == 2
-    assert "ray_termination" in p.stdout
+    assert "Status.RAY_TERMINATION" in p.stdout
     assert "success: False" in p.stdout
 
 
