@@ -15,10 +15,10 @@ with Coulomb's law: either sticking (``u_t = 0``, ``||r_t|| <= mu r_n``) or slid
 (``r_t = -mu r_n u_t / ||u_t||``, the friction impulse opposing the slip).
 
 >>> import numpy as np, coulomb
->>> # the seed's inelastic step: m = 2, v_n = -3, v_t = 1, mu = 0.2
+>>> # Stewart's (2000) inelastic contact step: m = 2, v_n = -3, v_t = 1, mu = 0.2
 >>> r = coulomb.contact.solve(np.eye(2) / 2, [-3.0, 1.0], 0.2, dim=2)
 >>> r.status, r.impulse.round(12).tolist(), r.velocity.round(12).tolist()
-('solved', [[6.0, -1.2]], [[0.0, 0.4]])
+(Status.SOLVED, [[6.0, -1.2]], [[0.0, 0.4]])
 
 Methods:
 
@@ -31,8 +31,8 @@ Methods:
     the ellipse (the ellipse projection when the contact's tangential block is a multiple of
     the identity).
 ``"lemke"``
-    The seed's Stewart-Trinkle LCP: the friction disk of every frictional contact is replaced
-    by the polygon of ``facets`` unit tangent directions in +/- pairs (default 8 in 3D; in 2D
+    Stewart and Trinkle's (1996) polyhedral-cone LCP: the friction disk of every frictional
+    contact is replaced by the polygon of ``facets`` unit tangent directions in +/- pairs (default 8 in 3D; in 2D
     only 2, the directions +1 and -1, which is exact), ``z = (P_n, beta, lambda)`` solves
     ``0 <= z ⊥ A z + b >= 0`` by Lemke's method and the impulses are mapped back
     (``P_t = D beta``). Frictionless contacts carry only the normal unknown. The LCP is
@@ -87,7 +87,7 @@ that same test.
     ``error_q <= tol``).
 
 ``error``
-    The natural-map residual on De Saxcé's form (as ../shared/DESIGN.md defines it),
+    The natural-map residual on De Saxcé's form (Acary and Brogliato 2008; De Saxcé and Feng 1991),
     ``||r - P_K(r - (u + mu ||u_t|| n))||_2 / max(||q||, ||r||, ||u||)``, with ``P_K`` the
     projection on the product of the Coulomb cones (divided by 1 instead when all three norms
     are below 1e-300). It is zero exactly at a solution.

@@ -1,5 +1,5 @@
-r"""Scenes: bodies, contact shapes, half-spaces and contact pairs, simulated by the seed's
-impulse time stepper (the whole loop runs in Rust, with the GIL released).
+r"""Scenes: bodies, contact shapes, half-spaces and contact pairs, simulated by Stewart's
+(2000) impulse time stepper (the whole loop runs in Rust, with the GIL released).
 
 A planar scene (``dim=2``) has particles ``(x, y)`` and planar rigid bodies ``(x, y, theta)``;
 a spatial scene (``dim=3``) has particles ``(x, y, z)`` and spatial rigid bodies (position, unit
