@@ -32,8 +32,9 @@ Methods:
     the identity).
 ``"lemke"``
     Stewart and Trinkle's (1996) polyhedral-cone LCP: the friction disk of every frictional
-    contact is replaced by the polygon of ``facets`` unit tangent directions in +/- pairs (default 8 in 3D; in 2D
-    only 2, the directions +1 and -1, which is exact), ``z = (P_n, beta, lambda)`` solves
+    contact is replaced by the polygon of ``facets`` unit tangent directions in +/- pairs
+    (default 8 in 3D; in 2D only 2, the directions +1 and -1, which is exact),
+    ``z = (P_n, beta, lambda)`` solves
     ``0 <= z ⊥ A z + b >= 0`` by Lemke's method and the impulses are mapped back
     (``P_t = D beta``). Frictionless contacts carry only the normal unknown. The LCP is
     assembled in balanced units (the multiplier column and row scaled by each contact's
