@@ -544,6 +544,8 @@ class Scene:
             (:class:`~coulomb.errors.ProblemTooLargeError`, saying which ``record_every``
             fits).
 
+        Notes
+        -----
         Counts are ints (``max_iter``, ``facets``, ``record_every``), ``t_end / h`` at most
         10^9 steps; options of the other solver are refused (``relaxation`` is NSGS's,
         ``facets`` Lemke's). Ctrl-C stops the run (``KeyboardInterrupt``).
