@@ -50,7 +50,8 @@ def requirement_names(reqs: list[str]) -> set[str]:
 
 def test_every_extra_is_known_and_all_is_their_union():
     declared = pyproject_extras()
-    assert set(declared) == set(EXTRAS) | {"all", "test"}
+    # docs and test are for developers: no code checks for them
+    assert set(declared) == set(EXTRAS) | {"all", "test", "docs"}
     union = set().union(*(requirement_names(declared[e]) for e in EXTRAS))
     assert requirement_names(declared["all"]) == union
     for extra, modules in EXTRAS.items():
@@ -60,11 +61,13 @@ def test_every_extra_is_known_and_all_is_their_union():
         assert set(modules) <= names, extra
     # the test extra installs every optional dependency the tests exercise
     assert union <= requirement_names(declared["test"])
+    # and the doc tools, since the test command (README, .ci/run) builds the docs
+    assert requirement_names(declared["docs"]) <= requirement_names(declared["test"])
 
 
 def test_readme_lists_every_extra():
     readme = (ROOT / "README.md").read_text()
-    for extra in [*EXTRAS, "all", "test"]:
+    for extra in [*EXTRAS, "all", "test", "docs"]:
         assert re.search(rf"^\| `{extra}` \|", readme, re.M), extra
 
 
