@@ -288,14 +288,27 @@ pub enum FreeMotion<'a> {
     Force(&'a [f64]),
 }
 
+/// `TooLarge` when the dense `n x n` W of `n` contact components exceeds the memory budget
+/// (`crate::limits`), checked before any work.
+fn check_dense_w(n: usize) -> Result<()> {
+    crate::limits::check_bytes(
+        &format!("the dense W = G^T M^-1 G of {n} contact components"),
+        n.saturating_mul(n),
+        8,
+        "",
+    )?;
+    Ok(())
+}
+
 /// `W = G^T M^{-1} G`, `q = G^T v_free + extra` (see the module notes); `extra` has
-/// `G.ncols` entries when given.
+/// `G.ncols` entries when given. `TooLarge` when the dense W exceeds the memory budget.
 pub fn assemble(
     m: &Triplets<'_>,
     g: &Triplets<'_>,
     free: FreeMotion<'_>,
     extra: Option<&[f64]>,
 ) -> Result<Assembled> {
+    check_dense_w(g.ncols)?;
     let factor = MassFactor::new(m)?;
     assemble_with(&factor, m.nrows, g, free, extra)
 }
@@ -316,6 +329,7 @@ pub fn assemble_with(
     }
     g.check("the contact Jacobian G")?;
     let n = g.ncols;
+    check_dense_w(n)?;
     let v_free = match free {
         FreeMotion::Velocity(v) | FreeMotion::Force(v) if v.len() != ndof => {
             return Err(CoulombError::Shape(format!(
@@ -448,5 +462,32 @@ mod tests {
         for (i, v) in back.iter().enumerate() {
             assert!((v - (i as f64 + 1.0)).abs() < 1e-14, "{back:?}");
         }
+    }
+
+    #[test]
+    fn a_dense_w_over_the_memory_budget_is_refused_before_any_work() {
+        // 2^32 contact components: W's bytes overflow usize, over any budget
+        let one = [0usize];
+        let m = Triplets {
+            nrows: 1,
+            ncols: 1,
+            rows: &one,
+            cols: &one,
+            vals: &[1.0],
+        };
+        let g = Triplets {
+            nrows: 1,
+            ncols: 1 << 32,
+            rows: &[],
+            cols: &[],
+            vals: &[],
+        };
+        let free = FreeMotion::Velocity(&[0.0]);
+        let err = assemble(&m, &g, free, None).unwrap_err();
+        assert!(matches!(err, CoulombError::TooLarge(_)), "{err}");
+        assert!(err.to_string().contains("dense W"), "{err}");
+        let factor = MassFactor::new(&m).unwrap();
+        let err = assemble_with(&factor, 1, &g, free, None).unwrap_err();
+        assert!(matches!(err, CoulombError::TooLarge(_)), "{err}");
     }
 }

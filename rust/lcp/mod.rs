@@ -358,11 +358,20 @@ fn robust_sqrt_sum<I: Iterator<Item = f64> + Clone>(values: I) -> f64 {
     n.value()
 }
 
-/// the measures of z on `lcp`, equilibrating it first (for callers outside a solve, such as
-/// checking a peer's answer).
-pub fn measure(lcp: &LcpRef<'_>, z: &[f64]) -> (Vec<f64>, LcpMeasures) {
+/// the measures of z on `lcp` (with `w = M z + q`), equilibrating it first (for callers
+/// outside a solve, such as checking a peer's answer). z must have n finite entries:
+/// `Shape` or `NonFinite` otherwise.
+pub fn measure(lcp: &LcpRef<'_>, z: &[f64]) -> Result<(Vec<f64>, LcpMeasures)> {
+    if z.len() != lcp.n {
+        return Err(CoulombError::Shape(format!(
+            "z has length {}, expected {}",
+            z.len(),
+            lcp.n
+        )));
+    }
+    check_finite("z", z)?;
     let eq = scaling::Equilibration::compute(lcp.n, lcp.m, lcp.q);
-    lcp.evaluate(z, &eq)
+    Ok(lcp.evaluate(z, &eq))
 }
 
 /// whether an answer's measures pass `tol` (both the literature's error and the unit-free one).
@@ -419,10 +428,27 @@ mod tests {
         let m = [1.0, 0.0, 0.0, 1.0];
         let q = [-1.0, -2.0];
         let lcp = LcpRef::new(2, &m, &q).unwrap();
-        let (w, meas) = measure(&lcp, &[1.0, 0.0]);
+        let (w, meas) = measure(&lcp, &[1.0, 0.0]).unwrap();
         assert_eq!(w, vec![0.0, -2.0]);
         assert!((meas.error - 2.0 / 5f64.sqrt()).abs() < 1e-15);
         assert_eq!(meas.min_w, -2.0);
         assert_eq!(meas.max_complementarity, 0.0);
+    }
+
+    #[test]
+    fn measure_refuses_a_z_of_the_wrong_length_or_not_finite() {
+        let m = [1.0, 0.0, 0.0, 1.0];
+        let q = [-1.0, -2.0];
+        let lcp = LcpRef::new(2, &m, &q).unwrap();
+        for z in [&[1.0][..], &[1.0, 0.0, 0.0][..]] {
+            let err = measure(&lcp, z).unwrap_err();
+            assert!(matches!(err, CoulombError::Shape(_)), "{err}");
+            assert!(err.to_string().contains("expected 2"), "{err}");
+        }
+        for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            let err = measure(&lcp, &[1.0, bad]).unwrap_err();
+            assert!(matches!(err, CoulombError::NonFinite(_)), "{err}");
+            assert!(err.to_string().contains('z'), "{err}");
+        }
     }
 }

@@ -4,6 +4,7 @@ matrix that is not positive definite or not symmetric is refused, naming M."""
 
 from __future__ import annotations
 
+import coulomb
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -145,3 +146,17 @@ def test_shape_and_value_errors():
         contact.assemble(M, G, v, force=v)
     with pytest.raises(errors.ShapeError):
         contact.post_velocity(M, G, v, np.zeros(3))
+
+
+def test_a_dense_w_over_the_memory_budget_is_refused():
+    old = coulomb.memory_budget()
+    try:
+        coulomb.set_memory_budget(2**20)
+        # 400 contact components: W holds 400^2 * 8 = 1.28 MB > 1 MiB; 300 fit (0.72 MB)
+        with pytest.raises(errors.ProblemTooLargeError, match="dense W"):
+            contact.assemble(np.ones(2), sp.csr_matrix((2, 400)), np.zeros(2))
+        W, q = contact.assemble(np.ones(2), sp.csr_matrix((2, 300)), np.zeros(2))
+        assert W.shape == (300, 300) and not W.any() and not q.any()
+    finally:
+        coulomb.set_memory_budget(old)
+    assert coulomb.memory_budget() == old

@@ -245,3 +245,15 @@ def test_well_formed_file_is_column_major(tmp_path):
     assert p.n == 2
     np.testing.assert_array_equal(p.M, [[1.0, 3.0], [2.0, 4.0]])
     np.testing.assert_array_equal(p.q, [-1.0, -2.0])
+
+
+@pytest.mark.parametrize("n", [1, 2, 5])
+def test_check_refuses_a_z_of_the_wrong_length_or_with_nan(n):
+    M, q = np.eye(n), -np.ones(n)
+    for bad in (np.ones(n + 1), np.ones(max(n - 1, 0))):
+        with pytest.raises(errors.ShapeError, match=f"z has length {bad.size}, expected {n}"):
+            lcp.check(M, q, bad)
+    with pytest.raises(errors.NonFiniteError, match="z"):
+        lcp.check(M, q, nan_at(np.ones(n), n - 1))
+    # the right length gives the measures of z = 1: w = 0, an exact solution
+    assert lcp.check(M, q, np.ones(n)).error == 0.0
