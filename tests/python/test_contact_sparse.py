@@ -380,7 +380,7 @@ def test_anisotropic_input_errors(mu, dim, exc, words):
     assert words in str(info.value)
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=60, deadline=None, derandomize=True)
 @given(
     qt=st.tuples(st.floats(-5, 5, allow_nan=False), st.floats(-5, 5, allow_nan=False)),
     m1=st.floats(0.01, 2.0),
