@@ -746,7 +746,7 @@ class Model:
             "active", "status", "error", "scaled_error", "iterations", "momentum_residual",
             "min_normal_impulse", "cone_violation", "complementarity", "resumed", "fallback",
             "contact_step", "contact_id", "contact_impulse", "contact_velocity",
-            "contact_approach", "contact_gap", "contact_closed")}
+            "contact_approach", "contact_gap", "contact_closed", "load_power")}
 
         def push_state(t: float, m: np.ndarray, gaps: list[float]) -> None:
             rec["t"].append(t)
@@ -765,6 +765,7 @@ class Model:
             t = k * h
             f = (np.asarray(self.force(q, v, t), dtype=np.float64).reshape(q.size)
                  if self.force else np.zeros(q.size))
+            rec["load_power"].append(float(f @ v))
             v_free = v + h * np.linalg.solve(m, f)
             active = []
             for i, (g, rows) in enumerate(frames):
@@ -856,6 +857,13 @@ class Model:
             m = self._mass(q)
             frames = [self._frame(c, q) for c in self.contacts]
             push_state((k + 1) * h, m, [g for g, _ in frames])
+        # f . v of the last state, for the step's energy E_h = T + V + (h/2) f . v (a stopped
+        # run recorded one per state already: its last step's state was not kept)
+        if stopped is None:
+            f = (np.asarray(self.force(q, v, (len(rec["t"]) - 1) * h),
+                            dtype=np.float64).reshape(q.size)
+                 if self.force else np.zeros(q.size))
+            rec["load_power"].append(float(f @ v))
         raw: dict[str, Any] = {"dim": dim, "stopped": stopped, "solve_time": float("nan")}
         for key, val in rec.items():
             if key in ("q", "v"):

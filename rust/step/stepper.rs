@@ -2,7 +2,7 @@
 //! its own file: bodies (kinematics, mass, integration), narrow phase (gaps, normals, frames),
 //! contact persistence (warm starts, the broad phase's pairs) and impact memory, the impact
 //! law and W (law), the contact solve (solve), Poisson's impact phase (poisson), the located
-//! impact (event), drift, and the record below.
+//! impact (event), drift, and the record (record: [`simulate`], [`Trajectory`]).
 
 // index loops mirror the equations (a: velocity component, j: contact-frame component)
 #![allow(clippy::needless_range_loop)]
@@ -19,112 +19,25 @@ mod law;
 mod narrow;
 #[path = "persistence.rs"]
 mod persistence;
+#[path = "record.rs"]
+mod record;
 #[path = "solve.rs"]
 mod solve;
 
 use self::bodies::{bodies_of, norm3, rotate, BodyInfo, Frozen};
 use self::narrow::{declared_candidates, frame, Candidate, Geometry};
 use self::persistence::{sphere_points, CandState};
+pub use self::record::{simulate, simulate_recorded, ContactRecord, StepRecord, Trajectory};
 use self::solve::SolveBuffers;
 use super::broad::BroadPhase;
 use super::poisson::routh;
 use super::{
     BodyKind, Drift, Pair, PolyhedralSettings, Restitution, Scene, StepSettings, StepSolver,
 };
-use crate::contact::ContactStatus;
 use crate::error::Result;
 
 /// below this a norm counts as zero when forming a relative residual.
 const TINY: f64 = 1e-300;
-
-/// The checks of one step k -> k+1 (the seed's "Time-step accuracy and validation" list).
-#[derive(Clone, Debug)]
-pub struct StepRecord {
-    /// active contacts (closed or imminently closing) that carried unknowns.
-    pub active: usize,
-    /// the contact solver's status; `None` when no contact was active.
-    pub status: Option<ContactStatus>,
-    /// the contact solver's error (natural-map residual, relative); 0 without contacts.
-    pub error: f64,
-    /// the contact solver's unit-consistent error, the measure its verdict (`status`) is
-    /// taken on ([`crate::contact::ContactMeasures::passes`]); 0 without contacts.
-    pub scaled_error: f64,
-    /// the contact solver's sweeps or pivots.
-    pub iterations: usize,
-    /// `||M (v_{k+1} - v_free) - G P||` divided by `max(||G P||, ||M v_free||, ||M v_{k+1}||)`
-    /// (the absolute norm when all are zero).
-    pub momentum_residual: f64,
-    /// `min_i P_{n,i}` over the active contacts (0 without contacts).
-    pub min_normal_impulse: f64,
-    /// `max_i max(||P_{t,i}|| - mu_i P_{n,i}, 0)`.
-    pub cone_violation: f64,
-    /// `max_i |P_{n,i} (J_n v_{k+1} + e v_n^- or gap term)_i|`, the complementarity product.
-    pub complementarity: f64,
-    /// a closed contact used the approach velocity remembered from the step that closed it
-    /// (that step stopped the approach with the gap term; this one gives the rebound back), so
-    /// energy is judged across the two steps.
-    pub resumed: bool,
-    /// NSGS missed its tolerance and the polyhedral Lemke's answer, better on the exact-disk
-    /// error, was used instead (see [`super::StepSettings::fallback`]).
-    pub fallback: bool,
-    /// the largest position change of the drift projection (m or rad), 0 without it.
-    pub projection: f64,
-}
-
-/// One active contact in one step.
-#[derive(Clone, Copy, Debug)]
-pub struct ContactRecord {
-    /// the step k (the impulse acts between `t_k` and `t_{k+1}`).
-    pub step: usize,
-    /// the contact's identity, stable over steps: for a declared pair, the index of its
-    /// candidate (pair, feature) in declaration order, `0..D`; for a sphere pair found by the
-    /// broad phase ([`super::Pair::Spheres`]), `D + i B + j` with `i < j` the two spheres'
-    /// indices among the B sphere points (the points of single-point shapes, in shape order).
-    pub id: usize,
-    /// the impulse, normal first then tangents (N s), `dim` used entries.
-    pub impulse: [f64; 3],
-    /// the contact velocity `J v_{k+1}` in the contact frame (m/s), `dim` used entries.
-    pub velocity: [f64; 3],
-    /// the normal approach velocity used by the step: `v_n^-` (closed) or `J_n v_k` (open).
-    pub approach: f64,
-    /// the gap at `q_k` (m).
-    pub gap: f64,
-    /// whether the contact got the impact law (it was closed, `gap <= gap_tolerance`, or owed
-    /// the rebound of an impact the previous step stopped) rather than the gap term.
-    pub closed: bool,
-}
-
-/// The result of [`simulate`]: states at `t_0 .. t_N`, the checks of every step and the
-/// impulse of every active contact.
-#[derive(Clone, Debug)]
-pub struct Trajectory {
-    /// the contact dimension.
-    pub dim: usize,
-    /// coordinates per state.
-    pub nq: usize,
-    /// velocities per state.
-    pub nv: usize,
-    /// the times, `N + 1`.
-    pub t: Vec<f64>,
-    /// the coordinates, `(N + 1) nq` row-major.
-    pub q: Vec<f64>,
-    /// the velocities, `(N + 1) nv` row-major.
-    pub v: Vec<f64>,
-    /// kinetic energy per state (J).
-    pub kinetic_energy: Vec<f64>,
-    /// potential energy of gravity and the constant forces per state, `-Σ (m g + F) . x` (J).
-    pub potential_energy: Vec<f64>,
-    /// the smallest gap over every candidate contact, per state (`+inf` without candidates).
-    pub min_gap: Vec<f64>,
-    /// how many candidate contacts have a gap below `-gap_tolerance`, per state.
-    pub negative_gaps: Vec<usize>,
-    /// the checks of every step, `N`.
-    pub steps: Vec<StepRecord>,
-    /// every active contact of every step.
-    pub contacts: Vec<ContactRecord>,
-    /// `None` when all steps ran; otherwise why the run stopped early.
-    pub stopped: Option<String>,
-}
 
 /// One side of an active contact: the body, its G block and `M^{-1} G`.
 #[derive(Clone, Copy, Debug, Default)]
@@ -540,119 +453,5 @@ impl Stepper {
         let (g, neg) = self.gap_summary();
         out.min_gap.push(g);
         out.negative_gaps.push(neg);
-    }
-}
-
-/// Runs `settings.steps` steps of the impulse time stepper on `scene` from its initial state.
-/// A step whose impulses or velocities are not finite stops the run (`stopped` says why);
-/// a contact solve that misses its tolerance is recorded in its step's status and the run goes
-/// on with the best impulses found.
-pub fn simulate(scene: &Scene, settings: &StepSettings) -> Result<Trajectory> {
-    simulate_recorded(scene, settings, 1)
-}
-
-/// [`simulate`], keeping the state only after every `record_every`-th step (and after the
-/// last): the trajectory has `ceil(steps / record_every) + 1` states. The step records in
-/// between are folded into the one of the next recorded step, which holds the worst of each
-/// check over the steps it stands for ([`StepRecord::fold`]), so a solver failure or a
-/// violated check is never lost; [`ContactRecord`]s are kept for the recorded steps only,
-/// their `step` being the record's row. The records grow as the run goes (nothing is
-/// reserved for every step up front) and their size is checked against the memory budget
-/// ([`crate::limits`]) before the run (the states) and as it goes (the contacts). The run can
-/// be stopped by the caller's interrupt hook ([`crate::interrupt`]).
-pub fn simulate_recorded(
-    scene: &Scene,
-    settings: &StepSettings,
-    record_every: usize,
-) -> Result<Trajectory> {
-    let mut st = Stepper::new(scene, settings)?;
-    let steps = settings.steps;
-    let every = record_every.max(1);
-    let rows = steps.div_ceil(every) + 1;
-    let row_bytes = 8 * (st.nq + st.nv + 5) + std::mem::size_of::<StepRecord>();
-    let budget = crate::limits::memory_budget();
-    let needed = (steps as f64 * row_bytes as f64 / budget as f64)
-        .ceil()
-        .max(1.0);
-    crate::limits::check_bytes(
-        &format!("recording {rows} states of {} coordinates", st.nq),
-        rows,
-        row_bytes,
-        &format!("record fewer states with record_every >= {needed:.0}"),
-    )?;
-    let reserve = rows.min(4096);
-    let mut out = Trajectory {
-        dim: st.dim,
-        nq: st.nq,
-        nv: st.nv,
-        t: Vec::with_capacity(reserve),
-        q: Vec::with_capacity(reserve * st.nq),
-        v: Vec::with_capacity(reserve * st.nv),
-        kinetic_energy: Vec::with_capacity(reserve),
-        potential_energy: Vec::with_capacity(reserve),
-        min_gap: Vec::with_capacity(reserve),
-        negative_gaps: Vec::with_capacity(reserve),
-        steps: Vec::with_capacity(reserve),
-        contacts: Vec::new(),
-        stopped: None,
-    };
-    st.push_state(&mut out);
-    let mut pending: Option<StepRecord> = None;
-    for k in 0..steps {
-        if crate::interrupt::poll(st.nq * st.nv + 64) {
-            break; // the caller's interrupt hook asked to stop (see crate::interrupt)
-        }
-        let kept = out.contacts.len();
-        let mut rec = st.step(&mut out.contacts)?;
-        if let Some(p) = pending.take() {
-            rec.fold(&p);
-        }
-        let row = out.steps.len();
-        out.contacts[kept..].iter_mut().for_each(|c| c.step = row);
-        let finite = st.v.iter().chain(st.q.iter()).all(|x| x.is_finite());
-        if !finite {
-            out.stopped = Some(format!(
-                "step {k} produced a non-finite state (contact solver: {})",
-                rec.status.map_or("no contacts", |s| s.as_str())
-            ));
-            out.contacts.truncate(kept);
-            break;
-        }
-        if (k + 1) % every != 0 && k + 1 != steps {
-            out.contacts.truncate(kept);
-            pending = Some(rec);
-            continue;
-        }
-        crate::limits::check_bytes(
-            &format!("recording {} contact records", out.contacts.len()),
-            out.contacts.len(),
-            std::mem::size_of::<ContactRecord>(),
-            "record fewer states with record_every",
-        )?;
-        out.steps.push(rec);
-        st.push_state(&mut out);
-    }
-    Ok(out)
-}
-
-impl StepRecord {
-    /// folds the record of an earlier, unrecorded step into this one: the worst of each check
-    /// (the first failed status, the largest error, residual, violation and iteration count,
-    /// the smallest normal impulse, and whether any step resumed or fell back).
-    pub fn fold(&mut self, earlier: &StepRecord) {
-        let failed = |s: Option<ContactStatus>| s.is_some_and(|s| s != ContactStatus::Solved);
-        if failed(earlier.status) || (self.status.is_none() && earlier.status.is_some()) {
-            self.status = earlier.status;
-        }
-        self.active = self.active.max(earlier.active);
-        self.error = self.error.max(earlier.error);
-        self.iterations = self.iterations.max(earlier.iterations);
-        self.momentum_residual = self.momentum_residual.max(earlier.momentum_residual);
-        self.min_normal_impulse = self.min_normal_impulse.min(earlier.min_normal_impulse);
-        self.cone_violation = self.cone_violation.max(earlier.cone_violation);
-        self.complementarity = self.complementarity.max(earlier.complementarity);
-        self.resumed |= earlier.resumed;
-        self.fallback |= earlier.fallback;
-        self.projection = self.projection.max(earlier.projection);
     }
 }
