@@ -122,6 +122,24 @@ pub(super) fn rotate(q: &mut [f64], phi: [f64; 3]) {
     store_quaternion(q, &out);
 }
 
+/// `q <- q ⊕ d` for one body: d in its velocity coordinates (a rotation vector for a spatial
+/// body's orientation).
+pub(super) fn displace_body(q: &mut [f64], kind: BodyKind, d: &[f64]) {
+    match kind {
+        BodyKind::Particle | BodyKind::Planar => {
+            for (qk, dk) in q.iter_mut().zip(d) {
+                *qk += dk;
+            }
+        }
+        BodyKind::Spatial => {
+            for k in 0..3 {
+                q[k] += d[k];
+            }
+            rotate(&mut q[3..7], [d[3], d[4], d[5]]);
+        }
+    }
+}
+
 /// the Euclidean norm of a 3-vector.
 pub(super) fn norm3(a: [f64; 3]) -> f64 {
     Vector3::from(a).norm()
@@ -249,21 +267,7 @@ impl Stepper {
     /// `q <- q ⊕ dq` with dq in velocity coordinates (a rotation vector for spatial bodies).
     pub(super) fn displace(&mut self, dq: &[f64]) {
         for b in &self.bodies {
-            let q = &mut self.q[b.off_q..];
-            let d = &dq[b.off_v..b.off_v + b.nv];
-            match b.kind {
-                BodyKind::Particle | BodyKind::Planar => {
-                    for k in 0..b.nv {
-                        q[k] += d[k];
-                    }
-                }
-                BodyKind::Spatial => {
-                    for k in 0..3 {
-                        q[k] += d[k];
-                    }
-                    rotate(&mut q[3..7], [d[3], d[4], d[5]]);
-                }
-            }
+            displace_body(&mut self.q[b.off_q..], b.kind, &dq[b.off_v..b.off_v + b.nv]);
         }
     }
 

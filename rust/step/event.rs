@@ -27,7 +27,8 @@
 //! contact that stays closed, as after an inelastic impact under gravity). Otherwise the step
 //! is the plain one.
 
-use super::{frame, rotate, BodyKind, ContactRecord, Geometry, Restitution, StepRecord, Stepper};
+use super::bodies::displace_body;
+use super::{frame, ContactRecord, Geometry, Restitution, StepRecord, Stepper};
 use crate::contact::{solve_nsgs, ContactProblem, NsgsSettings};
 use crate::error::Result;
 
@@ -76,19 +77,7 @@ impl Stepper {
             let q0 = &self.saved_q[oq..oq + kind.nq(self.dim)];
             let q = &mut self.q[oq..oq + kind.nq(self.dim)];
             q.copy_from_slice(q0);
-            match kind {
-                BodyKind::Particle | BodyKind::Planar => {
-                    for k in 0..nv {
-                        q[k] += d[k];
-                    }
-                }
-                BodyKind::Spatial => {
-                    for k in 0..3 {
-                        q[k] += d[k];
-                    }
-                    rotate(&mut q[3..7], [d[3], d[4], d[5]]);
-                }
-            }
+            displace_body(q, kind, &d[..nv]);
         }
         self.freeze();
     }
@@ -147,19 +136,7 @@ impl Stepper {
                 self.v[ov + k] += a * rest - 0.5 * a * h;
             }
             let q = &mut self.q[oq..oq + kind.nq(self.dim)];
-            match kind {
-                BodyKind::Particle | BodyKind::Planar => {
-                    for k in 0..nv {
-                        q[k] += d[k];
-                    }
-                }
-                BodyKind::Spatial => {
-                    for k in 0..3 {
-                        q[k] += d[k];
-                    }
-                    rotate(&mut q[3..7], [d[3], d[4], d[5]]);
-                }
-            }
+            displace_body(q, kind, &d[..nv]);
         }
         self.freeze();
         let penetrates = self.closest().0 < -tol_gap;

@@ -24,7 +24,7 @@ mod record;
 #[path = "solve.rs"]
 mod solve;
 
-use self::bodies::{bodies_of, norm3, rotate, BodyInfo, Frozen};
+use self::bodies::{bodies_of, norm3, BodyInfo, Frozen};
 use self::narrow::{declared_candidates, frame, Candidate, Geometry};
 use self::persistence::{sphere_points, CandState};
 pub use self::record::{simulate, simulate_recorded, ContactRecord, StepRecord, Trajectory};
