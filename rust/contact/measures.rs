@@ -255,16 +255,7 @@ fn scaled_residuals(
     let rn = r[0].max(0.0);
     let e = match problem.anisotropy(i) {
         None => {
-            let mut v = [0.0; 3];
-            v[0] = r[0] - (su[0] + mu * tangent_norm(&su[1..dim]));
-            for k in 1..dim {
-                v[k] = r[k] - su[k];
-            }
-            project_cone(&mut v[..dim], mu);
-            let mut e = [0.0; 3];
-            for k in 0..dim {
-                e[k] = r[k] - v[k];
-            }
+            let e = de_saxce_residual(&r[..dim], &su[..dim], mu);
             // Coulomb with the normal impulse frozen: projection on the disk of radius mu r_n
             let radius = mu * rn;
             let mut x = [0.0; 2];
@@ -324,21 +315,10 @@ pub(crate) fn measure_into(
         let ui = &u[o..o + dim];
         // the literature's map (velocities added to impulses as they are)
         let (e1, viol) = match problem.anisotropy(i) {
-            None => {
-                let ut_norm = tangent_norm(&ui[1..]);
-                // v = r - (u + mu ||u_t|| n), residual r - P_K(v)
-                let mut v = [0.0; 3];
-                v[0] = ri[0] - (ui[0] + mu * ut_norm);
-                for k in 1..dim {
-                    v[k] = ri[k] - ui[k];
-                }
-                project_cone(&mut v[..dim], mu);
-                let mut e = [0.0; 3];
-                for k in 0..dim {
-                    e[k] = ri[k] - v[k];
-                }
-                (e, tangent_norm(&ri[1..]) - mu * ri[0])
-            }
+            None => (
+                de_saxce_residual(ri, ui, mu),
+                tangent_norm(&ri[1..]) - mu * ri[0],
+            ),
             Some(pair) => anisotropic_residual(pair, ri, ui),
         };
         res.add_all(&e1[..dim]);
@@ -428,6 +408,23 @@ pub(crate) fn anisotropic_residual(pair: [f64; 2], r: &[f64], u: &[f64]) -> ([f6
     project_cone(&mut v, m);
     let e = [r[0] - v[0], r[1] - b[0] * v[1], r[2] - b[1] * v[2]];
     (e, (rh[1].hypot(rh[2]) - m * r[0]).max(flat))
+}
+
+/// De Saxcé's natural-map residual of one isotropic contact,
+/// `e = r - P_K(r - (u + mu ||u_t|| n))` (De Saxcé and Feng 1991), zero-padded to 3.
+fn de_saxce_residual(r: &[f64], u: &[f64], mu: f64) -> [f64; 3] {
+    let dim = r.len();
+    let mut v = [0.0; 3];
+    v[0] = r[0] - (u[0] + mu * tangent_norm(&u[1..dim]));
+    for k in 1..dim {
+        v[k] = r[k] - u[k];
+    }
+    project_cone(&mut v[..dim], mu);
+    let mut e = [0.0; 3];
+    for k in 0..dim {
+        e[k] = r[k] - v[k];
+    }
+    e
 }
 
 #[cfg(test)]
