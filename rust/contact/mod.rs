@@ -378,7 +378,8 @@ fn pad(d: usize, t: &[f64], b: &mut [[f64; 3]; 3]) {
 pub enum ContactStatus {
     /// the error is at most the tolerance.
     Solved,
-    /// the iteration limit was reached first; the error is reported.
+    /// the method's budget was spent first (its iteration limit, Lemke's pivot limit, or the
+    /// robust mode's restarts after stalls); the error is reported.
     IterationLimit,
     /// the arithmetic broke down (non-finite iterates, or a contact with no normal stiffness
     /// `W_nn <= 0` that the answer needed).
@@ -500,7 +501,7 @@ mod tests {
             let r = [rng.normal(), rng.normal(), rng.normal()];
             let u = [rng.normal(), rng.normal(), rng.normal()];
             let mu = rng.range(0.0, 2.0);
-            let (e, viol) = measures::anisotropic_residual([mu, mu], &r, &u);
+            let (e, viol) = measures::anisotropic_residual([mu, mu], &r, &u, 0.0);
             let d2: f64 = e.iter().map(|x| x * x).sum();
             let mut v = [
                 r[0] - u[0] - mu * u[1].hypot(u[2]),

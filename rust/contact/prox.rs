@@ -94,7 +94,7 @@ use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::{SparseColMat, Triplet};
 
-use super::lcp_finish::finish_2d;
+use super::lcp_finish::{finish_2d, finish_2d_whole};
 use super::nsgs::{solve_nsgs, NsgsSettings};
 use super::projection::{project_cone, tangent_norm};
 use super::{measure_into, ContactMeasures, ContactProblem, ContactSolution, ContactStatus};
@@ -520,6 +520,16 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
         }
     }
 
+    // 2D, not solved: the whole problem as one LCP (the working set of the first stall may
+    // have missed the answer's contacts, or the stall came only at the end of the budget)
+    if dim == 2 && !measures.passes(s.tol) && nc <= super::lcp_finish::MAX_CONTACTS {
+        if let Some(fin) = finish_2d_whole(problem, s.tol)? {
+            r = fin.impulse;
+            u = fin.velocity;
+            measures = fin.measures;
+            finish = Some((fin.contacts, fin.rounds, fin.pivots));
+        }
+    }
     let finished = match finish {
         Some((contacts, rounds, pivots)) => format!(
             " and the 2D LCP finish (Lemke, {pivots} pivots in {rounds} rounds on {contacts} of \
@@ -541,12 +551,15 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
             format!("the iterates became non-finite after {iterations} Newton steps"),
         )
     } else if stalled {
+        // the budget of restarts is spent: like the step budget, a limit of the method (the
+        // arithmetic did not break down), and reported as such, so that a problem stalling
+        // at step 197 in some units and stopping at step 200 in others gets one status
         (
-            ContactStatus::NumericalFailure,
+            ContactStatus::IterationLimit,
             format!(
-                "stalled after {iterations} Newton steps: no step decreases the natural-map \
-                 residual even with the proximal parameter at {eta:.1e} (scaled_error {:.2e} > \
-                 tol {:.1e})",
+                "stalled after {iterations} Newton steps and {restarts} restarts: no step \
+                 decreases the natural-map residual even with the proximal parameter at \
+                 {eta:.1e} (scaled_error {:.2e} > tol {:.1e})",
                 measures.scaled_error, s.tol
             ),
         )
