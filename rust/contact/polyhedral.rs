@@ -65,7 +65,7 @@
 
 use super::{measure_into, ContactProblem, ContactSolution, ContactStatus};
 use crate::error::{CoulombError, Result};
-use crate::lcp::{solve_lemke, LcpRef, LcpSolution, LcpStatus, LemkeSettings};
+use crate::lcp::{solve_lemke, LcpRef, LcpSolution, LcpStatus, LemkeEngine, LemkeSettings};
 
 /// Settings of [`solve_polyhedral`].
 #[derive(Clone, Debug)]
@@ -324,6 +324,39 @@ fn check_facets(dim: usize, facets: usize) -> Result<()> {
     Ok(())
 }
 
+/// Other Lemke paths on the same polyhedral LCP, tried in turn when the first does not solve
+/// it (only under the default engine and covering vector, which they replace): the other
+/// engine (the product form and the tableau round differently, and with mu of 1e4 and more
+/// the LCP is conditioned like mu, so a lexicographic tie or a pivot near the tolerance can
+/// go either way), then two fixed covering vectors spread in [0.5, 1.5) on the problem in
+/// normalized units. Each path is deterministic, and every answer is judged by the same rule.
+fn other_paths(s: &LemkeSettings, n: usize) -> Vec<LemkeSettings> {
+    if s.engine != LemkeEngine::Auto || s.covering_vector.is_some() || n == 0 {
+        return Vec::new();
+    }
+    let other = if (16..=1024).contains(&n) {
+        LemkeEngine::Tableau
+    } else {
+        LemkeEngine::ProductForm
+    };
+    let mut out = vec![LemkeSettings {
+        engine: other,
+        ..s.clone()
+    }];
+    for k in [1.0, 2.0] {
+        // the golden-ratio sequence: reproducible and never zero
+        let phi = 0.618_033_988_749_895 * k;
+        let d: Vec<f64> = (0..n)
+            .map(|i| 0.5 + ((i as f64 + 1.0) * phi).fract())
+            .collect();
+        out.push(LemkeSettings {
+            covering_vector: Some(d),
+            ..s.clone()
+        });
+    }
+    out
+}
+
 /// Solves the friction-contact problem on the polyhedral cone by Lemke's method (see the
 /// module notes), returning the impulses together with the LCP answer itself.
 pub fn solve_polyhedral_lcp(
@@ -332,9 +365,30 @@ pub fn solve_polyhedral_lcp(
 ) -> Result<(ContactSolution, PolyhedralLcp, LcpSolution)> {
     let lcp = PolyhedralLcp::new(problem, settings.facets)?;
     let lref = LcpRef::new(lcp.n, &lcp.m, &lcp.q)?;
-    let ls = solve_lemke(&lref, &settings.lemke)?;
-    let r = lcp.impulses(&ls.z);
     let mut u = vec![0.0; problem.size()];
+    let tol = settings.lemke.tol;
+    let accepted = |ls: &LcpSolution, r: &[f64], u: &mut [f64]| {
+        ls.status == LcpStatus::Solved
+            && (problem.dim != 2 || measure_into(problem, r, u).passes(tol))
+    };
+    let mut ls = solve_lemke(&lref, &settings.lemke)?;
+    let mut r = lcp.impulses(&ls.z);
+    let mut pivots = ls.pivots;
+    if !accepted(&ls, &r, &mut u) {
+        // other paths (see `other_paths`); the first that solves is kept, else the first's
+        // verdict stands
+        for alt in other_paths(&settings.lemke, lcp.n) {
+            let t = solve_lemke(&lref, &alt)?;
+            pivots += t.pivots;
+            let rt = lcp.impulses(&t.z);
+            if accepted(&t, &rt, &mut u) {
+                ls = t;
+                r = rt;
+                break;
+            }
+        }
+        ls.pivots = pivots;
+    }
     let measures = measure_into(problem, &r, &mut u);
     let lm = &ls.measures;
     let what = format!(
