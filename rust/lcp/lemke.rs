@@ -811,6 +811,16 @@ pub fn solve_lemke_with(
                     (t, false)
                 }
             }
+            // the path ended elsewhere (a ray, the limit): with rounding, a path that reaches
+            // z0 = 0 to rounding may still pick another leaving row; its answer, and the
+            // principal solution of its basic z's, are judged like any other
+            None if ending != Ending::NonFinite && settings.polish => {
+                let t = candidate(lcp, &eq, z.clone());
+                match principal(lcp, &eq, &basis) {
+                    Some(p) if better(&p.measures, &t.measures) => (p, true),
+                    _ => (t, false),
+                }
+            }
             None => (candidate(lcp, &eq, z.clone()), false),
         };
         out.z = best.z;
@@ -820,6 +830,22 @@ pub fn solve_lemke_with(
         out.polished = polished;
         let m = &out.measures;
         match ending {
+            Ending::Ray | Ending::Limit if passes(m, tol) => {
+                out.status = LcpStatus::Solved;
+                out.message = format!(
+                    "solved in {} pivots (error {:.2e}{}; the path ended on {}, but the answer \
+                     there passes tol)",
+                    out.pivots,
+                    m.error,
+                    if polished { ", polished" } else { "" },
+                    if ending == Ending::Ray {
+                        "a ray"
+                    } else {
+                        "the pivot limit"
+                    }
+                );
+                return Ok(with_fallback_note(out, abandoned));
+            }
             Ending::Terminal if passes(m, tol) => {
                 out.status = LcpStatus::Solved;
                 out.message = format!(
