@@ -52,18 +52,18 @@ def test_status_is_invariant_under_units(seed, dim, ka, kb, method):
     # like mu, and on problems without a solution an iterative method's path is chaotic: a
     # verdict near the tolerance may then flip with the rounding of the scaled data (bounded
     # by the campaign test below, counted in docs/properties.md), never into a false success.
-    # The robust mode in 3D is excluded here: on singular W its Newton path may converge near
-    # the end of its budget (solved in 165 steps in some units, 2.97e-5 at 200 in others;
-    # 1 in 581 in the long campaign, which bounds it); its successes are checked above.
+    # The robust mode in 3D is excluded here: on singular W its Newton path may converge late
+    # in its budget (campaign seed 2481: solved in 111 steps in some units, 2.5e-5 at 200 in
+    # others; 1 in 581 in the long campaign, which bounds it); its successes are checked above.
     if method == "prox" and dim == 3:
         return
     base = generate(seed, dim, True, mu_choices=MODERATE_MU)
     other = generate(seed, dim, True, ka, kb, mu_choices=MODERATE_MU)
     r, s = solve(base, method), solve(other, method)
     if method != "lemke" and r.status != s.status:
-        # an iterative method converging at the edge of its budget (NSGS on singular W: solved
-        # in 1895 sweeps in some units, 7e-6 after 2000 in others): the other run stopped at
-        # the limit, this one used most of it
+        # an iterative method converging at the edge of its budget (NSGS on singular W,
+        # campaign seed 1345: solved in 1926 sweeps in some units, 2.6e-8 after 2000 in
+        # others): the other run stopped at the limit, this one used most of it
         done, stopped = (r, s) if r.success else (s, r)
         budget = 2000 if method == "nsgs" else 200
         assert done.success and stopped.status == "iteration_limit", (r.message, s.message)
