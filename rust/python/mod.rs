@@ -5,13 +5,15 @@
 //!
 //! One file per area: [`lcp`] (`lcp_solve`, `lcp_measures`), [`contact`] (`contact_solve`,
 //! `contact_assemble`, `contact_post_velocity`), [`step`] (`step_simulate`), [`io`] (the
-//! Siconos readers), [`errors`] (the exception of each error kind). This file registers them
-//! and holds what they share: [`guarded`] (GIL release, Ctrl-C, panics) and array borrowing.
+//! Siconos readers), [`errors`] (the exception of each error kind), [`settings`] (the contact
+//! solvers' settings, built once for `contact` and `step`). This file registers them and holds
+//! what they share: [`guarded`] (GIL release, Ctrl-C, panics) and array borrowing.
 
 mod contact;
 mod errors;
 mod io;
 mod lcp;
+mod settings;
 mod step;
 
 use std::panic::{catch_unwind, AssertUnwindSafe};

@@ -8,8 +8,8 @@ use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString};
 
-use super::{guarded, to_py};
-use crate::contact::{NsgsSettings, PolyhedralSettings};
+use super::{guarded, settings, to_py};
+use crate::contact::ContactOrder;
 use crate::error::CoulombError;
 use crate::step::{
     simulate_recorded, Body, BodyKind, Drift, HalfSpace, Pair, Restitution, Scene, Shape,
@@ -163,22 +163,14 @@ pub(super) fn step_simulate<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let scene = scene_from_dict(scene)?;
     let solver = match solver {
-        "nsgs" => StepSolver::Nsgs(NsgsSettings {
+        "nsgs" => StepSolver::Nsgs(settings::nsgs(
             tol,
-            max_iter: max_iter.unwrap_or(1000),
+            max_iter,
             relaxation,
-            initial: None,
-            order: crate::contact::ContactOrder::Forward,
-        }),
-        "lemke" => {
-            let mut s = PolyhedralSettings::for_dim(scene.dim);
-            if let Some(f) = facets {
-                s.facets = f;
-            }
-            s.lemke.tol = tol;
-            s.lemke.max_pivots = max_iter;
-            StepSolver::Lemke(s)
-        }
+            None,
+            ContactOrder::Forward,
+        )),
+        "lemke" => StepSolver::Lemke(settings::lemke(scene.dim, tol, max_iter, facets)),
         other => {
             return Err(to_py(
                 py,
