@@ -1,5 +1,5 @@
 //! From a mechanism to its contact problem: the Delassus matrix and the free contact velocity
-//! (DESIGN.md conventions; the seed's "inelastic step"):
+//! (the inelastic step of Stewart 2000, with Acary and Brogliato's 2008 sign conventions):
 //!
 //! ```text
 //!     W = G^T M^{-1} G,        q = G^T v_free + w,        v = v_free + M^{-1} G r,

@@ -493,7 +493,7 @@ mod tests {
         assert!(norm2(&[f64::NAN, 1.0]).is_nan());
         assert_eq!(norm2(&[f64::INFINITY, 1.0]), f64::INFINITY);
         assert_eq!(norm2(&[0.0, -0.0]), 0.0);
-        // r = 0 for the seed's step at 1e-200: measured as at scale 1, not as 0
+        // r = 0 for the chapter's inelastic step at 1e-200: measured as at scale 1, not as 0
         let (w, q) = ([0.5e-200, 0.0, 0.0, 0.5e-200], [-3e-200, 1e-200]);
         let p = ContactProblem::new(2, &w, &q, &[0.2]).unwrap();
         let (_, m) = measure(&p, &[0.0, 0.0]).unwrap();
@@ -505,7 +505,7 @@ mod tests {
     }
 
     #[test]
-    fn measures_of_the_seed_answer_and_of_zero() {
+    fn measures_of_the_chapter_answer_and_of_zero() {
         let w = [0.5, 0.0, 0.0, 0.5];
         let q = [-3.0, 1.0];
         let p = ContactProblem::new(2, &w, &q, &[0.2]).unwrap();

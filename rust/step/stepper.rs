@@ -275,7 +275,7 @@ impl Stepper {
         }
     }
 
-    /// The seed's "One impulse-based time step", from `(t_k, q_k, v_k)` to
+    /// One impulse time step (Stewart and Trinkle 1996), from `(t_k, q_k, v_k)` to
     /// `(t_{k+1}, q_{k+1}, v_{k+1})`; appends the active contacts to `contacts` and returns the
     /// step's checks. Errors only for settings the contact solver refuses.
     ///
@@ -323,10 +323,10 @@ impl Stepper {
         Ok(record)
     }
 
-    /// The contact search (seed: "A contact search must first identify closed or imminently
-    /// closing contacts"): every candidate closed (`g <= gap_tolerance`), owed a rebound, or
-    /// open but closing within the step by its speed bound becomes an active contact with its
-    /// G and `M^{-1} G` columns; the others forget their state.
+    /// The contact search, which must find the closed and the imminently closing contacts
+    /// before the solve (Stewart 2000): every candidate closed (`g <= gap_tolerance`), owed a
+    /// rebound, or open but closing within the step by its speed bound becomes an active
+    /// contact with its G and `M^{-1} G` columns; the others forget their state.
     fn search_contacts(&mut self) {
         let h = self.settings.h;
         let tol_gap = self.settings.gap_tolerance;
