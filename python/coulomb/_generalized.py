@@ -308,18 +308,18 @@ class Model:
                  if self.force else np.zeros(q.size))
             rec["load_power"].append(float(f @ v))
         raw: dict[str, Any] = {"dim": dim, "stopped": stopped, "solve_time": float("nan")}
-        for key, val in rec.items():
+        for key, column in rec.items():
             if key in ("q", "v"):
-                raw[key] = np.array(val, dtype=np.float64).reshape(len(val), q.size)
+                raw[key] = np.array(column, dtype=np.float64).reshape(len(column), q.size)
             elif key in ("contact_impulse", "contact_velocity"):
-                raw[key] = np.array(val, dtype=np.float64).reshape(len(val), dim)
+                raw[key] = np.array(column, dtype=np.float64).reshape(len(column), dim)
             elif key == "status":
-                raw[key] = list(val)
+                raw[key] = list(column)
             elif key in ("resumed", "fallback", "contact_closed"):
-                raw[key] = np.array(val, dtype=bool)
+                raw[key] = np.array(column, dtype=bool)
             elif key in ("active", "iterations", "negative_gaps", "contact_step", "contact_id"):
-                raw[key] = np.array(val, dtype=np.int64)
+                raw[key] = np.array(column, dtype=np.int64)
             else:
-                raw[key] = np.array(val, dtype=np.float64)
+                raw[key] = np.array(column, dtype=np.float64)
         return Trajectory._from_core(raw, scene=None, h=h, solver=solver,
                                      gap_tolerance=gap_tolerance, tol=tol)

@@ -518,7 +518,6 @@ class Scene:
             restitution=restitution, record_every=record_every,
             locate_impacts=locate_impacts,
         )
-        tr = Trajectory._from_core(raw, scene=self, h=h, solver=solver,
-                                   gap_tolerance=gap_tolerance, tol=tol)
-        tr["record_every"] = record_every
-        return tr
+        return Trajectory._from_core(raw, scene=self, h=h, solver=solver,
+                                     gap_tolerance=gap_tolerance, tol=tol,
+                                     record_every=record_every)
