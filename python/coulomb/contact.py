@@ -127,6 +127,7 @@ from ._result import Result
 from ._status import Status
 from .errors import InvalidInputError, InvalidParameterError, NonFiniteError, ShapeError
 from .lcp import _as_array
+from .settings import NSGSSettings, PolyhedralSettings, ProxSettings, accepts
 
 __all__ = ["ContactResult", "assemble", "post_velocity", "solve"]
 
@@ -181,6 +182,7 @@ class ContactResult(Result):
     solve_time: float
 
 
+@accepts("method", (NSGSSettings, PolyhedralSettings, ProxSettings))
 def solve(
     W: ArrayLike,
     q: ArrayLike,
@@ -195,6 +197,7 @@ def solve(
     facets: int | None = None,
     eta: float | None = None,
     order: str | ArrayLike = "forward",
+    settings: NSGSSettings | PolyhedralSettings | ProxSettings | None = None,
 ) -> ContactResult:
     """Solve the friction-contact problem ``u = W r + q`` with Coulomb's law at every contact.
 
@@ -240,6 +243,11 @@ def solve(
         ``"nsgs"`` only: the order in which a sweep visits the contacts; ``"symmetric"`` is a
         forward then a backward pass (no directional bias in stacks and chains, twice the cost
         per sweep); an array is a permutation of the contacts.
+    settings : NSGSSettings, PolyhedralSettings or ProxSettings, optional
+        The method and its options as one object (:mod:`coulomb.settings`), in place of
+        ``method`` and ``tol``, ``max_iter``, ``relaxation``, ``order``, ``facets``, ``eta``;
+        ``initial`` combines with it. A keyword also given in it raises
+        :class:`~coulomb.errors.SettingsConflictError`.
 
     Returns
     -------

@@ -55,6 +55,7 @@ from .errors import (
     NonFiniteError,
     ShapeError,
 )
+from .settings import StepSettings, accepts
 from .trajectory import Trajectory
 
 __all__ = [
@@ -406,6 +407,7 @@ class Scene:
             iq, iv = iq + nq, iv + nv
         return out
 
+    @accepts(None, (StepSettings,))
     def simulate(
         self,
         t_end: float,
@@ -424,6 +426,7 @@ class Scene:
         restitution: Literal["newton", "poisson"] = "newton",
         record_every: int = 1,
         locate_impacts: bool = False,
+        settings: StepSettings | None = None,
     ) -> Trajectory:
         """Runs ``ceil(t_end / h)`` steps of the impulse time stepper from the initial state.
 
@@ -488,6 +491,11 @@ class Scene:
             ``coulomb.memory_budget()`` and a run that would exceed it is refused
             (:class:`~coulomb.errors.ProblemTooLargeError`, saying which ``record_every``
             fits).
+        settings : StepSettings, optional
+            Every option above as one object (:mod:`coulomb.settings`; its ``solver`` field an
+            :class:`~coulomb.settings.NSGSSettings` or
+            :class:`~coulomb.settings.PolyhedralSettings`). A keyword also given in it raises
+            :class:`~coulomb.errors.SettingsConflictError`.
 
         Notes
         -----

@@ -118,6 +118,7 @@ def test_input_error_classes_are_distinct():
         errors.InvalidParameterError,
         errors.ProblemTooLargeError,
         errors.ProblemFormatError,
+        errors.SettingsConflictError,
     ],
 )
 def test_error_hierarchy(cls):
@@ -138,6 +139,7 @@ def test_internal_error_is_a_coulomb_error():
         "NonFiniteError",
         "ProblemFormatError",
         "ProblemTooLargeError",
+        "SettingsConflictError",
         "ShapeError",
     }
 
