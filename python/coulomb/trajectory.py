@@ -87,12 +87,18 @@ class Trajectory:
         One line for a person.
     t : ndarray, shape (N + 1,)
         Times (s).
-    q, v : ndarray, shape (N + 1, nq) and (N + 1, nv)
-        Coordinates and velocities of every body in the order added (:meth:`body` slices one
-        out); a planar body's are ``(x, y, theta)``, a spatial body's position and unit
-        quaternion ``(w, x, y, z)`` then its velocity and angular velocity (world frame).
-    kinetic_energy, potential_energy, total_energy : ndarray, shape (N + 1,)
-        ``T``, ``V`` (of gravity and the constant forces, ``-sum (m g + F) . x``) and
+    q : ndarray, shape (N + 1, nq)
+        Coordinates of every body in the order added (:meth:`body` slices one out): a
+        particle's position, a planar body's ``(x, y, theta)``, a spatial body's position and
+        unit quaternion ``(w, x, y, z)``.
+    v : ndarray, shape (N + 1, nv)
+        Velocities: a planar body's ``(vx, vy, omega)``, a spatial body's velocity and angular
+        velocity (world frame).
+    kinetic_energy : ndarray, shape (N + 1,)
+        ``T`` (J).
+    potential_energy : ndarray, shape (N + 1,)
+        ``V`` of gravity and the constant forces, ``-sum (m g + F) . x`` (J).
+    total_energy : ndarray, shape (N + 1,)
         ``T + V`` (J).
     load_power : ndarray, shape (N + 1,)
         ``f . v`` of those constant loads (W; for a :class:`~coulomb.Model`, of its
@@ -114,9 +120,13 @@ class Trajectory:
         Sweeps, Newton steps or pivots of step k's solve.
     momentum_residual : ndarray, shape (N,)
         ``||M (v_{k+1} - v_free) - G P||`` over ``max(||G P||, ||M v_free||, ||M v_{k+1}||)``.
-    min_normal_impulse, cone_violation, complementarity : ndarray, shape (N,)
-        ``min P_n``, ``max(||P_t|| - mu P_n, 0)`` and ``max |P_n (J_n v_{k+1} + e v_n^-)|``
-        (with the gap term ``g / h`` for an open contact), in N s and m/s.
+    min_normal_impulse : ndarray, shape (N,)
+        ``min P_n`` over the step's contacts (N s).
+    cone_violation : ndarray, shape (N,)
+        ``max(||P_t|| - mu P_n, 0)`` (N s).
+    complementarity : ndarray, shape (N,)
+        ``max |P_n (J_n v_{k+1} + e v_n^-)|``, with the gap term ``g / h`` for an open contact
+        (N m).
     resumed : ndarray of bool, shape (N,)
         A closed contact took its restitution from the approach velocity of the step that
         closed it.
@@ -124,13 +134,18 @@ class Trajectory:
         NSGS missed its tolerance and the fallback's better answer was used.
     projection : ndarray, shape (N,)
         The largest coordinate change of the drift projection (0 without it).
-    contact_step, contact_id : ndarray of int, shape (n_records,)
-        The step (row of the step arrays) of each contact record and the contact's id, stable
-        over steps (the candidate pair of features).
-    contact_impulse, contact_velocity : ndarray, shape (n_records, dim)
-        The impulse (normal first, N s) and ``J v_{k+1}`` in the contact frame (m/s).
-    contact_approach, contact_gap : ndarray, shape (n_records,)
-        The approach velocity the impact law used (m/s) and the gap at ``t_k`` (m).
+    contact_step : ndarray of int, shape (n_records,)
+        The step (row of the step arrays) of each contact record.
+    contact_id : ndarray of int, shape (n_records,)
+        The contact's id, stable over steps (the candidate pair of features).
+    contact_impulse : ndarray, shape (n_records, dim)
+        The impulse, normal first (N s).
+    contact_velocity : ndarray, shape (n_records, dim)
+        ``J v_{k+1}`` in the contact frame (m/s).
+    contact_approach : ndarray, shape (n_records,)
+        The approach velocity the impact law used (m/s).
+    contact_gap : ndarray, shape (n_records,)
+        The gap at ``t_k`` (m).
     contact_closed : ndarray of bool, shape (n_records,)
         Whether the contact was closed (restitution applied) rather than closing.
     dim : int
@@ -139,8 +154,10 @@ class Trajectory:
         The time step (s).
     solver : str
         ``"nsgs"`` or ``"lemke"``.
-    tol, gap_tolerance : float
-        The contact solver's tolerance and the gap (m) at or below which a contact is closed.
+    tol : float
+        The contact solver's tolerance.
+    gap_tolerance : float
+        The gap (m) at or below which a contact is closed.
     record_every : int
         Steps per recorded row (the checks of a row are the worst over its steps).
     stopped : str or None

@@ -3,10 +3,9 @@ the statuses as coulomb.Status, and values that follow from the physics of a fal
 
 from __future__ import annotations
 
+import coulomb
 import numpy as np
 import pytest
-
-import coulomb
 from coulomb import Status
 
 
