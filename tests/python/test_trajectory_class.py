@@ -52,3 +52,13 @@ def test_trajectory_repr_summarises_the_run() -> None:
 def test_trajectory_is_made_by_simulate_only() -> None:
     with pytest.raises(TypeError):
         coulomb.Trajectory()
+
+
+def test_trajectory_pickles_for_executors() -> None:
+    import pickle
+
+    tr = _ball(0.3)
+    back = pickle.loads(pickle.dumps(tr))
+    np.testing.assert_array_equal(back.q, tr.q)
+    assert back.status is Status.COMPLETED and back.scene is not None
+    assert list(back.solver_status) == list(tr.solver_status)
