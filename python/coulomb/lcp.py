@@ -238,9 +238,8 @@ def solve(
     else:
         Ma = _as_array(M, "M", 2)
         qa = _as_array(q, "q", 1)
-    n = qa.shape[0]
-    if Ma.shape != (n, n):
-        raise ShapeError(f"M must have shape ({n}, {n}) to match q of length {n}, got {Ma.shape}")
+    # M square and q of its size: checked by the core before any work (ShapeError)
+    n = Ma.shape[0]
     if type(tol) is not float or not 0.0 < tol < 1.0:
         tol = _validate.tolerance("tol", tol)
     if method == "lemke":

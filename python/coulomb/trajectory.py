@@ -72,9 +72,10 @@ class Trajectory:
     """States, impulses and per-step checks of a simulation.
 
     Made by :meth:`coulomb.Scene.simulate` and :meth:`coulomb.Model.simulate`; every array is a
-    NumPy array. ``N`` is the number of recorded rows of steps (``ceil(t_end / h)`` steps
-    kept every ``record_every``-th and the last; fewer if the run stopped), the states are the ``N + 1`` instants ``t_0 .. t_N``, and the
-    contact records have one row per active contact per recorded step.
+    NumPy array. ``N`` is the number of recorded rows of steps (of the ``ceil(t_end / h)``
+    steps, every ``record_every``-th and the last; fewer if the run stopped), the states are
+    the ``N + 1`` instants ``t_0 .. t_N``, and the contact records have one row per active
+    contact per recorded step.
 
     Attributes
     ----------
