@@ -232,6 +232,7 @@ class Model:
             fallback=fallback, drift=drift, drift_bias=float(drift_bias),
             restitution=restitution, record_every=record_every,
         )
-        raw["record_every"] = record_every
-        return Trajectory._from_core(raw, scene=None, h=h, solver=solver,
+        data: dict[str, Any] = dict(raw)
+        data["record_every"] = record_every
+        return Trajectory._from_core(data, scene=None, h=h, solver=solver,
                                      gap_tolerance=gap_tolerance, tol=tol)

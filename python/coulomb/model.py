@@ -518,7 +518,7 @@ class Scene:
             restitution=restitution, record_every=record_every,
             locate_impacts=locate_impacts,
         )
-        tr = Trajectory._from_core(raw, scene=self, h=h, solver=solver,
+        tr = Trajectory._from_core(dict(raw), scene=self, h=h, solver=solver,
                                    gap_tolerance=gap_tolerance, tol=tol)
         tr["record_every"] = record_every
         return tr

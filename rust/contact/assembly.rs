@@ -297,7 +297,8 @@ pub(crate) fn cholesky_in_place(
 /// columns of G restricted to block b (a *side* of the contact). Each block lists the sides
 /// acting on it ([`WAssembly::side`]); each pair of sides sharing a block is multiplied once
 /// (`O(Σ_b k_b^2)` products, not `O(nc^2)`) by the caller's `dim x dim` product and mirrored
-/// (W is symmetric by construction). W is stored dense (row-major) or as COO triplets for
+/// (the blocks between two contacts are symmetric by construction; a contact's own block is
+/// the caller's product, symmetric to rounding). W is stored dense (row-major) or as COO triplets for
 /// [`BlockCsr`]. The workspaces are kept from one assembly to the next: assembling a W of a
 /// size seen before allocates nothing.
 ///
@@ -684,6 +685,114 @@ mod tests {
         }
         for (i, v) in back.iter().enumerate() {
             assert!((v - (i as f64 + 1.0)).abs() < 1e-14, "{back:?}");
+        }
+    }
+
+    /// W = G^T M^{-1} G of three contacts (dim 2) on three bodies of two velocities each
+    /// (contact 0 on bodies 0 and 1, contact 1 on body 1, contact 2 on bodies 1 and 2, so
+    /// contacts 0 and 2 share body 1 only), by the one assembly, dense and sparse, against
+    /// the dense product.
+    #[test]
+    fn the_one_assembly_sums_over_shared_blocks_dense_and_sparse() {
+        let (dim, nv, nb) = (2usize, 2usize, 3usize);
+        let minv = [
+            [0.5, 0.1, 0.1, 0.25],
+            [1.0, -0.2, -0.2, 0.5],
+            [0.2, 0.0, 0.0, 0.8],
+        ];
+        // sides: (contact, body, G block: dim columns of nv)
+        let sides: [(usize, usize, [[f64; 2]; 2]); 5] = [
+            (0, 0, [[1.0, 0.5], [0.0, 2.0]]),
+            (0, 1, [[-1.0, 0.3], [0.4, -2.0]]),
+            (1, 1, [[0.7, 0.0], [1.0, 1.0]]),
+            (2, 1, [[0.2, 1.5], [-0.6, 0.1]]),
+            (2, 2, [[-0.9, 0.4], [0.3, 0.3]]),
+        ];
+        let mut side_of = vec![vec![]; 3];
+        for (k, s) in sides.iter().enumerate() {
+            side_of[s.0].push(k);
+        }
+        // the dense G (nb nv x 3 dim) and M^{-1}
+        let (ndof, n) = (nb * nv, 3 * dim);
+        let mut g = vec![0.0; ndof * n];
+        for &(c, b, blk) in &sides {
+            for al in 0..dim {
+                for r in 0..nv {
+                    g[(b * nv + r) * n + c * dim + al] = blk[al][r];
+                }
+            }
+        }
+        let mut expected = vec![0.0; n * n];
+        for i in 0..n {
+            for j in 0..n {
+                for b in 0..nb {
+                    for r in 0..nv {
+                        for c in 0..nv {
+                            expected[i * n + j] += g[(b * nv + r) * n + i]
+                                * minv[b][r * nv + c]
+                                * g[(b * nv + c) * n + j];
+                        }
+                    }
+                }
+            }
+        }
+        let mut asm = WAssembly::new();
+        for sparse in [false, true, false] {
+            asm.begin(nb);
+            for (c, list) in side_of.iter().enumerate() {
+                for (k, &s) in list.iter().enumerate() {
+                    asm.side(c, k, sides[s].1);
+                }
+            }
+            let mut calls = 0;
+            asm.assemble(dim, 3, sparse, |(i, ki), (j, kj)| {
+                calls += 1;
+                let (si, sj) = (&sides[side_of[i][ki]], &sides[side_of[j][kj]]);
+                assert_eq!(si.1, sj.1, "a product across bodies");
+                let m = &minv[si.1];
+                let mut blk = [[0.0; 3]; 3];
+                for al in 0..dim {
+                    for be in 0..dim {
+                        for r in 0..nv {
+                            for c in 0..nv {
+                                blk[al][be] += si.2[al][r] * m[r * nv + c] * sj.2[be][c];
+                            }
+                        }
+                    }
+                }
+                blk
+            });
+            // body 0: 1 side, body 1: 3 sides (6 pairs), body 2: 1 side
+            assert_eq!(calls, 1 + 6 + 1);
+            let w = if sparse {
+                let csr = asm.block_csr().unwrap();
+                let mut w = vec![0.0; n * n];
+                let mut e = vec![0.0; n];
+                for j in 0..n {
+                    e.fill(0.0);
+                    e[j] = 1.0;
+                    let mut col = vec![0.0; n];
+                    csr.mul(&e, &mut col);
+                    for i in 0..n {
+                        w[i * n + j] = col[i];
+                    }
+                }
+                w
+            } else {
+                asm.dense().to_vec()
+            };
+            for k in 0..n * n {
+                assert!((w[k] - expected[k]).abs() < 1e-14, "{sparse}: {k}: {w:?}");
+            }
+            // blocks of two contacts are mirrored exactly; a contact's own block is the
+            // caller's product (symmetric to rounding)
+            for i in 0..n {
+                for j in 0..n {
+                    if i / dim != j / dim {
+                        assert_eq!(w[i * n + j], w[j * n + i]);
+                    }
+                }
+            }
         }
     }
 

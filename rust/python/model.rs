@@ -36,8 +36,9 @@ fn attach<T>(error: &mut Option<PyErr>, f: impl FnOnce(Python<'_>) -> PyResult<T
     })
 }
 
-/// copies a callback's float64 array into `out` (its length must be `out.len()`).
-fn copy_into(obj: &Bound<'_, PyAny>, what: &str, out: &mut [f64]) -> PyResult<()> {
+/// copies a callback's float64 array into `outs`, one after the other (its length must be
+/// their total length).
+fn copy_into(obj: &Bound<'_, PyAny>, what: &str, outs: &mut [&mut [f64]]) -> PyResult<()> {
     let arr = obj.extract::<PyReadonlyArray1<'_, f64>>().map_err(|e| {
         let e: PyErr = e.into();
         to_py(
@@ -51,17 +52,18 @@ fn copy_into(obj: &Bound<'_, PyAny>, what: &str, out: &mut [f64]) -> PyResult<()
             CoulombError::Shape(format!("{what} must be a contiguous float64 array")),
         )
     })?;
-    if s.len() != out.len() {
+    let total: usize = outs.iter().map(|o| o.len()).sum();
+    if s.len() != total {
         return Err(to_py(
             obj.py(),
-            CoulombError::Shape(format!(
-                "{what} has {} entries, expected {}",
-                s.len(),
-                out.len()
-            )),
+            CoulombError::Shape(format!("{what} has {} entries, expected {total}", s.len())),
         ));
     }
-    out.copy_from_slice(s);
+    let mut at = 0;
+    for out in outs.iter_mut() {
+        out.copy_from_slice(&s[at..at + out.len()]);
+        at += out.len();
+    }
     Ok(())
 }
 
@@ -82,7 +84,7 @@ impl GeneralizedSystem for PySystem {
         let mass = &self.mass;
         attach(&mut self.error, |py| {
             let out = mass.bind(py).call1((PyArray1::from_slice(py, q),))?;
-            copy_into(&out, "M(q)", m)
+            copy_into(&out, "M(q)", &mut [m])
         })
     }
 
@@ -94,7 +96,7 @@ impl GeneralizedSystem for PySystem {
         attach(&mut self.error, |py| {
             let args = (PyArray1::from_slice(py, q), PyArray1::from_slice(py, v), t);
             let out = force.bind(py).call1(args)?;
-            copy_into(&out, "f(q, v, t)", f)
+            copy_into(&out, "f(q, v, t)", &mut [f])
         })
     }
 
@@ -104,11 +106,7 @@ impl GeneralizedSystem for PySystem {
         };
         attach(&mut self.error, |py| {
             let out = contacts.bind(py).call1((PyArray1::from_slice(py, q),))?;
-            let mut all = vec![0.0; gaps.len() + rows.len()];
-            copy_into(&out, "the gaps and Jacobian rows", &mut all)?;
-            gaps.copy_from_slice(&all[..gaps.len()]);
-            rows.copy_from_slice(&all[gaps.len()..]);
-            Ok(())
+            copy_into(&out, "the gaps and Jacobian rows", &mut [gaps, rows])
         })
     }
 
