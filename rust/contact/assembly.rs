@@ -693,6 +693,7 @@ mod tests {
     /// contacts 0 and 2 share body 1 only), by the one assembly, dense and sparse, against
     /// the dense product.
     #[test]
+    #[allow(clippy::needless_range_loop)]
     fn the_one_assembly_sums_over_shared_blocks_dense_and_sparse() {
         let (dim, nv, nb) = (2usize, 2usize, 3usize);
         let minv = [
