@@ -22,16 +22,17 @@
 //! returned as it is. Located impacts ([`StepSettings::locate_impacts`]) are scenes' only.
 
 use super::super::impact::ImpactMemory;
-use super::law::{poisson_phase, PoissonInput};
 use super::persistence::CandState;
-use super::solve::{solve_step_problem, step_problem, SolveBuffers, SPARSE_FROM};
+use super::solve::{SolveBuffers, SPARSE_FROM};
 use super::{Active, ContactRecord, StepRecord, Stepper, Trajectory, TINY};
 use crate::contact::assembly::{cholesky_in_place, solve_cholesky, WAssembly};
 use crate::error::{check_finite, CoulombError, Result};
-use crate::step::{Drift, PolyhedralSettings, Restitution, StepSettings, StepSolver};
+use crate::step::{Drift, StepSettings};
 
 #[path = "generalized_drift.rs"]
 mod generalized_drift;
+#[path = "generalized_law.rs"]
+mod generalized_law;
 
 /// A mechanism in generalized coordinates (`dq/dt = v`, so `nq = nv`) whose mass matrix,
 /// forces and contacts the stepper asks for at each state it reaches.
@@ -364,168 +365,6 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
             blk
         });
         self.contact_terms(record);
-    }
-
-    /// `q_c = G^T v_free` plus each contact's restitution, bias or gap term, `q_1 = G^T v_k`
-    /// (open contacts separated) for Poisson's impact phase, and mu.
-    fn contact_terms(&mut self, record: &mut StepRecord) {
-        let dim = self.dim;
-        let h = self.settings.h;
-        let n = self.active.len() * dim;
-        self.qc.clear();
-        self.qc.resize(n, 0.0);
-        self.q1.clear();
-        self.q1.resize(n, 0.0);
-        self.mu.clear();
-        let poisson = self.settings.restitution == Restitution::Poisson;
-        self.poisson_impact = false;
-        for i in 0..self.active.len() {
-            let ai = self.active[i];
-            let (mu, e) = self.laws[ai.cand];
-            let st = self.state[ai.cand];
-            self.mu.push(mu);
-            for al in 0..dim {
-                let (a, b) = {
-                    let g = self.row(ai.cand, al);
-                    (dot(g, &self.v_free), dot(g, &self.v))
-                };
-                self.qc[i * dim + al] = a;
-                self.q1[i * dim + al] = b;
-            }
-            let bound = if ai.closed {
-                // Newton: 0 <= P_n ⊥ J_n v_{k+1} + e v_n^- >= 0
-                let vminus = st.impact.approach_with(ai.vn_k);
-                if st.impact.pending {
-                    record.resumed = true;
-                }
-                self.active[i].approach = vminus;
-                let bias = match self.settings.drift {
-                    Drift::VelocityBias(beta) if ai.gap < 0.0 => beta * ai.gap / h,
-                    _ => 0.0,
-                };
-                if poisson {
-                    self.active[i].carried = st.impact.compression;
-                    self.poisson_impact |= ai.vn_k < 0.0 || st.impact.pending;
-                    bias
-                } else {
-                    e * vminus + bias
-                }
-            } else {
-                // imminent: 0 <= P_n ⊥ J_n v_{k+1} + g / h >= 0
-                self.active[i].approach = ai.vn_k;
-                self.q1[i * dim] = self.q1[i * dim].max(0.0) + ai.gap / h;
-                ai.gap / h
-            };
-            self.qc[i * dim] += bound;
-        }
-    }
-
-    /// The contact solve into `self.solve.impulse`: the warm start and Lemke's guessed basis
-    /// by contact, Poisson's impact phase when it has work, then the step's solve.
-    fn solve_contacts(&mut self, record: &mut StepRecord) -> Result<()> {
-        let dim = self.dim;
-        let nc = self.active.len();
-        let w_sparse = if nc >= SPARSE_FROM {
-            Some(self.delassus.block_csr()?)
-        } else {
-            None
-        };
-        let mut initial = std::mem::take(&mut self.initial);
-        initial.clear();
-        if self.settings.warm_start {
-            for a in &self.active {
-                initial.extend_from_slice(&self.state[a.cand].warm[..dim]);
-            }
-        }
-        let mut basis = std::mem::take(&mut self.basis_guess);
-        self.basis_of_active(&mut basis);
-        let warm = (!initial.is_empty()).then_some(initial.as_slice());
-        let mut p_impact = std::mem::take(&mut self.p_impact);
-        p_impact.clear();
-        let dense = self.delassus.dense();
-        if self.poisson_impact {
-            let problem = step_problem(dim, dense, w_sparse.as_ref(), &self.q1, &self.mu)?;
-            self.restitution.clear();
-            self.restitution
-                .extend(self.active.iter().map(|a| self.laws[a.cand].1));
-            poisson_phase(
-                &PoissonInput {
-                    settings: &self.settings,
-                    problem: &problem,
-                    active: &self.active,
-                    e: &self.restitution,
-                    warm,
-                    guess: &basis,
-                },
-                record,
-                &mut self.solve,
-                &mut p_impact,
-            )?;
-            let mut wp = std::mem::take(&mut self.solve.velocity);
-            wp.resize(nc * dim, 0.0);
-            problem.mul_w(&p_impact, &mut wp);
-            for (q, d) in self.qc.iter_mut().zip(&wp) {
-                *q += d;
-            }
-            self.solve.velocity = wp;
-        }
-        let problem = step_problem(dim, dense, w_sparse.as_ref(), &self.qc, &self.mu)?;
-        let out = solve_step_problem(
-            &self.settings,
-            &problem,
-            warm,
-            &basis,
-            record,
-            &mut self.solve,
-        )?;
-        self.initial = initial;
-        self.basis_guess = basis;
-        for (p, d) in self.solve.impulse.iter_mut().zip(&p_impact) {
-            *p += d;
-        }
-        self.p_impact = p_impact;
-        record.status = Some(out.status);
-        record.error = out.measures.error;
-        record.scaled_error = out.measures.scaled_error;
-        record.iterations = out.iterations;
-        record.min_normal_impulse = out.measures.min_normal_impulse;
-        record.cone_violation = out.measures.cone_violation;
-        record.complementarity = out.measures.max_complementarity;
-        Ok(())
-    }
-
-    /// Lemke's guessed basis from the active contacts' last bases (as the scenes' stepper).
-    fn basis_of_active(&self, out: &mut Vec<usize>) {
-        out.clear();
-        let facets = match &self.settings.solver {
-            StepSolver::Lemke(s) => s.facets,
-            StepSolver::Nsgs(_) => PolyhedralSettings::for_dim(self.dim).facets,
-        };
-        if facets + 2 > 64 || !self.settings.warm_start {
-            return;
-        }
-        let nc = self.active.len();
-        let frictional = |a: &Active| self.laws[a.cand].0 > 0.0;
-        let nf = self.active.iter().filter(|a| frictional(a)).count();
-        let (mut beta, mut lambda) = (nc, nc + nf * facets);
-        for (i, a) in self.active.iter().enumerate() {
-            let bits = self.state[a.cand].basis;
-            if bits & 1 != 0 {
-                out.push(i);
-            }
-            if frictional(a) {
-                for k in 0..facets {
-                    if bits & (1 << (2 + k)) != 0 {
-                        out.push(beta + k);
-                    }
-                }
-                if bits & 2 != 0 {
-                    out.push(lambda);
-                }
-                beta += facets;
-                lambda += 1;
-            }
-        }
     }
 
     /// `v_{k+1} = v_free + M^{-1} G P` (into `v_next`, which holds `v_free`), and `G P`.

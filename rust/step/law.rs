@@ -116,8 +116,8 @@ impl Stepper {
     }
 
     /// W over the active contacts (see [`Stepper::assemble`]) by the one assembly
-    /// ([`crate::contact::assembly::WAssembly`]): each body is a block, each side of a contact its G columns and
-    /// `M_b^{-1}` times them.
+    /// ([`crate::contact::assembly::WAssembly`]): each body is a block, each side of a
+    /// contact its G columns and `M_b^{-1}` times them.
     fn assemble_w(&mut self) {
         let nc = self.active.len();
         let active = &self.active;
