@@ -688,54 +688,62 @@ mod tests {
         }
     }
 
-    /// W = G^T M^{-1} G of three contacts (dim 2) on three bodies of two velocities each
-    /// (contact 0 on bodies 0 and 1, contact 1 on body 1, contact 2 on bodies 1 and 2, so
-    /// contacts 0 and 2 share body 1 only), by the one assembly, dense and sparse, against
-    /// the dense product.
-    #[test]
+    /// sides of the test below: (contact, body, G block: dim = 2 columns of nv = 2).
+    type TestSide = (usize, usize, [[f64; 2]; 2]);
+
+    /// `G^T M^{-1} G` by dense products, G (nb nv x 3 dim) built from the sides.
     #[allow(clippy::needless_range_loop)]
-    fn the_one_assembly_sums_over_shared_blocks_dense_and_sparse() {
+    fn dense_w(sides: &[TestSide], minv: &[[f64; 4]; 3]) -> Vec<f64> {
         let (dim, nv, nb) = (2usize, 2usize, 3usize);
-        let minv = [
-            [0.5, 0.1, 0.1, 0.25],
-            [1.0, -0.2, -0.2, 0.5],
-            [0.2, 0.0, 0.0, 0.8],
-        ];
-        // sides: (contact, body, G block: dim columns of nv)
-        let sides: [(usize, usize, [[f64; 2]; 2]); 5] = [
-            (0, 0, [[1.0, 0.5], [0.0, 2.0]]),
-            (0, 1, [[-1.0, 0.3], [0.4, -2.0]]),
-            (1, 1, [[0.7, 0.0], [1.0, 1.0]]),
-            (2, 1, [[0.2, 1.5], [-0.6, 0.1]]),
-            (2, 2, [[-0.9, 0.4], [0.3, 0.3]]),
-        ];
-        let mut side_of = vec![vec![]; 3];
-        for (k, s) in sides.iter().enumerate() {
-            side_of[s.0].push(k);
-        }
-        // the dense G (nb nv x 3 dim) and M^{-1}
         let (ndof, n) = (nb * nv, 3 * dim);
         let mut g = vec![0.0; ndof * n];
-        for &(c, b, blk) in &sides {
+        for &(c, b, blk) in sides {
             for al in 0..dim {
                 for r in 0..nv {
                     g[(b * nv + r) * n + c * dim + al] = blk[al][r];
                 }
             }
         }
-        let mut expected = vec![0.0; n * n];
+        let mut w = vec![0.0; n * n];
         for i in 0..n {
             for j in 0..n {
                 for b in 0..nb {
                     for r in 0..nv {
                         for c in 0..nv {
-                            expected[i * n + j] += g[(b * nv + r) * n + i]
+                            w[i * n + j] += g[(b * nv + r) * n + i]
                                 * minv[b][r * nv + c]
                                 * g[(b * nv + c) * n + j];
                         }
                     }
                 }
             }
+        }
+        w
+    }
+
+    /// W of three contacts (dim 2) on three bodies of two velocities each (contact 0 on
+    /// bodies 0 and 1, contact 1 on body 1, contact 2 on bodies 1 and 2, so contacts 0 and 2
+    /// share body 1 only), by the one assembly, dense and sparse, against the dense product.
+    #[test]
+    #[allow(clippy::needless_range_loop)]
+    fn the_one_assembly_sums_over_shared_blocks_dense_and_sparse() {
+        let (dim, nv, nb, n) = (2usize, 2usize, 3usize, 6usize);
+        let minv = [
+            [0.5, 0.1, 0.1, 0.25],
+            [1.0, -0.2, -0.2, 0.5],
+            [0.2, 0.0, 0.0, 0.8],
+        ];
+        let sides: [TestSide; 5] = [
+            (0, 0, [[1.0, 0.5], [0.0, 2.0]]),
+            (0, 1, [[-1.0, 0.3], [0.4, -2.0]]),
+            (1, 1, [[0.7, 0.0], [1.0, 1.0]]),
+            (2, 1, [[0.2, 1.5], [-0.6, 0.1]]),
+            (2, 2, [[-0.9, 0.4], [0.3, 0.3]]),
+        ];
+        let expected = dense_w(&sides, &minv);
+        let mut side_of = vec![vec![]; 3];
+        for (k, s) in sides.iter().enumerate() {
+            side_of[s.0].push(k);
         }
         let mut asm = WAssembly::new();
         for sparse in [false, true, false] {
@@ -765,23 +773,20 @@ mod tests {
             });
             // body 0: 1 side, body 1: 3 sides (6 pairs), body 2: 1 side
             assert_eq!(calls, 1 + 6 + 1);
-            let w = if sparse {
+            let mut w = asm.dense().to_vec();
+            if sparse {
                 let csr = asm.block_csr().unwrap();
-                let mut w = vec![0.0; n * n];
-                let mut e = vec![0.0; n];
+                w = vec![0.0; n * n];
+                let (mut e, mut col) = (vec![0.0; n], vec![0.0; n]);
                 for j in 0..n {
                     e.fill(0.0);
                     e[j] = 1.0;
-                    let mut col = vec![0.0; n];
                     csr.mul(&e, &mut col);
                     for i in 0..n {
                         w[i * n + j] = col[i];
                     }
                 }
-                w
-            } else {
-                asm.dense().to_vec()
-            };
+            }
             for k in 0..n * n {
                 assert!((w[k] - expected[k]).abs() < 1e-14, "{sparse}: {k}: {w:?}");
             }
