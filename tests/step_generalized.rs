@@ -306,3 +306,188 @@ fn a_mass_matrix_that_is_not_positive_definite_is_refused() {
     assert!(matches!(err, CoulombError::InvalidParameter(_)), "{err}");
     assert!(err.to_string().contains("positive definite"), "{err}");
 }
+
+/// particles in a row above the floor (the last coordinate up), enough to make W block sparse.
+const ROW: usize = 30;
+
+fn row_frames<const D: usize>(q: &[f64], gaps: &mut [f64], rows: &mut [f64]) {
+    let nv = ROW * D;
+    rows.fill(0.0);
+    for i in 0..ROW {
+        gaps[i] = q[i * D + D - 1];
+        // normal: up; tangents: the horizontal axes
+        rows[(i * D) * nv + i * D + D - 1] = 1.0;
+        for t in 1..D {
+            rows[(i * D + t) * nv + i * D + t - 1] = 1.0;
+        }
+    }
+}
+
+fn particle_row(dim: usize, mu: f64, e: f64) -> (Diagonal, Scene, Vec<f64>, Vec<f64>) {
+    let (mut q0, mut v0) = (vec![], vec![]);
+    let mut bodies = vec![];
+    let mut shapes = vec![];
+    let mut pairs = vec![];
+    for i in 0..ROW {
+        let mut q = vec![0.0; dim];
+        let mut v = vec![0.0; dim];
+        q[0] = i as f64;
+        q[dim - 1] = 1e-4 * (i % 3) as f64;
+        v[0] = 0.1 * (i % 5) as f64;
+        v[dim - 1] = -0.5 - 0.01 * i as f64;
+        q0.extend_from_slice(&q);
+        v0.extend_from_slice(&v);
+        bodies.push(Body {
+            kind: BodyKind::Particle,
+            mass: 1.0 + (i % 4) as f64,
+            inertia: vec![],
+            q0: q,
+            v0: v,
+            force: vec![0.0; dim],
+        });
+        shapes.push(Shape {
+            body: i,
+            points: vec![vec![0.0; dim]],
+            radius: 0.0,
+        });
+        pairs.push(Pair::ShapeHalfSpace {
+            shape: i,
+            half_space: 0,
+            mu,
+            e,
+        });
+    }
+    let mut up = vec![0.0; dim];
+    up[dim - 1] = 1.0;
+    let mut gravity = vec![0.0; dim];
+    gravity[dim - 1] = -G;
+    let mass: Vec<f64> = (0..ROW * dim)
+        .map(|k| 1.0 + ((k / dim) % 4) as f64)
+        .collect();
+    let force: Vec<f64> = (0..ROW * dim)
+        .map(|k| {
+            if k % dim == dim - 1 {
+                -G * mass[k]
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let sys = Diagonal {
+        dim,
+        mass,
+        force,
+        laws: vec![(mu, e); ROW],
+        frames: if dim == 2 {
+            row_frames::<2>
+        } else {
+            row_frames::<3>
+        },
+        fail_at: None,
+        mass_calls: 0,
+    };
+    let scene = Scene {
+        dim,
+        gravity,
+        bodies,
+        shapes,
+        half_spaces: vec![HalfSpace {
+            point: vec![0.0; dim],
+            normal: up,
+        }],
+        pairs,
+    };
+    (sys, scene, q0, v0)
+}
+
+#[test]
+fn many_uncoupled_contacts_block_sparse_and_poissons_isolated_impacts_as_the_scene() {
+    // every particle lands on its own: W is block sparse (>= 24 contacts) and block diagonal,
+    // so Poisson's phase integrates each impact alone (Routh), as for the scene's bodies
+    for dim in [2, 3] {
+        for law in [Restitution::Newton, Restitution::Poisson] {
+            let (sys, scene, q0, v0) = particle_row(dim, 0.3, 0.5);
+            let mut st = settings(1e-3, 300);
+            st.restitution = law;
+            let model = simulate_generalized(sys, &q0, &v0, &st, 1).unwrap();
+            let reference = simulate(&scene, &st).unwrap();
+            assert!(model.trajectory.steps.iter().any(|s| s.active >= ROW));
+            same_run(&model.trajectory, &reference, 1e-12);
+        }
+    }
+}
+
+/// two rods (mass 1, length 1), each with its left end a contact against the floor.
+fn two_rod_frames(q: &[f64], gaps: &mut [f64], rows: &mut [f64]) {
+    rows.fill(0.0);
+    for k in 0..2 {
+        let (s, c) = q[3 * k + 2].sin_cos();
+        gaps[k] = q[3 * k + 1] - 0.5 * s;
+        let (n, t) = ((2 * k) * 6 + 3 * k, (2 * k + 1) * 6 + 3 * k);
+        rows[n..n + 3].copy_from_slice(&[0.0, 1.0, -0.5 * c]);
+        rows[t..t + 3].copy_from_slice(&[1.0, 0.0, 0.5 * s]);
+    }
+}
+
+#[test]
+fn poissons_law_integrates_an_impact_alone_beside_a_resting_uncoupled_contact() {
+    // rod A rests on its end (closed, not approaching); rod B strikes obliquely with spin:
+    // B's impact is isolated (no closed contact coupled to it through M), so Poisson's phase
+    // integrates it by Routh's method, as the scene does for two bodies
+    let h = 1e-3;
+    let a_q = [0.0, 0.5 * 0.7f64.sin(), 0.7];
+    for (vb, mu) in [
+        ([0.6, -1.0, 0.0], 0.5),
+        ([0.2, -1.0, 3.0], 0.3),
+        ([-0.5, -1.0, 5.0], 0.8),
+    ] {
+        let b_q = [3.0, 0.5 * 0.8f64.sin() + 1e-4, 0.8];
+        let q0: Vec<f64> = a_q.iter().chain(&b_q).copied().collect();
+        let v0: Vec<f64> = [0.0; 3].iter().chain(&vb).copied().collect();
+        let sys = Diagonal {
+            dim: 2,
+            mass: vec![1.0, 1.0, 1.0 / 12.0, 1.0, 1.0, 1.0 / 12.0],
+            force: vec![0.0; 6],
+            laws: vec![(mu, 0.8); 2],
+            frames: two_rod_frames,
+            fail_at: None,
+            mass_calls: 0,
+        };
+        let rod_body = |q: &[f64], v: &[f64]| Body {
+            kind: BodyKind::Planar,
+            mass: 1.0,
+            inertia: vec![1.0 / 12.0],
+            q0: q.to_vec(),
+            v0: v.to_vec(),
+            force: vec![0.0, 0.0],
+        };
+        let end = |body| Shape {
+            body,
+            points: vec![vec![-0.5, 0.0]],
+            radius: 0.0,
+        };
+        let pair = |shape| Pair::ShapeHalfSpace {
+            shape,
+            half_space: 0,
+            mu,
+            e: 0.8,
+        };
+        let scene = Scene {
+            dim: 2,
+            gravity: vec![0.0, 0.0],
+            bodies: vec![rod_body(&a_q, &[0.0; 3]), rod_body(&b_q, &vb)],
+            shapes: vec![end(0), end(1)],
+            half_spaces: vec![HalfSpace {
+                point: vec![0.0, 0.0],
+                normal: vec![0.0, 1.0],
+            }],
+            pairs: vec![pair(0), pair(1)],
+        };
+        let mut st = settings(h, 20);
+        st.restitution = Restitution::Poisson;
+        let model = simulate_generalized(sys, &q0, &v0, &st, 1).unwrap();
+        let reference = simulate(&scene, &st).unwrap();
+        assert!(model.trajectory.steps.iter().any(|s| s.active == 2));
+        same_run(&model.trajectory, &reference, 1e-12);
+    }
+}

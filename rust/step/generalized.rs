@@ -112,6 +112,8 @@ pub struct GeneralizedStepper<S: GeneralizedSystem> {
     /// `M^{-1} G` of the active contacts, `(i dim + α) nv ..`.
     mg: Vec<f64>,
     delassus: WAssembly,
+    /// the union-find forest of the active contacts coupled through M.
+    coupling: Vec<usize>,
     qc: Vec<f64>,
     q1: Vec<f64>,
     mu: Vec<f64>,
@@ -180,6 +182,7 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
             active: Vec::with_capacity(nc),
             mg: Vec::new(),
             delassus: WAssembly::new(),
+            coupling: Vec::new(),
             qc: Vec::new(),
             q1: Vec::new(),
             mu: Vec::new(),
@@ -325,7 +328,8 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
                 nsides: 1,
                 ..Active::default()
             };
-            // every contact acts on the one block of M (body 0)
+            // one side on the one block of M; its body is the contact's coupling class,
+            // set by the assembly
             act.sides[0].body = 0;
             self.active.push(act);
         }
@@ -347,6 +351,12 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
                 solve_cholesky(&self.chol, nv, x);
             }
         }
+        // contacts coupled through M (a nonzero block W_ij) are linked, so that Poisson's
+        // impact phase treats a contact as isolated exactly when no closed contact is coupled
+        // to it, directly or through others (as bodies do in scenes)
+        let mut link = std::mem::take(&mut self.coupling);
+        link.clear();
+        link.extend(0..na);
         let (rows, mg, active) = (&self.rows, &self.mg, &self.active);
         let w = &mut self.delassus;
         w.begin(1);
@@ -362,8 +372,17 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
                     blk[al][be] = dot(g, &mg[(j * dim + be) * nv..(j * dim + be + 1) * nv]);
                 }
             }
+            if i != j && blk.iter().flatten().any(|&x| x != 0.0) {
+                let (ri, rj) = (root(&mut link, i), root(&mut link, j));
+                link[ri.max(rj)] = ri.min(rj);
+            }
             blk
         });
+        for i in 0..na {
+            let r = root(&mut link, i);
+            self.active[i].sides[0].body = r;
+        }
+        self.coupling = link;
         self.contact_terms(record);
     }
 
@@ -474,6 +493,15 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
         load_power.push(dot(&self.f, &self.v));
         Ok(())
     }
+}
+
+/// the representative of `i`'s set in a union-find forest (paths halved on the way).
+fn root(link: &mut [usize], mut i: usize) -> usize {
+    while link[i] != i {
+        link[i] = link[link[i]];
+        i = link[i];
+    }
+    i
 }
 
 /// `x . y`.
