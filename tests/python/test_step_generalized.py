@@ -9,6 +9,8 @@ import numpy as np
 import pytest
 from coulomb import GapContact, HalfSpace, Model, Particle, Point, Scene
 from coulomb.errors import InvalidParameterError
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 G = 9.81
 TH = math.radians(45.0)
@@ -288,3 +290,34 @@ def test_a_spatial_particle_on_a_tilted_plane_as_a_model_gives_the_scenes_figure
         assert np.abs(a.q - b.q).max() < 1e-2 and a.check().ok
     # the particle stays on the plane (n . q >= -gap tolerance up to the step's drift)
     assert float((a.q @ n).min()) > -1e-6
+
+
+@settings(max_examples=25, deadline=None, derandomize=True)
+@given(dim=st.sampled_from([2, 3]), mass=st.floats(1e-3, 1e3),
+       mu=st.sampled_from([0.0, 0.3, 1.0, 1e3]), e=st.floats(0.0, 1.0),
+       tilt=st.floats(-0.6, 0.6), speed=st.floats(0.1, 10.0),
+       law=st.sampled_from(["newton", "poisson"]))
+def test_particle_models_give_the_scenes_figures_over_the_class(dim, mass, mu, e, tilt, speed,
+                                                                law):
+    # a particle thrown at a tilted plane under gravity, as a model and as a scene
+    n = np.zeros(dim)
+    n[0], n[-1] = math.sin(tilt), math.cos(tilt)
+    basis = np.linalg.svd(n.reshape(1, -1))[2][1:]  # an orthonormal tangent basis
+    q0 = list(0.01 * n)
+    v0 = list(-speed * n + 0.3 * speed * basis[0])
+    g = np.zeros(dim)
+    g[-1] = -G
+    model = Model(dim=dim, mass_matrix=mass * np.eye(dim), q0=q0, v0=v0,
+                  force=lambda q, v, t: mass * g,
+                  contacts=[GapContact(lambda q: float(n @ q), lambda q: n, lambda q: basis,
+                                       mu=mu, e=e)],
+                  potential=lambda q: -mass * float(g @ q))
+    scene = Scene(dim=dim, gravity=tuple(g))
+    p = scene.add(Particle(mass=mass, position=q0, velocity=v0))
+    plane = scene.add(HalfSpace(tuple([0.0] * dim), tuple(n)))
+    scene.contact(scene.attach(p, Point()), plane, mu=mu, e=e)
+    a = model.simulate(0.05, 1e-3, restitution=law)
+    b = scene.simulate(0.05, 1e-3, restitution=law)
+    assert a.active.any()
+    assert_same_run(a, b, 1e-9)
+    assert a.check().ok == b.check().ok
