@@ -20,6 +20,7 @@ __all__ = [
     "lcp_measures",
     "lcp_solve",
     "memory_budget",
+    "model_simulate",
     "read_siconos_fc",
     "read_siconos_lcp",
     "set_memory_budget",
