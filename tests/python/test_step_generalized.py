@@ -321,3 +321,46 @@ def test_particle_models_give_the_scenes_figures_over_the_class(dim, mass, mu, e
     assert a.active.any()
     assert_same_run(a, b, 1e-9)
     assert a.check().ok == b.check().ok
+
+
+def test_a_model_run_holds_the_gil_only_while_calling_back():
+    import sys
+    import threading
+
+    # each force callback starts a thread with about 1 ms of Python work and returns; Rust
+    # then factors a 400 x 400 M(q) (milliseconds) before the next callback, which looks
+    # whether the thread has finished. Had Rust kept the GIL, the thread could run only at the
+    # next callback's first bytecodes (a switch interval, 0.1 ms), never long enough to finish
+    n = 400
+    rng = np.random.default_rng(3)
+    a = rng.standard_normal((n, n))
+    mass = np.ascontiguousarray(a @ a.T / n + np.eye(n))
+    done: list[bool] = []
+    running: list[threading.Event] = []
+
+    def work(event: threading.Event) -> None:
+        total = 0
+        for k in range(20_000):
+            total += k
+        event.set()
+
+    def force(q, v, t):
+        if running:
+            done.append(running[-1].is_set())
+            running[-1].wait()
+        event = threading.Event()
+        running.append(event)
+        threading.Thread(target=work, args=(event,)).start()
+        return np.zeros(n)
+
+    old = sys.getswitchinterval()
+    sys.setswitchinterval(1e-4)
+    try:
+        model = Model(dim=2, mass_matrix=mass, q0=np.zeros(n), force=force)
+        model.simulate(0.02, 1e-3)
+    finally:
+        sys.setswitchinterval(old)
+        for event in running:
+            event.wait()
+    assert len(done) == 20
+    assert sum(done) >= 1, done
