@@ -34,8 +34,8 @@ loses ``m g y_k`` (``y_k`` the height there, at most ``m g h |v_n^-|``: first or
 removes that loss.
 
 :class:`Model` takes a user-defined model in generalized coordinates instead (``M(q)``,
-``f(q, v, t)`` and :class:`GapContact` gap functions with Jacobians), stepped by a Python loop
-around the same Rust contact solver.
+``f(q, v, t)`` and :class:`GapContact` gap functions with Jacobians), stepped by the same Rust
+stepper, which calls those functions back at each state.
 """
 
 from __future__ import annotations

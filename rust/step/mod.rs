@@ -68,6 +68,9 @@ mod impact;
 mod poisson;
 mod stepper;
 
+pub use stepper::generalized::{
+    simulate_generalized, GeneralizedStepper, GeneralizedSystem, GeneralizedTrajectory,
+};
 pub use stepper::{simulate, simulate_recorded, ContactRecord, StepRecord, Stepper, Trajectory};
 
 use crate::contact::{NsgsSettings, PolyhedralSettings};

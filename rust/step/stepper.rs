@@ -13,6 +13,8 @@ mod bodies;
 mod drift;
 #[path = "event.rs"]
 mod event;
+#[path = "generalized.rs"]
+pub mod generalized;
 #[path = "law.rs"]
 mod law;
 #[path = "narrow.rs"]
@@ -34,6 +36,7 @@ use super::poisson::routh;
 use super::{
     BodyKind, Drift, Pair, PolyhedralSettings, Restitution, Scene, StepSettings, StepSolver,
 };
+use crate::contact::assembly::WAssembly;
 use crate::error::Result;
 
 /// below this a norm counts as zero when forming a relative residual.
@@ -104,17 +107,14 @@ pub struct Stepper {
     frozen: Vec<Frozen>,
     v_free: Vec<f64>,
     active: Vec<Active>,
-    w: Vec<f64>,
-    incidence: Vec<Vec<(usize, usize)>>,
+    /// the assembly of W (dense, or COO triplets for block CSR), kept from step to step.
+    delassus: WAssembly,
     /// the step index whose state `prepare` has done (M, v_free, speed bounds, pairs,
     /// geometry), so the record of a state and the step from it share that work.
     prepared: Option<usize>,
     /// every candidate's geometry at the prepared state.
     geo_cache: Vec<Geometry>,
     speed_bounds: Vec<[f64; 2]>,
-    coo_rows: Vec<usize>,
-    coo_cols: Vec<usize>,
-    coo_vals: Vec<f64>,
     qc: Vec<f64>,
     q1: Vec<f64>,
     mu: Vec<f64>,
@@ -181,14 +181,10 @@ impl Stepper {
             v,
             step_index: 0,
             active: Vec::with_capacity(nc),
-            w: Vec::new(),
-            incidence: vec![Vec::new(); scene.bodies.len()],
+            delassus: WAssembly::new(),
             prepared: None,
             geo_cache: Vec::new(),
             speed_bounds: vec![[0.0; 2]; scene.bodies.len()],
-            coo_rows: Vec::new(),
-            coo_cols: Vec::new(),
-            coo_vals: Vec::new(),
             qc: Vec::new(),
             q1: Vec::new(),
             mu: Vec::new(),
