@@ -32,6 +32,12 @@
 //!   summed from those terms, its rounding is a few ulps of `t_i`, and the measure reaches
 //!   rounding level at a solution.
 //!
+//!   In De Saxce's map the slip `s = ||u_{t,i}||` is counted only above the rounding of the
+//!   sum it comes from, `f = (n + 3) eps ||t_{t,i}||`, as `s - f^2 / s` (0 below f): with a
+//!   large mu, `mu ||u_t||` would otherwise turn the rounding of a sticking contact's u_t into
+//!   an error of `mu eps` (1e-4 at mu = 1e12), and the verdict would follow that rounding from
+//!   one unit system to the next.
+//!
 //!   with `D(R)` the disk of radius R (the ellipse `(x_1 / mu_1)^2 + (x_2 / mu_2)^2 <= r_n^2`
 //!   for anisotropic friction). Both maps vanish exactly at the solutions. De Saxce's alone is
 //!   blind for a large mu: its normal argument `rho (u_n + mu ||u_t||)` lets `mu ||u_t||` hide
@@ -287,10 +293,22 @@ fn scaled_residuals(
 /// unknowns whose terms have the magnitudes `terms` (`(|W| |r| + |q|)_t`): each component is a
 /// sum of `n + 1` products, so its rounding, and the effect of rounding r and the data
 /// by one unit in the last place, is at most `(n + 3) eps` times its terms (Higham 2002,
-/// sec. 3.1). A slip below this is not distinguishable from 0.
+/// sec. 3.1). A slip below this is not distinguishable from 0 (see [`counted_slip`]).
 #[inline]
 pub(crate) fn rounding_floor(n: usize, terms: &[f64]) -> f64 {
     (n as f64 + 3.0) * f64::EPSILON * norm2(terms)
+}
+
+/// The slip `s = ||u_t||` De Saxce's map counts when u_t is formed to within `floor`:
+/// 0 up to the floor, then `s - floor^2 / s`, continuous and increasing, and equal to s to
+/// rounding once s is well above the floor (so an exact answer still measures exactly 0).
+#[inline]
+fn counted_slip(s: f64, floor: f64) -> f64 {
+    if s <= floor {
+        0.0
+    } else {
+        s - floor * (floor / s)
+    }
 }
 
 /// `u = W r + q` into `u` and the measures of r, without allocating.
@@ -421,7 +439,7 @@ pub(crate) fn anisotropic_residual(
             flat = flat.max(r[1 + k].abs());
         }
     }
-    let uht = (uh[1].hypot(uh[2]) - slip_floor).max(0.0);
+    let uht = counted_slip(uh[1].hypot(uh[2]), slip_floor);
     let mut v = [rh[0] - (uh[0] + m * uht), rh[1] - uh[1], rh[2] - uh[2]];
     project_cone(&mut v, m);
     let e = [r[0] - v[0], r[1] - b[0] * v[1], r[2] - b[1] * v[2]];
@@ -430,12 +448,12 @@ pub(crate) fn anisotropic_residual(
 
 /// De Saxcé's natural-map residual of one isotropic contact,
 /// `e = r - P_K(r - (u + mu ||u_t|| n))` (De Saxcé and Feng 1991), zero-padded to 3, with the
-/// slip `||u_t||` taken as `max(0, ||u_t|| - slip_floor)` (0 for the literature's map; the
-/// rounding of u_t for the verdict's, see [`rounding_floor`]).
+/// slip `||u_t||` counted by [`counted_slip`] above `slip_floor` (0 for the literature's map;
+/// the rounding of u_t for the verdict's, see [`rounding_floor`]).
 fn de_saxce_residual(r: &[f64], u: &[f64], mu: f64, slip_floor: f64) -> [f64; 3] {
     let dim = r.len();
     let mut v = [0.0; 3];
-    let slip = (tangent_norm(&u[1..dim]) - slip_floor).max(0.0);
+    let slip = counted_slip(tangent_norm(&u[1..dim]), slip_floor);
     v[0] = r[0] - (u[0] + mu * slip);
     for k in 1..dim {
         v[k] = r[k] - u[k];
@@ -541,7 +559,7 @@ mod tests {
         assert!(norm2(&[f64::NAN, 1.0]).is_nan());
         assert_eq!(norm2(&[f64::INFINITY, 1.0]), f64::INFINITY);
         assert_eq!(norm2(&[0.0, -0.0]), 0.0);
-        // r = 0 for the seed's step at 1e-200: measured as at scale 1, not as 0
+        // r = 0 for the chapter's inelastic step at 1e-200: measured as at scale 1, not as 0
         let (w, q) = ([0.5e-200, 0.0, 0.0, 0.5e-200], [-3e-200, 1e-200]);
         let p = ContactProblem::new(2, &w, &q, &[0.2]).unwrap();
         let (_, m) = measure(&p, &[0.0, 0.0]).unwrap();
@@ -553,7 +571,7 @@ mod tests {
     }
 
     #[test]
-    fn measures_of_the_seed_answer_and_of_zero() {
+    fn measures_of_the_chapter_answer_and_of_zero() {
         let w = [0.5, 0.0, 0.0, 0.5];
         let q = [-3.0, 1.0];
         let p = ContactProblem::new(2, &w, &q, &[0.2]).unwrap();

@@ -1,4 +1,4 @@
-//! Frictional contact over a frozen Delassus matrix (DESIGN.md, part 2):
+//! Frictional contact over a frozen Delassus matrix (Jean 1999; Acary and Brogliato 2008):
 //!
 //! ```text
 //!     u = W r + q,   per contact i:  K_i ∋ r_i  ⊥  u_i + mu_i ||u_{t,i}|| n  ∈ K_i^*,
@@ -488,7 +488,7 @@ mod tests {
         ));
         let a = p.with_anisotropic_friction(&[0.2, 0.5]).unwrap();
         assert!(!a.is_isotropic() && a.anisotropy(0) == Some([0.2, 0.5]));
-        // sliding along t1 with mu_1 = 0.2: the seed's answer, zero error
+        // sliding along t1 with mu_1 = 0.2: the chapter's answer, zero error
         let (u, m) = measure(&a, &[6.0, -1.2, 0.0]).unwrap();
         assert!((u[1] - 0.4).abs() < 1e-15);
         assert!(m.error < 1e-15 && m.cone_violation == 0.0, "{m:?}");

@@ -1,6 +1,6 @@
-//! The polyhedral-cone (Stewart-Trinkle) contact LCP, solved by Lemke's method (the seed's
-//! "Polyhedral approximation of the friction cone", "Friction selection as complementarity"
-//! and "The inelastic step as an LCP").
+//! The polyhedral-cone (Stewart-Trinkle) contact LCP, solved by Lemke's method: the friction
+//! disk replaced by a polygon of tangent directions, friction selected by complementarity, and
+//! the inelastic step written as one LCP (Stewart and Trinkle 1996; Stewart 2000).
 //!
 //! Per frictional contact i (`mu_i > 0`) the friction disk is replaced by the polygon spanned
 //! by `s` unit tangent directions in ± pairs, `D_i = [d_1 … d_s]`, with
@@ -27,8 +27,8 @@
 //! last row are pure numbers (mu, ±1), and b holds velocities and zeros. Lemke's pivot
 //! tolerances are relative to the entries, so with W and q of order 1e-10 the λ column looked
 //! like the large entries and the W blocks like rounding: friction was dropped (r = (6, 0) for
-//! the seed's step scaled by 1e-10, instead of (6, -1.2)). The LCP is therefore assembled in
-//! balanced units: per frictional contact, with `c_i = 1 / rho_i` its normal stiffness
+//! the chapter's inelastic step scaled by 1e-10, instead of (6, -1.2)). The LCP is therefore
+//! assembled in balanced units: per frictional contact, with `c_i = 1 / rho_i` its normal stiffness
 //! `W_nn,i` (the scale of [`super::measures`]), the λ column is multiplied by `c_i` and the last
 //! row too,
 //!
@@ -66,6 +66,7 @@
 use super::{measure_into, ContactProblem, ContactSolution, ContactStatus};
 use crate::error::{CoulombError, Result};
 use crate::lcp::{solve_lemke, LcpRef, LcpSolution, LcpStatus, LemkeEngine, LemkeSettings};
+use crate::readable::Readable;
 
 /// Settings of [`solve_polyhedral`].
 #[derive(Clone, Debug)]
@@ -402,17 +403,22 @@ pub fn solve_polyhedral_lcp(
         LcpStatus::Solved if problem.dim == 2 && !measures.passes(settings.lemke.tol) => (
             ContactStatus::NumericalFailure,
             format!(
-                "{what} solved by Lemke in {} pivots (LCP error {:.2e}), but the impulses miss \
-                 the tolerance on the contact problem (scaled_error {:.2e} > tol {:.1e})",
-                ls.pivots, lm.error, measures.scaled_error, settings.lemke.tol
+                "{what} solved by Lemke in {} pivots (LCP error {}), but the impulses miss \
+                 the tolerance on the contact problem (scaled_error {} > tol {})",
+                ls.pivots,
+                Readable(lm.error),
+                Readable(measures.scaled_error),
+                Readable(settings.lemke.tol)
             ),
         ),
         LcpStatus::Solved => (
             ContactStatus::Solved,
             format!(
-                "{what} solved by Lemke in {} pivots (LCP error {:.2e}; against the exact disk \
-                 scaled_error {:.2e})",
-                ls.pivots, lm.error, measures.scaled_error
+                "{what} solved by Lemke in {} pivots (LCP error {}; against the exact disk \
+                 scaled_error {})",
+                ls.pivots,
+                Readable(lm.error),
+                Readable(measures.scaled_error)
             ),
         ),
         LcpStatus::PivotLimit => (
@@ -449,7 +455,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_seed_lcp_is_assembled_as_on_the_slide() {
+    fn the_chapter_lcp_is_assembled_as_on_the_slide() {
         let w = [0.5, 0.0, 0.0, 0.5];
         let q = [-3.0, 1.0];
         let p = ContactProblem::new(2, &w, &q, &[0.2]).unwrap();

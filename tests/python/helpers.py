@@ -226,7 +226,8 @@ def contact_scaled_error(W: Array, q: Array, mu: Array, dim: int, r: Array) -> f
     positive ``W_nn`` for a contact whose own is not positive or below 1e-12 times it), the
     worst contact's larger of De Saxce's and Alart-Curnier's natural maps in impulse units,
     relative to ``max(||r_i||, rho_i ||(|W| |r| + |q|)_i||)``; in De Saxce's map the slip
-    ``||u_t||`` counts above its rounding, ``(n + 3) eps ||(|W| |r| + |q|)_t||``."""
+    ``s = ||u_t||`` counts above its rounding ``f = (n + 3) eps ||(|W| |r| + |q|)_t||``, as
+    ``s - f^2 / s`` (0 below f)."""
     r = np.asarray(r, dtype=float).reshape(-1)
     q = np.asarray(q, dtype=float)
     W = np.asarray(W, dtype=float)
@@ -247,7 +248,8 @@ def contact_scaled_error(W: Array, q: Array, mu: Array, dim: int, r: Array) -> f
         ri, su = r[s], rho[i] * u[s]
         v = ri - su
         floor = (r.size + 3) * np.finfo(float).eps * np.linalg.norm(terms[s][1:])
-        v[0] -= m * rho[i] * max(0.0, np.linalg.norm(u[s][1:]) - floor)
+        slip = float(np.linalg.norm(u[s][1:]))
+        v[0] -= m * rho[i] * (0.0 if slip <= floor else slip - floor * (floor / slip))
         ds = ri - project_coulomb_cone(v, float(m))
         x = ri[1:] - su[1:]
         radius = m * max(ri[0], 0.0)

@@ -1,4 +1,5 @@
-//! Lemke's complementary pivoting method (the seed's "What the LCP solver guarantees").
+//! Lemke's complementary pivoting method (Cottle, Pang and Stone 1992; Stewart 2000 on what
+//! it guarantees for contact LCPs).
 //!
 //! With a covering vector d > 0 and an artificial variable z0 >= 0, Lemke follows the
 //! almost-complementary path of
@@ -41,6 +42,7 @@ use super::revised::{PathEnd, RevisedLemke};
 use super::scaling::Equilibration;
 use super::{check_tol, passes, LcpRef, LcpSolution, LcpStatus, WarmStart};
 use crate::error::{check_finite, CoulombError, Result};
+use crate::readable::Readable;
 use answer::{better, candidate, principal, with_fallback_note, Candidate};
 pub use tableau::LemkeWorkspace;
 
@@ -344,10 +346,10 @@ fn verdict(
         Ending::Ray | Ending::Limit if passes(&m, tol) => {
             out.status = LcpStatus::Solved;
             out.message = format!(
-                "solved in {} pivots (error {:.2e}{}; the path ended on {}, but the answer \
+                "solved in {} pivots (error {}{}; the path ended on {}, but the answer \
                  there passes tol)",
                 out.pivots,
-                m.error,
+                Readable(m.error),
                 if polished { ", polished" } else { "" },
                 if ending == Ending::Ray {
                     "a ray"
@@ -360,9 +362,9 @@ fn verdict(
         Ending::Terminal if passes(&m, tol) => {
             out.status = LcpStatus::Solved;
             out.message = format!(
-                "solved in {} pivots (error {:.2e}{})",
+                "solved in {} pivots (error {}{})",
                 out.pivots,
-                m.error,
+                Readable(m.error),
                 if polished { ", polished" } else { "" }
             );
             return true;
@@ -370,9 +372,11 @@ fn verdict(
         Ending::Terminal => {
             out.status = LcpStatus::NumericalFailure;
             out.message = format!(
-                "z0 left the basis but the answer fails tol {tol:.1e}: error {:.2e}, \
-                 scaled error {:.2e} (ill-conditioned basis)",
-                m.error, m.scaled_error
+                "z0 left the basis but the answer fails tol {}: error {}, \
+                 scaled error {} (ill-conditioned basis)",
+                Readable(tol),
+                Readable(m.error),
+                Readable(m.scaled_error)
             );
             return true;
         }
@@ -389,8 +393,8 @@ fn verdict(
         Ending::Limit => {
             out.status = LcpStatus::PivotLimit;
             out.message = format!(
-                "stopped at the pivot limit ({max_pivots}) with error {:.2e}",
-                m.error
+                "stopped at the pivot limit ({max_pivots}) with error {}",
+                Readable(m.error)
             );
             return true;
         }
@@ -505,7 +509,7 @@ mod tests {
     }
 
     #[test]
-    fn seed_scalar_lcp_w_equals_2z_minus_6() {
+    fn chapter_scalar_lcp_w_equals_2z_minus_6() {
         let s = lemke(1, &[2.0], &[-6.0]);
         assert_eq!(s.status, LcpStatus::Solved);
         assert!((s.z[0] - 3.0).abs() < 1e-14);
@@ -513,7 +517,7 @@ mod tests {
     }
 
     #[test]
-    fn seed_scalar_lcp_w_equals_minus_z_minus_1_has_no_solution() {
+    fn chapter_scalar_lcp_w_equals_minus_z_minus_1_has_no_solution() {
         let s = lemke(1, &[-1.0], &[-1.0]);
         assert_eq!(s.status, LcpStatus::RayTermination);
         assert!(!s.success());
