@@ -80,7 +80,10 @@ that same test.
     for a large mu: ``mu ||u_t||`` hides an approaching contact, so with mu = 1e8 the answer
     r = 0 of a contact that must push looked solved). ``scaled_error`` is the worst contact's
     ``max(||e_i||, ||a_i||)`` divided by its own impulse scale
-    ``max(||r_i||, rho_i ||(|W| |r| + |q|)_i||)``. Multiplying impulse units by a and velocity
+    ``max(||r_i||, rho_i ||(|W| |r| + |q|)_i||)``. A slip ``s = ||u_t,i||`` below its own
+    rounding ``f = (n + 3) eps ||(|W| |r| + |q|)_t,i||`` counts as none (above it, as
+    ``s - f^2/s``), so a sticking contact with mu up to 1e12 solved to rounding is solved in
+    every unit system instead of turning ``mu`` times its rounding into an error. Multiplying impulse units by a and velocity
     units by b (``W -> (b/a) W``, ``q -> b q``) leaves it unchanged, and so ``success`` and
     ``status``; ``error`` and ``error_q`` add velocities to impulses and change with the
     units, so they are reported, never used for the verdict (at W of order 1e-5 they accepted
@@ -147,7 +150,8 @@ class ContactResult(Result):
         True exactly when ``scaled_error <= tol`` (for ``"lemke"`` in 3D: when the polyhedral
         LCP was solved).
     status : str
-        ``"solved"``, ``"iteration_limit"`` or ``"numerical_failure"``.
+        ``"solved"``, ``"iteration_limit"`` (the budget was spent: ``max_iter`` sweeps, or
+        every restart of ``"prox"`` stalled) or ``"numerical_failure"``.
     message : str
         One line for a person.
     iterations : int
