@@ -30,7 +30,11 @@ enum Repr2 {
 
 /// A validated 2D shape in its body frame.
 #[derive(Clone)]
-pub struct Shape2(Repr2);
+pub struct Shape2 {
+    repr: Repr2,
+    /// a number unique to the shape (kept by clones), naming it in contact caches.
+    id: u64,
+}
 
 impl std::fmt::Debug for Shape2 {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -51,7 +55,7 @@ pub(crate) fn check_pose2(name: &str, pose: &Isometry2<f64>) -> Result<()> {
 impl Shape2 {
     /// A disk of `radius > 0`.
     pub fn disk(radius: f64) -> Result<Self> {
-        Ok(Self(Repr2::Disk(Ball::new(positive(
+        Ok(Self::new(Repr2::Disk(Ball::new(positive(
             "disk radius",
             radius,
         )?))))
@@ -75,7 +79,7 @@ impl Shape2 {
         }
         let pts: Vec<Point2<f64>> = points.iter().map(|&p| p.into()).collect();
         ConvexPolygon::from_convex_hull(&pts)
-            .map(|p| Self(Repr2::ConvexPolygon(p)))
+            .map(|p| Self::new(Repr2::ConvexPolygon(p)))
             .ok_or_else(|| {
                 CoulombError::InvalidParameter("convex polygon could not be built".to_string())
             })
@@ -91,14 +95,18 @@ impl Shape2 {
                 "segment from {a:?} to {b:?} has zero length"
             )));
         }
-        Ok(Self(Repr2::Segment(Segment::new(a.into(), b.into()))))
+        Ok(Self::new(Repr2::Segment(Segment::new(a.into(), b.into()))))
     }
 
     /// The points within `radius > 0` of the segment `[a, b]`.
     pub fn capsule(a: [f64; 2], b: [f64; 2], radius: f64) -> Result<Self> {
         finite_points("capsule segment", &[a, b])?;
         let r = positive("capsule radius", radius)?;
-        Ok(Self(Repr2::Capsule(Capsule::new(a.into(), b.into(), r))))
+        Ok(Self::new(Repr2::Capsule(Capsule::new(
+            a.into(),
+            b.into(),
+            r,
+        ))))
     }
 
     /// The half-plane `{x : n · x <= 0}` of outward `normal` (finite, nonzero; normalised).
@@ -107,12 +115,28 @@ impl Shape2 {
         let n = Unit::try_new(Vector2::from(normal), f64::MIN_POSITIVE).ok_or_else(|| {
             CoulombError::InvalidParameter("half-space normal is zero".to_string())
         })?;
-        Ok(Self(Repr2::HalfSpace(HalfSpace::new(n))))
+        Ok(Self::new(Repr2::HalfSpace(HalfSpace::new(n))))
+    }
+
+    fn new(repr: Repr2) -> Self {
+        Self {
+            repr,
+            id: super::validate::next_shape_id(),
+        }
+    }
+
+    pub(crate) fn id(&self) -> u64 {
+        self.id
+    }
+
+    /// The parry shape scaled by `k > 0` (exactly, for `k` a power of two).
+    pub(crate) fn scaled_parry(&self, k: f64) -> Option<Box<dyn ParryShape>> {
+        self.parry().scale_dyn(&Vector2::repeat(k), 0)
     }
 
     /// Which shape this is.
     pub fn kind(&self) -> ShapeKind2 {
-        match &self.0 {
+        match &self.repr {
             Repr2::Disk(_) => ShapeKind2::Disk,
             Repr2::ConvexPolygon(_) => ShapeKind2::ConvexPolygon,
             Repr2::Segment(_) => ShapeKind2::Segment,
@@ -128,13 +152,20 @@ impl Shape2 {
 
     /// The parry shape (the narrow phase's boundary).
     pub(crate) fn parry(&self) -> &dyn ParryShape {
-        match &self.0 {
+        match &self.repr {
             Repr2::Disk(s) => s,
             Repr2::ConvexPolygon(s) => s,
             Repr2::Segment(s) => s,
             Repr2::Capsule(s) => s,
             Repr2::HalfSpace(s) => s,
         }
+    }
+
+    /// The half diagonal of the shape's bounding box in its frame; `None` for a half-space.
+    pub(crate) fn size(&self) -> Option<f64> {
+        let b = self.parry().compute_local_aabb();
+        let d = 0.5 * (b.maxs - b.mins).norm();
+        (d.is_finite() && d > 0.0).then_some(d)
     }
 
     /// The axis-aligned bounding box `(min, max)` at `pose` (infinite for a half-space).

@@ -9,7 +9,7 @@
 use nalgebra::{DMatrix, Isometry3, Point3, Unit, Vector3};
 use parry3d_f64::shape::{
     Ball, Capsule, Compound, Cone, ConvexPolyhedron, Cuboid, Cylinder, HalfSpace, HeightField,
-    Shape as ParryShape, SharedShape, TriMesh, TriMeshFlags,
+    HeightFieldFlags, Shape as ParryShape, SharedShape, TriMesh, TriMeshFlags,
 };
 
 use super::validate::{extent, finite_points, positive, spans_3d, triangle_area2, FLAT};
@@ -47,7 +47,11 @@ enum Repr3 {
 
 /// A validated 3D shape in its body frame.
 #[derive(Clone)]
-pub struct Shape3(Repr3);
+pub struct Shape3 {
+    repr: Repr3,
+    /// a number unique to the shape (kept by clones), naming it in contact caches.
+    id: u64,
+}
 
 impl std::fmt::Debug for Shape3 {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -72,7 +76,7 @@ pub(crate) fn check_pose3(name: &str, pose: &Isometry3<f64>) -> Result<()> {
 impl Shape3 {
     /// A ball of `radius > 0`.
     pub fn sphere(radius: f64) -> Result<Self> {
-        Ok(Self(Repr3::Sphere(Ball::new(positive(
+        Ok(Self::new(Repr3::Sphere(Ball::new(positive(
             "sphere radius",
             radius,
         )?))))
@@ -86,28 +90,32 @@ impl Shape3 {
             positive("box half extent y", y)?,
             positive("box half extent z", z)?,
         );
-        Ok(Self(Repr3::Cuboid(Cuboid::new(v))))
+        Ok(Self::new(Repr3::Cuboid(Cuboid::new(v))))
     }
 
     /// The points within `radius > 0` of the segment `[a, b]` (`a == b` gives a sphere).
     pub fn capsule(a: [f64; 3], b: [f64; 3], radius: f64) -> Result<Self> {
         finite_points("capsule segment", &[a, b])?;
         let r = positive("capsule radius", radius)?;
-        Ok(Self(Repr3::Capsule(Capsule::new(a.into(), b.into(), r))))
+        Ok(Self::new(Repr3::Capsule(Capsule::new(
+            a.into(),
+            b.into(),
+            r,
+        ))))
     }
 
     /// A cylinder along y of half height `half_height > 0` and `radius > 0`.
     pub fn cylinder(half_height: f64, radius: f64) -> Result<Self> {
         let h = positive("cylinder half height", half_height)?;
         let r = positive("cylinder radius", radius)?;
-        Ok(Self(Repr3::Cylinder(Cylinder::new(h, r))))
+        Ok(Self::new(Repr3::Cylinder(Cylinder::new(h, r))))
     }
 
     /// A cone along y (apex at `+half_height`) with base `radius > 0`.
     pub fn cone(half_height: f64, radius: f64) -> Result<Self> {
         let h = positive("cone half height", half_height)?;
         let r = positive("cone radius", radius)?;
-        Ok(Self(Repr3::Cone(Cone::new(h, r))))
+        Ok(Self::new(Repr3::Cone(Cone::new(h, r))))
     }
 
     /// The convex hull of `points`: finite, and not all on one plane (relative to their
@@ -122,7 +130,7 @@ impl Shape3 {
         }
         let pts: Vec<Point3<f64>> = points.iter().map(|&p| p.into()).collect();
         ConvexPolyhedron::from_convex_hull(&pts)
-            .map(|h| Self(Repr3::ConvexHull(h)))
+            .map(|h| Self::new(Repr3::ConvexHull(h)))
             .ok_or_else(|| {
                 CoulombError::InvalidParameter("convex hull could not be built".to_string())
             })
@@ -147,11 +155,12 @@ impl Shape3 {
             }
             shared.push((*pose, part.shared()));
         }
-        Ok(Self(Repr3::Compound(Compound::new(shared))))
+        Ok(Self::new(Repr3::Compound(Compound::new(shared))))
     }
 
-    /// A static triangle mesh: `vertices` finite, `triangles` indexing them, no triangle of
-    /// area below `FLAT L^2` (`L` the mesh's extent), and no edge shared by more than two
+    /// A static triangle mesh: `vertices` finite, `triangles` indexing them, wound counter-
+    /// clockwise seen from outside (the side contacts come from) and consistently, no triangle
+    /// of area below `FLAT L^2` (`L` the mesh's extent), and no edge shared by more than two
     /// triangles (manifold).
     pub fn triangle_mesh(vertices: &[[f64; 3]], triangles: &[[u32; 3]]) -> Result<Self> {
         finite_points("triangle mesh vertices", vertices)?;
@@ -189,9 +198,17 @@ impl Shape3 {
             }
         }
         let verts: Vec<Point3<f64>> = vertices.iter().map(|&p| p.into()).collect();
-        TriMesh::with_flags(verts, triangles.to_vec(), TriMeshFlags::empty())
-            .map(|m| Self(Repr3::TriangleMesh(m)))
-            .map_err(|e| CoulombError::InvalidParameter(format!("triangle mesh: {e}")))
+        let mut mesh = TriMesh::new(verts, triangles.to_vec())
+            .map_err(|e| CoulombError::InvalidParameter(format!("triangle mesh: {e}")))?;
+        // oriented, with its internal edges fixed: a contact on an edge or vertex between
+        // triangles gets a normal within the cone of the adjacent faces' normals
+        mesh.set_flags(TriMeshFlags::ORIENTED | TriMeshFlags::FIX_INTERNAL_EDGES)
+            .map_err(|e| {
+                CoulombError::InvalidParameter(format!(
+                    "triangle mesh topology (orientation or manifoldness): {e}"
+                ))
+            })?;
+        Ok(Self::new(Repr3::TriangleMesh(mesh)))
     }
 
     /// A static heightfield over the x-z square `[-sx/2, sx/2] x [-sz/2, sz/2]`: `heights`
@@ -212,7 +229,11 @@ impl Shape3 {
             positive("heightfield scale z", scale[2])?,
         );
         let h = DMatrix::from_row_slice(rows, cols, heights);
-        Ok(Self(Repr3::Heightfield(HeightField::new(h, s))))
+        Ok(Self::new(Repr3::Heightfield(HeightField::with_flags(
+            h,
+            s,
+            HeightFieldFlags::FIX_INTERNAL_EDGES,
+        ))))
     }
 
     /// The half-space `{x : n · x <= 0}` of outward `normal` (finite, nonzero; normalised).
@@ -221,12 +242,28 @@ impl Shape3 {
         let n = Unit::try_new(Vector3::from(normal), f64::MIN_POSITIVE).ok_or_else(|| {
             CoulombError::InvalidParameter("half-space normal is zero".to_string())
         })?;
-        Ok(Self(Repr3::HalfSpace(HalfSpace::new(n))))
+        Ok(Self::new(Repr3::HalfSpace(HalfSpace::new(n))))
+    }
+
+    fn new(repr: Repr3) -> Self {
+        Self {
+            repr,
+            id: super::validate::next_shape_id(),
+        }
+    }
+
+    pub(crate) fn id(&self) -> u64 {
+        self.id
+    }
+
+    /// The parry shape scaled by `k > 0` (exactly, for `k` a power of two).
+    pub(crate) fn scaled_parry(&self, k: f64) -> Option<Box<dyn ParryShape>> {
+        self.parry().scale_dyn(&Vector3::repeat(k), 0)
     }
 
     /// Which shape this is.
     pub fn kind(&self) -> ShapeKind3 {
-        match &self.0 {
+        match &self.repr {
             Repr3::Sphere(_) => ShapeKind3::Sphere,
             Repr3::Cuboid(_) => ShapeKind3::Cuboid,
             Repr3::Capsule(_) => ShapeKind3::Capsule,
@@ -255,7 +292,7 @@ impl Shape3 {
 
     /// The parry shape (the narrow phase's boundary).
     pub(crate) fn parry(&self) -> &dyn ParryShape {
-        match &self.0 {
+        match &self.repr {
             Repr3::Sphere(s) => s,
             Repr3::Cuboid(s) => s,
             Repr3::Capsule(s) => s,
@@ -271,6 +308,13 @@ impl Shape3 {
 
     fn shared(&self) -> SharedShape {
         SharedShape(self.parry().clone_dyn().into())
+    }
+
+    /// The half diagonal of the shape's bounding box in its frame; `None` for a half-space.
+    pub(crate) fn size(&self) -> Option<f64> {
+        let b = self.parry().compute_local_aabb();
+        let d = 0.5 * (b.maxs - b.mins).norm();
+        (d.is_finite() && d > 0.0).then_some(d)
     }
 
     /// The axis-aligned bounding box `(min, max)` of the shape at `pose` (infinite for a

@@ -2,6 +2,12 @@
 
 use crate::error::{CoulombError, Result};
 
+/// A fresh shape id.
+pub(crate) fn next_shape_id() -> u64 {
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
+    NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+}
+
 /// `value` finite and > 0.
 pub(crate) fn positive(name: &str, value: f64) -> Result<f64> {
     if !value.is_finite() {
