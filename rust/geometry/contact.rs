@@ -20,10 +20,12 @@ use nalgebra::{Isometry2, Isometry3, Point2, Point3, Vector2, Vector3};
 use parry2d_f64::query::{
     ContactManifold as Manifold2, ContactManifoldsWorkspace as Workspace2,
     DefaultQueryDispatcher as Dispatcher2, PersistentQueryDispatcher as _,
+    TrackedContact as Tracked2,
 };
 use parry3d_f64::query::{
     ContactManifold as Manifold3, ContactManifoldsWorkspace as Workspace3,
     DefaultQueryDispatcher as Dispatcher3, PersistentQueryDispatcher as _,
+    TrackedContact as Tracked3,
 };
 
 use parry2d_f64::shape::Shape as Parry2;
@@ -104,6 +106,9 @@ fn unit_of(size: f64) -> f64 {
     2f64.powi(e)
 }
 
+/// Depth (in the query's unit) by which GJK's extra point must beat the clipped ones to stay.
+const REDUNDANT: f64 = 1e-9;
+
 /// Relative size of the pull-apart of the second query (see [`contacts3`]).
 const PULL: f64 = 1e-8;
 /// Relative gap at or below which the second query is made.
@@ -143,7 +148,7 @@ fn unsupported(what: String) -> CoulombError {
 macro_rules! contacts_impl {
     ($(#[$doc:meta])* $name:ident, $raw:ident, $shape:ty, $iso:ident, $vec:ident, $point:ident,
      $cache:ident, $dispatcher:ident, $check_pose:ident, $manifold:ty, $workspace:ty,
-     $dynshape:ty) => {
+     $dynshape:ty, $tracked:ident) => {
         /// parry's manifolds of `a` at `pose_a` and `b` at `pose_b` translated by `shift`,
         /// converted; gaps taken back to the unshifted poses (`g - n · shift`, exact while the
         /// same features touch), kept when `<= prediction`.
@@ -180,7 +185,22 @@ macro_rules! contacts_impl {
                 let part_b = m.subshape_pos2.unwrap_or_else($iso::identity);
                 let normal = pose_a.rotation * (part_a.rotation * m.local_n1);
                 let back = normal.dot(&shift);
+                // parry adds GJK's closest pair (features unknown) to the clipped points in 3D:
+                // dropped when a clipped point is at least as deep (it lies among them)
+                let unknown = |p: &&_| {
+                    let p: &$tracked<()> = p;
+                    p.fid1.is_unknown() && p.fid2.is_unknown()
+                };
+                let known = m
+                    .points
+                    .iter()
+                    .filter(|p| !unknown(p))
+                    .map(|p| p.dist)
+                    .fold(f64::INFINITY, f64::min);
                 for p in &m.points {
+                    if unknown(&p) && known <= p.dist + REDUNDANT {
+                        continue;
+                    }
                     let gap = p.dist * unit - back;
                     if gap <= prediction {
                         out.push($point {
@@ -281,11 +301,11 @@ contacts_impl!(
     /// `n · shift`), and the answer with the larger deepest gap is kept (the second one unless
     /// the first beats it by more than `1e-12 L`).
     contacts3, raw3, Shape3, Isometry3, Vector3, ContactPoint3, ContactCache3, Dispatcher3,
-    check_pose3, Manifold3<(), ()>, Workspace3, dyn Parry3
+    check_pose3, Manifold3<(), ()>, Workspace3, dyn Parry3, Tracked3
 );
 
 contacts_impl!(
     /// [`contacts3`] in 2D.
     contacts2, raw2, Shape2, Isometry2, Vector2, ContactPoint2, ContactCache2, Dispatcher2,
-    check_pose2, Manifold2<(), ()>, Workspace2, dyn Parry2
+    check_pose2, Manifold2<(), ()>, Workspace2, dyn Parry2, Tracked2
 );

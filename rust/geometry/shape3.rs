@@ -8,7 +8,7 @@
 
 use nalgebra::{DMatrix, Isometry3, Point3, Unit, Vector3};
 use parry3d_f64::shape::{
-    Ball, Capsule, Compound, Cone, ConvexPolyhedron, Cuboid, Cylinder, HalfSpace, HeightField,
+    Ball, Capsule, Compound, Cone, ConvexPolyhedron, Cylinder, HalfSpace, HeightField,
     HeightFieldFlags, Shape as ParryShape, SharedShape, TriMesh, TriMeshFlags,
 };
 
@@ -34,7 +34,7 @@ pub enum ShapeKind3 {
 #[derive(Clone)]
 enum Repr3 {
     Sphere(Ball),
-    Cuboid(Cuboid),
+    Cuboid(ConvexPolyhedron),
     Capsule(Capsule),
     Cylinder(Cylinder),
     Cone(Cone),
@@ -83,14 +83,27 @@ impl Shape3 {
     }
 
     /// A box with half side lengths `half_extents`, each > 0.
+    ///
+    /// Held as the convex polyhedron of its 8 corners: parry's own box-box manifold is a
+    /// separating-axis test whose "gap" between separated boxes is the largest axis
+    /// separation (a lower bound of the distance), and which can return no point for boxes
+    /// within the prediction distance corner to corner; the polyhedron goes through GJK and
+    /// gives the distance.
     pub fn cuboid(half_extents: [f64; 3]) -> Result<Self> {
         let [x, y, z] = half_extents;
-        let v = Vector3::new(
+        let (x, y, z) = (
             positive("box half extent x", x)?,
             positive("box half extent y", y)?,
             positive("box half extent z", z)?,
         );
-        Ok(Self::new(Repr3::Cuboid(Cuboid::new(v))))
+        let mut corners = Vec::with_capacity(8);
+        for k in 0..8 {
+            let sign = |bit: usize| if k & bit == 0 { -1.0 } else { 1.0 };
+            corners.push(Point3::new(sign(1) * x, sign(2) * y, sign(4) * z));
+        }
+        ConvexPolyhedron::from_convex_hull(&corners)
+            .map(|h| Self::new(Repr3::Cuboid(h)))
+            .ok_or_else(|| CoulombError::InvalidParameter("box could not be built".to_string()))
     }
 
     /// The points within `radius > 0` of the segment `[a, b]` (`a == b` gives a sphere).
