@@ -945,3 +945,155 @@ proptest! {
         prop_assert!(note(kind_of(&p, "scale normal"), (big.normal - one.normal).norm()) < normal_tol(&p));
     }
 }
+
+fn ids3(pts: &[ContactPoint3]) -> Vec<coulomb::geometry::ContactId> {
+    let mut v: Vec<_> = pts.iter().map(|p| p.id).collect();
+    v.sort_unstable();
+    v
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(128))]
+
+    /// A box resting on a floor (a half-space, a mesh) or a box, tilted a little: a small
+    /// slide, twist and tilt keeps the same corners on the same face, so the same ids.
+    #[test]
+    fn contact_ids_are_stable_under_a_small_motion_that_keeps_the_features(
+        d in [0.2f64..1.0, 0.2f64..1.0, 0.2f64..1.0],
+        tilt in [-0.05f64..0.05, -0.05f64..0.05],
+        slide in [-1e-3f64..1e-3, -1e-3f64..1e-3, -1e-4f64..1e-4],
+        twist in [-1e-3f64..1e-3, -1e-3f64..1e-3, -1e-3f64..1e-3],
+        floor_kind in 0u8..3,
+    ) {
+        let b = build3(&Desc3 { kind: 1, d }, 1.0);
+        let (floor, fp) = match floor_kind {
+            0 => floor(),
+            1 => {
+                let v = [[-5.0, -5.0, 0.0], [5.0, -5.0, 0.0], [5.0, 5.0, 0.0], [-5.0, 5.0, 0.0]];
+                (ok(Shape3::triangle_mesh(&v, &[[0, 1, 2], [0, 2, 3]])), Isometry3::identity())
+            }
+            _ => (ok(Shape3::cuboid([3.0, 3.0, 0.5])), Isometry3::translation(0.0, 0.0, -0.5)),
+        };
+        // lowest corner at height 1e-3 above the floor
+        let rot = Isometry3::rotation(Vector3::new(tilt[0], tilt[1], 0.0));
+        let low = (0..8)
+            .map(|k| {
+                let c = Point3::new(
+                    if k & 1 == 0 { -d[0] } else { d[0] },
+                    if k & 2 == 0 { -d[1] } else { d[1] },
+                    if k & 4 == 0 { -d[2] } else { d[2] },
+                );
+                (rot * c).z
+            })
+            .fold(f64::INFINITY, f64::min);
+        let pose = Isometry3::translation(0.1, -0.2, 1e-3 - low) * rot;
+        let moved = Isometry3::new(Vector3::from(slide), Vector3::from(twist)) * pose;
+        let pred = 0.2;
+        let mut cache = ContactCache3::default();
+        let mut before = Vec::new();
+        ok(contacts3(&floor, &fp, &b, &pose, pred, &mut cache, &mut before));
+        let mut after = Vec::new();
+        ok(contacts3(&floor, &fp, &b, &moved, pred, &mut cache, &mut after));
+        prop_assert!(!before.is_empty());
+        prop_assert_eq!(ids3(&before), ids3(&after));
+        // ids are distinct within a manifold
+        let ids = ids3(&before);
+        let mut dedup = ids.clone();
+        dedup.dedup();
+        prop_assert_eq!(ids.len(), dedup.len());
+    }
+
+    #[test]
+    fn the_broad_phase_finds_the_brute_force_pairs_over_any_scene(
+        shapes in proptest::collection::vec((0u8..8, [0.05f64..1.0, 0.05f64..1.0, 0.05f64..1.0]), 0..60),
+        poses in proptest::collection::vec(([-3.0f64..3.0, -3.0f64..3.0, -3.0f64..3.0], [-3.0f64..3.0, -3.0f64..3.0, -3.0f64..3.0]), 60),
+        scale_exp in -3.0f64..3.0,
+        two_d in any::<bool>(),
+    ) {
+        let s = 10f64.powf(scale_exp);
+        let mut boxes: Vec<Aabb> = Vec::new();
+        for (k, (kind, d)) in shapes.iter().enumerate() {
+            let (t, r) = poses[k];
+            let t = Vector3::from(t) * s;
+            if two_d {
+                let shape = match kind % 4 {
+                    0 => ok(Shape2::disk(d[0] * s)),
+                    1 => ok(Shape2::rectangle([d[0] * s, d[1] * s])),
+                    2 => ok(Shape2::capsule([0.0, -d[1] * s], [0.0, d[1] * s], d[0] * s)),
+                    _ => ok(Shape2::half_space([d[0], d[1] - 0.5])),
+                };
+                let pose = Isometry2::new(Vector2::new(t.x, t.y), r[0]);
+                boxes.push(lift2(shape.aabb(&pose)));
+            } else {
+                let shape = build3(&Desc3 { kind: *kind, d: *d }, s);
+                boxes.push(shape.aabb(&Isometry3::new(t, Vector3::from(r))));
+            }
+        }
+        let mut grid = AabbBroadPhase::new();
+        let mut got = Vec::new();
+        grid.pairs(&boxes, &mut got);
+        got.sort_unstable();
+        let mut want = Vec::new();
+        for i in 0..boxes.len() {
+            for j in i + 1..boxes.len() {
+                if boxes_meet(&boxes[i], &boxes[j]) {
+                    want.push((i as u32, j as u32));
+                }
+            }
+        }
+        prop_assert_eq!(got, want);
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(256))]
+
+    /// 2D: swap, rigid motion and scale over disks, polygons, segments, capsules and
+    /// half-planes, separated.
+    #[test]
+    fn in_2d_swap_motion_and_scale_keep_the_gap(
+        ka in 0u8..4, kb in 0u8..5,
+        da in [0.2f64..1.0, 0.2f64..1.0], db in [0.2f64..1.0, 0.2f64..1.0],
+        ra in -3.0f64..3.0, rb in -3.0f64..3.0, dir in -3.2f64..3.2, margin in 0.01f64..0.5,
+        motion in ([-2.0f64..2.0, -2.0f64..2.0], -3.0f64..3.0), e in -4.0f64..4.0,
+    ) {
+        let build = |k: u8, d: [f64; 2], s: f64| -> (Shape2, f64) {
+            let [x, y] = d.map(|v| v * s);
+            match k {
+                0 => (ok(Shape2::disk(x)), x),
+                1 => (ok(Shape2::convex_polygon(&[[x, 0.0], [0.0, y], [-x, 0.0], [0.3 * x, -y]])), x.max(y)),
+                2 => (ok(Shape2::segment([-x, 0.0], [x, 0.0])), x),
+                3 => (ok(Shape2::capsule([0.0, -y], [0.0, y], x)), x + y),
+                _ => (ok(Shape2::half_space([0.0, 1.0])), 0.0),
+            }
+        };
+        let u = Vector2::new(dir.cos(), dir.sin());
+        let place = |s: f64| {
+            let (a, r_a) = build(ka, da, s);
+            let (b, r_b) = build(kb, db, s);
+            let pa = Isometry2::new(Vector2::zeros(), ra);
+            let centre = u * (r_a + r_b + margin * s);
+            let rot_b = if kb == 4 { dir - std::f64::consts::FRAC_PI_2 - std::f64::consts::PI } else { rb };
+            let pb = Isometry2::new(centre, rot_b);
+            (a, b, pa, pb, r_a + r_b)
+        };
+        let (a, b, pa, pb, l) = place(1.0);
+        let pred = 2.0 * l + 1.0;
+        let ab = deepest2(&c2(&a, &pa, &b, &pb, pred));
+        let ba = deepest2(&c2(&b, &pb, &a, &pa, pred));
+        prop_assert!(ab.gap > 0.0);
+        prop_assert!((ab.gap - ba.gap).abs() < 1e-10 * l, "{ab:?} vs {ba:?}");
+        prop_assert!((ab.normal + ba.normal).norm() < 1e-10);
+        let t = Isometry2::new(Vector2::from(motion.0), motion.1);
+        let (ma, mb) = (t * pa, t * pb);
+        let m = deepest2(&c2(&a, &ma, &b, &mb, pred));
+        check_consistent2(&[m], &ma, &mb, l);
+        prop_assert!((m.gap - ab.gap).abs() < 1e-10 * l);
+        prop_assert!((m.normal - t.rotation * ab.normal).norm() < 1e-10);
+        let s = 10f64.powf(e);
+        let (sa, sb, spa, spb, _) = place(s);
+        let big = deepest2(&c2(&sa, &spa, &sb, &spb, pred * s));
+        prop_assert!((big.gap / s - ab.gap).abs() < 1e-10 * l, "s {s}: {} vs {}", big.gap / s, ab.gap);
+        prop_assert!((big.normal - ab.normal).norm() < 1e-10);
+    }
+}
