@@ -9,6 +9,7 @@ use coulomb::geometry::{
 use nalgebra::{Isometry2, Isometry3, Vector2, Vector3};
 use std::f64::consts::FRAC_PI_2;
 
+mod alloc_count;
 #[path = "geometry/invariance.rs"]
 mod invariance;
 
@@ -735,4 +736,50 @@ fn faces_touching_within_rounding_give_a_zero_gap_and_the_face_normal() {
         }
     }
     let _ = (rect, hull);
+}
+
+/// Warm queries between separated shapes (the cache and output kept) allocate nothing, in
+/// both dims and at unit and scaled sizes. (Touching pairs do allocate inside parry: its
+/// half-space manifold takes the point buffer with `mem::take`, its polygon clipping and its
+/// mesh and heightfield traversal allocate; see the report in the module docs.)
+#[test]
+fn warm_queries_between_separated_shapes_allocate_nothing() {
+    let id = Isometry3::identity();
+    for s in [1.0, 1e-3] {
+        let b = ok(Shape3::cuboid([0.5 * s, 0.3 * s, 0.2 * s]));
+        let cap = ok(Shape3::capsule(
+            [0.0, -0.3 * s, 0.0],
+            [0.0, 0.3 * s, 0.0],
+            0.1 * s,
+        ));
+        let ball = ok(Shape3::sphere(0.2 * s));
+        let far = Isometry3::translation(2.0 * s, 0.1 * s, 0.0);
+        for (a, b2) in [(&b, &cap), (&b, &b), (&ball, &cap), (&cap, &cap)] {
+            let mut cache = ContactCache3::default();
+            let mut out = Vec::new();
+            for _ in 0..2 {
+                ok(contacts3(a, &id, b2, &far, 0.1 * s, &mut cache, &mut out));
+            }
+            let before = alloc_count::count();
+            for _ in 0..10 {
+                ok(contacts3(a, &id, b2, &far, 0.1 * s, &mut cache, &mut out));
+            }
+            assert_eq!(
+                alloc_count::count() - before,
+                0,
+                "{b2:?} on {a:?} at scale {s}"
+            );
+            assert!(out.is_empty());
+        }
+    }
+    let r = ok(Shape2::rectangle([0.5, 0.2]));
+    let (p0, p1) = (Isometry2::identity(), Isometry2::translation(3.0, 0.4));
+    let mut cache = ContactCache2::default();
+    let mut out = Vec::new();
+    for _ in 0..2 {
+        ok(contacts2(&r, &p0, &r, &p1, 0.1, &mut cache, &mut out));
+    }
+    let before = alloc_count::count();
+    ok(contacts2(&r, &p0, &r, &p1, 0.1, &mut cache, &mut out));
+    assert_eq!(alloc_count::count() - before, 0);
 }

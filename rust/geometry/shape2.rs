@@ -150,6 +150,11 @@ impl Shape2 {
         self.kind() == ShapeKind2::HalfSpace
     }
 
+    /// Whether the shape is a half-space (whose contacts parry computes in closed form).
+    pub(crate) fn is_half_space(&self) -> bool {
+        self.kind() == ShapeKind2::HalfSpace
+    }
+
     /// The parry shape (the narrow phase's boundary).
     pub(crate) fn parry(&self) -> &dyn ParryShape {
         match &self.repr {

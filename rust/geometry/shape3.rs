@@ -215,12 +215,14 @@ impl Shape3 {
             .map_err(|e| CoulombError::InvalidParameter(format!("triangle mesh: {e}")))?;
         // oriented, with its internal edges fixed: a contact on an edge or vertex between
         // triangles gets a normal within the cone of the adjacent faces' normals
-        mesh.set_flags(TriMeshFlags::ORIENTED | TriMeshFlags::FIX_INTERNAL_EDGES)
-            .map_err(|e| {
-                CoulombError::InvalidParameter(format!(
-                    "triangle mesh topology (orientation or manifoldness): {e}"
-                ))
-            })?;
+        let flags = TriMeshFlags::HALF_EDGE_TOPOLOGY
+            | TriMeshFlags::ORIENTED
+            | TriMeshFlags::FIX_INTERNAL_EDGES;
+        mesh.set_flags(flags).map_err(|e| {
+            CoulombError::InvalidParameter(format!(
+                "triangle mesh topology (orientation or manifoldness): {e}"
+            ))
+        })?;
         Ok(Self::new(Repr3::TriangleMesh(mesh)))
     }
 
@@ -301,6 +303,11 @@ impl Shape3 {
 
     fn is_convex(&self) -> bool {
         !self.is_static() && self.kind() != ShapeKind3::Compound
+    }
+
+    /// Whether the shape is a half-space (whose contacts parry computes in closed form).
+    pub(crate) fn is_half_space(&self) -> bool {
+        self.kind() == ShapeKind3::HalfSpace
     }
 
     /// The parry shape (the narrow phase's boundary).
@@ -386,6 +393,21 @@ mod tests {
         assert!(Shape3::heightfield(2, 2, &[0.0, 0.0, 0.0, f64::NAN], [1.0; 3]).is_err());
         assert!(Shape3::heightfield(2, 2, &[0.0; 4], [1.0, 0.0, 1.0]).is_err());
         assert!(Shape3::half_space([0.0; 3]).is_err());
+    }
+
+    #[test]
+    fn a_mesh_with_adjacent_triangles_wound_opposite_ways_is_refused() {
+        let square = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+        ];
+        assert!(Shape3::triangle_mesh(&square, &[[0, 1, 2], [0, 2, 3]]).is_ok());
+        assert!(matches!(
+            Shape3::triangle_mesh(&square, &[[0, 1, 2], [0, 3, 2]]),
+            Err(CoulombError::InvalidParameter(_))
+        ));
     }
 
     #[test]
