@@ -4,7 +4,6 @@
 use super::*;
 use coulomb::geometry::broad::{boxes_meet, lift2, Aabb};
 use coulomb::geometry::AabbBroadPhase;
-use nalgebra::Point3;
 use proptest::prelude::*;
 
 /// A shape of the class at unit size: kind, three dimensions in [0.2, 1].
