@@ -14,6 +14,7 @@
 
 pub mod contact;
 pub mod error;
+pub mod geometry;
 pub mod interrupt;
 pub mod io;
 pub mod lcp;
