@@ -43,6 +43,8 @@ impl Stepper {
         let mut basis = std::mem::take(&mut self.basis_guess);
         self.basis_of_active(&mut basis);
         let warm = (!initial.is_empty()).then_some(initial.as_slice());
+        // whether the warm start holds impulses a solve changed (module `solve`)
+        let corrected = warm.is_some() && self.active.iter().any(|a| self.state[a.cand].corrected);
         let mut p_impact = std::mem::take(&mut self.p_impact);
         p_impact.clear();
         if self.poisson_impact {
@@ -50,6 +52,7 @@ impl Stepper {
             let mut restitution = std::mem::take(&mut self.restitution);
             restitution.clear();
             restitution.extend(self.active.iter().map(|a| self.candidates[a.cand].e));
+            self.solve.corrected = corrected;
             poisson_phase(
                 &PoissonInput {
                     settings: &self.settings,
@@ -74,6 +77,7 @@ impl Stepper {
             self.solve.velocity = wp;
         }
         let problem = step_problem(dim, &self.w, w_sparse.as_ref(), &self.qc, &self.mu)?;
+        self.solve.corrected = corrected;
         let out = solve_step_problem(
             &self.settings,
             &problem,
