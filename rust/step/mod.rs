@@ -58,9 +58,14 @@
 //! by one or found each step by the broad phase ([`Pair::Spheres`], a uniform grid over the
 //! spheres, O(N) per step: [`broad`]).
 //!
-//! Drift: a velocity-level condition does not enforce `g(q_{k+1}) >= 0` exactly (seed,
-//! "Position drift and restitution"). Gaps are monitored in every step's record, and
-//! [`Drift`] chooses a correction: none (the default), a velocity bias, or a post-step
+//! Drift: a velocity-level condition does not enforce `g(q_{k+1}) >= 0` exactly. Each
+//! contact's normal condition carries the gap's second-order remainder over the step on
+//! `v_free`, `min(c, 0) / h` with `c = g(q_k ⊕ h v_free) - g(q_k) - h J_n v_free` (a turning
+//! body's contact point curves towards the surface by `(h^2 / 2) n . (ω × (ω × p))`), so a
+//! body turning in lasting contact keeps its gap to O(h^3) per step instead of sinking by
+//! O(h^2) every step (an O(h) sink over a run: a rod end swinging through at 14 rad/s sank
+//! 1.1e-3 m in 0.5 s at h = 1e-3, now 6.4e-6 m). Gaps are monitored in every step's record,
+//! and [`Drift`] chooses a correction: none (the default), a velocity bias, or a post-step
 //! projection onto `g >= 0`.
 
 pub mod broad;
