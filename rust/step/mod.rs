@@ -431,8 +431,9 @@ pub enum Drift {
     /// projection, no step gaining. At h = 1e-4 (0.5 s): 1.7e-7 m, 4.8e-7 m (1843 steps
     /// gaining up to 1.8e-6 J) and 2.6e-7 m (no step gaining; the projected trajectory
     /// differs, and no step of it ends deeper than the same step without projection). On the
-    /// rod of Painleve's example falling flat (h = 1e-3, 3 s): 5.3e-9 m without, >= 0 at the
-    /// end with the bias, every gap >= -1e-12 m with the projection.
+    /// rod of Painleve's example falling flat (h = 1e-3, 3 s) every gap is >= -1e-12 m with
+    /// each option (without correction its sticking end sank 5.3e-9 m before the contact
+    /// conditions carried the gap's curvature term).
     Projection,
 }
 
