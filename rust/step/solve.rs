@@ -259,8 +259,10 @@ fn reuse_warm_start(
     };
     ws.velocity.resize(problem.size(), 0.0);
     let m = measure_into(problem, init, &mut ws.velocity);
-    let polish = problem.nc <= LEMKE_FALLBACK_MAX;
-    if m.passes(s.tol) && m.cone_violation == 0.0 && !(ws.corrected && polish) {
+    // up to LEMKE_FALLBACK_MAX contacts the polish below is tried; above, NSGS starts from
+    // the warm start
+    let few = problem.nc <= LEMKE_FALLBACK_MAX;
+    if m.passes(s.tol) && m.cone_violation == 0.0 && !(ws.corrected && few) {
         ws.impulse.clear();
         ws.impulse.extend_from_slice(init);
         return Ok(Warm::Done(Outcome {
@@ -269,7 +271,7 @@ fn reuse_warm_start(
             measures: m,
         }));
     }
-    if m.passes(POLISH_NEAR * s.tol) && polish {
+    if m.passes(POLISH_NEAR * s.tol) && few {
         let polish = NsgsSettings {
             initial: Some(init.to_vec()),
             max_iter: s.max_iter.min(POLISH_SWEEPS),
