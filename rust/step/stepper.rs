@@ -110,6 +110,8 @@ pub struct Stepper {
     active: Vec<Active>,
     /// the assembly of W (dense, or COO triplets for block CSR), kept from step to step.
     delassus: WAssembly,
+    /// the drift projection's contact rows, kept from step to step.
+    proj_rows: Vec<drift::Row>,
     /// the step index whose state `prepare` has done (M, v_free, speed bounds, pairs,
     /// geometry), so the record of a state and the step from it share that work.
     prepared: Option<usize>,
@@ -183,6 +185,7 @@ impl Stepper {
             step_index: 0,
             active: Vec::with_capacity(nc),
             delassus: WAssembly::new(),
+            proj_rows: Vec::new(),
             prepared: None,
             geo_cache: Vec::new(),
             speed_bounds: vec![[0.0; 2]; scene.bodies.len()],
