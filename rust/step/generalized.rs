@@ -13,7 +13,9 @@
 //!
 //! with the same contact search (closed, owed a rebound, or closing within the step by its
 //! normal velocity), the same impact law (Newton's with the impact memory of module `impact`,
-//! or Poisson's with friction in both phases, module `poisson`), the same drift options, the
+//! or Poisson's with friction in both phases, module `poisson`), the same gap terms (with
+//! the gap's second-order remainder over the step, here `g(q_k + h v_free) - g(q_k) -
+//! h J_n v_free` from one more `contacts` call), the same drift options, the
 //! same contact solve (NSGS with its fallbacks, or Lemke, warm-started by contact) and the same
 //! records ([`Trajectory`], whose `scaled_error` carries each step's verdict). W is assembled
 //! by the one assembly, [`crate::contact::assembly::WAssembly`].
@@ -48,7 +50,9 @@ pub trait GeneralizedSystem {
     /// the generalized forces `f(q, v, t)` into `f` (`nv` entries).
     fn force(&mut self, q: &[f64], v: &[f64], t: f64, f: &mut [f64]) -> Result<()>;
     /// per contact i its gap `gaps[i]` (> 0 when separated) and the rows of its Jacobian,
-    /// normal first then the tangents, at `rows[(i dim + α) nv ..][..nv]`.
+    /// normal first then the tangents, at `rows[(i dim + α) nv ..][..nv]`. Called at each
+    /// state, and once more in a step with active contacts at the predicted state
+    /// `q_k + h v_free` (whose gaps give the gap's second-order term over the step).
     fn contacts(&mut self, q: &[f64], gaps: &mut [f64], rows: &mut [f64]) -> Result<()>;
     /// the potential energy `V(q)` of the forces, for the records (0 when not known).
     fn potential(&mut self, q: &[f64]) -> Result<f64>;
