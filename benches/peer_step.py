@@ -15,6 +15,7 @@ from __future__ import annotations
 import argparse
 import datetime
 import math
+import os
 import platform
 import re
 import subprocess
@@ -244,13 +245,18 @@ def main() -> int:
         f"{platform.python_version()}, {platform.machine()}). Command: "
         f"`python benches/peer_step.py`. h = 1 ms for every scene; best wall time of 3 runs "
         f"(1 for the piles); MuJoCo's loop in C++ by `mujoco.rollout`, coulomb's in Rust by "
-        f"`Scene.simulate` (which also records every step's state, impulses and checks).",
+        f"`Scene.simulate` (which also records every step's state, impulses and checks). "
+        f"'vs MuJoCo': steps/s over MuJoCo's on the same scene in the same run. Load average "
+        f"over the last minute when the run ended: {os.getloadavg()[0]:.1f} on "
+        f"{os.cpu_count()} cores.",
         "",
-        "| scene | solver | steps/s | wall time (s) | figures |",
-        "|---|---|---:|---:|---|",
+        "| scene | solver | steps/s | vs MuJoCo | wall time (s) | figures |",
+        "|---|---|---:|---:|---:|---|",
     ]
+    peer = {scene: sps for scene, who, sps, _, _ in rows if who.startswith("MuJoCo")}
     for scene, who, sps, sec, figs in rows:
-        lines.append(f"| {scene} | {who} | {sps:,.0f} | {sec:.3f} | {figs} |")
+        ratio = f"{sps / peer[scene]:.2f}" if scene in peer else ""
+        lines.append(f"| {scene} | {who} | {sps:,.0f} | {ratio} | {sec:.3f} | {figs} |")
     lines.append("")
     lines.append(
         "Exact answers: the ramp box stops at 1.505 m at t = 3.011 s and then does not move "

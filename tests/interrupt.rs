@@ -251,6 +251,8 @@ fn record_every_keeps_every_kth_state_and_the_worst_checks() {
         assert_eq!(sparse.steps[r].momentum_residual, worst_res);
         assert_eq!(sparse.steps[r].iterations, worst_it);
         assert_eq!(sparse.steps[r].min_normal_impulse, least_pn);
+        let worst_scaled = window.iter().fold(0.0f64, |m, x| m.max(x.scaled_error));
+        assert_eq!(sparse.steps[r].scaled_error, worst_scaled);
     }
     // contact records only for kept steps, `step` being the row
     for c in &sparse.contacts {

@@ -528,10 +528,11 @@ fn painleve_rod_falls_flat_with_every_step_solved() {
     }
 }
 
-/// The drift corrections on the falling rod (h = 1e-3, 3 s): without correction the sticking
-/// end sinks 5.3e-9 m (the linearised rotation about it); the velocity bias pushes it back out
-/// (the final gap is >= 0) at a small energy gain; the projection keeps every gap >= 0 to
-/// rounding with no energy gain.
+/// The drift corrections on the falling rod (h = 1e-3, 3 s): the sticking end sank 5.3e-9 m
+/// without correction while the linearised gap missed the rotation's O(h^2) about it; with
+/// the gap's curvature term in the contact conditions it no longer sinks (min gap -8e-18 m),
+/// and the velocity bias and the projection keep it there, the projection with no energy
+/// gain. (The drift options on a case that still drifts: tests/step_drift.rs.)
 #[test]
 fn drift_corrections_on_the_falling_rod() {
     use coulomb::step::Drift;
@@ -546,12 +547,11 @@ fn drift_corrections_on_the_falling_rod() {
     };
     let min = |v: &[f64]| v.iter().cloned().fold(f64::INFINITY, f64::min);
     let none = run_with(Drift::None);
-    assert!(min(&none.min_gap) < -1e-9);
+    assert!(min(&none.min_gap) > -1e-12, "{}", min(&none.min_gap));
     let bias = run_with(Drift::VelocityBias(0.2));
-    assert!(*bias.min_gap.last().expect("states") > -1e-12);
+    assert!(min(&bias.min_gap) > -1e-12, "{}", min(&bias.min_gap));
     let proj = run_with(Drift::Projection);
     assert!(min(&proj.min_gap) > -1e-12, "{}", min(&proj.min_gap));
-    assert!(proj.steps.iter().any(|s| s.projection > 0.0));
     for k in 0..proj.steps.len() {
         let e0 = proj.kinetic_energy[k] + proj.potential_energy[k];
         let e1 = proj.kinetic_energy[k + 1] + proj.potential_energy[k + 1];

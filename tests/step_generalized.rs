@@ -24,6 +24,8 @@ struct Diagonal {
     frames: Frames,
     fail_at: Option<usize>,
     mass_calls: usize,
+    /// the calls of `contacts`.
+    contact_calls: usize,
 }
 
 impl GeneralizedSystem for Diagonal {
@@ -55,6 +57,7 @@ impl GeneralizedSystem for Diagonal {
         Ok(())
     }
     fn contacts(&mut self, q: &[f64], gaps: &mut [f64], rows: &mut [f64]) -> Result<()> {
+        self.contact_calls += 1;
         (self.frames)(q, gaps, rows);
         Ok(())
     }
@@ -116,6 +119,7 @@ fn particle_on_ramp(mu: f64, v0: [f64; 2]) -> (Diagonal, Scene) {
         frames: ramp_frames,
         fail_at: None,
         mass_calls: 0,
+        contact_calls: 0,
     };
     let scene = Scene {
         dim: 2,
@@ -178,6 +182,7 @@ fn rod(mu: f64, e: f64, q0: [f64; 3], v0: [f64; 3], gravity: f64) -> (Diagonal, 
         frames: rod_frames,
         fail_at: None,
         mass_calls: 0,
+        contact_calls: 0,
     };
     let scene = Scene {
         dim: 2,
@@ -253,6 +258,7 @@ fn poissons_law_keeps_friction_in_both_phases_on_a_model() {
         frames: floor,
         fail_at: None,
         mass_calls: 0,
+        contact_calls: 0,
     };
     let mut st = settings(1e-3, 2);
     st.restitution = Restitution::Poisson;
@@ -285,6 +291,23 @@ fn every_drift_option_and_both_laws_match_the_scene_on_a_falling_rod() {
             assert_eq!(drift == Drift::Projection, proj(&model.trajectory) > 0.0);
         }
     }
+}
+
+#[test]
+fn the_contacts_are_asked_once_per_state_and_once_more_in_a_step_with_active_contacts() {
+    // the rod falls free for its first steps, then lands and slides: the extra call (the
+    // gaps at q_k + h v_free, for the gap's curvature term) is made in exactly the steps
+    // with active contacts
+    let q0 = [0.0, 0.5 * 0.6f64.sin() + 0.01, 0.6];
+    let v0 = [0.3, -0.5, 1.0];
+    let (mut sys, _) = rod(0.3, 0.5, q0, v0, G);
+    let steps = 200;
+    let tr = simulate_generalized(&mut sys, &q0, &v0, &settings(1e-3, steps), 1)
+        .unwrap()
+        .trajectory;
+    let active = tr.steps.iter().filter(|s| s.active > 0).count();
+    assert!(active > 0 && active < steps, "{active}");
+    assert_eq!(sys.contact_calls, steps + 1 + active);
 }
 
 #[test]
@@ -385,6 +408,7 @@ fn particle_row(dim: usize, mu: f64, e: f64) -> (Diagonal, Scene, Vec<f64>, Vec<
         },
         fail_at: None,
         mass_calls: 0,
+        contact_calls: 0,
     };
     let scene = Scene {
         dim,
@@ -452,6 +476,7 @@ fn poissons_law_integrates_an_impact_alone_beside_a_resting_uncoupled_contact() 
             frames: two_rod_frames,
             fail_at: None,
             mass_calls: 0,
+            contact_calls: 0,
         };
         let rod_body = |q: &[f64], v: &[f64]| Body {
             kind: BodyKind::Planar,

@@ -205,8 +205,10 @@ class Model:
         (Newton's or Poisson's law, the drift corrections, the fallback, ``record_every``),
         except ``locate_impacts`` (scenes only). The Rust stepper runs the loop and calls
         ``mass_matrix``, ``force``, the contacts' functions and ``potential`` back at each
-        state (holding the GIL only then); an exception raised in one of them stops the run
-        and is raised as it is."""
+        state (holding the GIL only then), and the contacts' functions once more in a step
+        with active contacts, at the predicted state ``q + h v_free``, for the gaps'
+        second-order term over the step (as scenes have); an exception raised in one of them
+        stops the run and is raised as it is."""
         t_end, h = _positive("t_end", t_end), _positive("h", h)
         steps = _steps(t_end, h)
         solver, tol, max_iter, relaxation, facets = _solver_options(

@@ -83,11 +83,11 @@ that same test.
     ``max(||r_i||, rho_i ||(|W| |r| + |q|)_i||)``. A slip ``s = ||u_t,i||`` below its own
     rounding ``f = (n + 3) eps ||(|W| |r| + |q|)_t,i||`` counts as none (above it, as
     ``s - f^2/s``), so a sticking contact with mu up to 1e12 solved to rounding is solved in
-    every unit system instead of turning ``mu`` times its rounding into an error. Multiplying impulse units by a and velocity
-    units by b (``W -> (b/a) W``, ``q -> b q``) leaves it unchanged, and so ``success`` and
-    ``status``; ``error`` and ``error_q`` add velocities to impulses and change with the
-    units, so they are reported, never used for the verdict (at W of order 1e-5 they accepted
-    answers of a problem without solution; at W of order 1e8 an exact answer may miss
+    every unit system instead of turning ``mu`` times its rounding into an error. Multiplying
+    impulse units by a and velocity units by b (``W -> (b/a) W``, ``q -> b q``) leaves it unchanged,
+    and so ``success`` and ``status``; ``error`` and ``error_q`` add velocities to impulses and
+    change with the units, so they are reported, never used for the verdict (at W of order 1e-5 they
+    accepted answers of a problem without solution; at W of order 1e8 an exact answer may miss
     ``error_q <= tol``).
 
 ``error``

@@ -30,8 +30,10 @@ turning normal leaves O(h^2)); the record is then consumed. The rebound is exact
 the step the impact falls when no force acts during the step; under a force such as gravity
 the approach is the velocity at the start of the landing step, so with ``e = 1`` each bounce
 loses ``m g y_k`` (``y_k`` the height there, at most ``m g h |v_n^-|``: first order in h).
-``locate_impacts=True`` finds the impact instant within the step for isolated impacts and
-removes that loss.
+In general the approach changes along the step at the gap's second derivative ``g''``, and a
+bounce changes the energy by up to ``h m_eff |v_n^-| |g''|``: a gain where the normal turns
+(two spheres passing obliquely: ``g'' = |v_t|^2 / d``). ``locate_impacts=True`` finds the
+impact instant within the step for isolated impacts and removes both.
 
 :class:`Model` takes a user-defined model in generalized coordinates instead (``M(q)``,
 ``f(q, v, t)`` and :class:`GapContact` gap functions with Jacobians), stepped by the same Rust

@@ -412,10 +412,12 @@ class Trajectory:
         flight and at impacts with ``e <= 1``, so elastic bounces under gravity pass at any h,
         while energy put in by a force, by the velocity bias of ``drift="velocity_bias"`` or
         by the contact law is flagged. The plain step's impact on a turning normal (a
-        rotating corner, oblique spheres) lands and rebounds with Jacobians one step apart
-        and gains O(h) there, which is flagged too; ``locate_impacts=True`` removes it for
-        isolated impacts. Newton's law with friction is such a law: an impact that sticks can gain
-        energy (Kane and Levinson's rod: a rod at 45 degrees striking at ``(0.6, -1)`` m/s with
+        rotating corner, oblique spheres) rebounds with the approach velocity of the landing
+        step's start, which along the step changes at the gap's second derivative ``g''``: it
+        gains up to ``h m_eff |v_n^-| |g''|`` per impact (two spheres: ``g'' = |v_t|^2 / d``),
+        which is flagged too; ``locate_impacts=True`` removes it for isolated impacts.
+        Newton's law with friction is such a law: an impact that sticks can gain energy
+        (Kane and Levinson's rod: a rod at 45 degrees striking at ``(0.6, -1)`` m/s with
         ``e = 1`` gains 0.1125 J; Stewart 2000), and check() reports it as an energy gain;
         ``restitution="poisson"`` never gains for one frictional contact. With
         ``strict=True`` a violation raises :class:`TrajectoryCheckError`.

@@ -30,7 +30,7 @@ const PASSES: usize = 3;
 const HALVINGS: usize = 12;
 
 /// a contact row: (gap, (body, normal column) per side, sides).
-type Row = (f64, [(usize, [f64; 6]); 2], usize);
+pub(super) type Row = (f64, [(usize, [f64; 6]); 2], usize);
 
 impl Stepper {
     /// the smallest gap over every candidate contact at the current q (bodies frozen).
@@ -88,9 +88,12 @@ impl Stepper {
     }
 
     /// `Δq = M^{-1} J_n^T λ` over the candidates with gap below `margin` (`None` when the
-    /// LCP has no finite answer).
-    fn displacement(&self, margin: f64) -> Result<Option<Vec<f64>>> {
-        let mut rows: Vec<Row> = Vec::new();
+    /// LCP has no finite answer). `J_n M^{-1} J_n^T` is built by the one assembly
+    /// ([`crate::contact::assembly::WAssembly`], one unknown per contact, each body a block),
+    /// in the step's assembly workspace (the step's W is no longer needed) and row buffer.
+    fn displacement(&mut self, margin: f64) -> Result<Option<Vec<f64>>> {
+        let mut rows = std::mem::take(&mut self.proj_rows);
+        rows.clear();
         for c in 0..self.candidates.len() {
             let geo = self.geometry(c);
             if geo.gap >= margin {
@@ -107,34 +110,42 @@ impl Stepper {
             }
             rows.push((geo.gap, cols, geo.nsides));
         }
+        let out = self.displacement_of(&rows);
+        self.proj_rows = rows;
+        out
+    }
+
+    /// see [`Stepper::displacement`].
+    fn displacement_of(&mut self, rows: &[Row]) -> Result<Option<Vec<f64>>> {
         if rows.is_empty() {
             return Ok(None);
         }
         let n = rows.len();
-        // W_nn = J_n M^{-1} J_n^T
-        let mut w = vec![0.0; n * n];
-        for (i, ri) in rows.iter().enumerate() {
-            for (j, rj) in rows.iter().enumerate() {
-                let mut s = 0.0;
-                for &(bi, ci) in &ri.1[..ri.2] {
-                    for &(bj, cj) in &rj.1[..rj.2] {
-                        if bi != bj {
-                            continue;
-                        }
-                        let minv = &self.frozen[bi].minv;
-                        let nv = self.bodies[bi].nv;
-                        for a in 0..nv {
-                            for c in 0..nv {
-                                s += ci[a] * minv[a * 6 + c] * cj[c];
-                            }
-                        }
-                    }
-                }
-                w[i * n + j] = s;
+        // W_nn = J_n M^{-1} J_n^T: each pair of sides on one body gives `c_i^T M_b^{-1} c_j`
+        let w = &mut self.delassus;
+        w.begin(self.bodies.len());
+        for (i, r) in rows.iter().enumerate() {
+            for (k, &(b, _)) in r.1[..r.2].iter().enumerate() {
+                w.side(i, k, b);
             }
         }
+        let (frozen, bodies) = (&self.frozen, &self.bodies);
+        w.assemble(1, n, false, |(i, ki), (j, kj)| {
+            let ((b, ci), (_, cj)) = (&rows[i].1[ki], &rows[j].1[kj]);
+            let minv = &frozen[*b].minv;
+            let nv = bodies[*b].nv;
+            let mut s = 0.0;
+            for a in 0..nv {
+                for c in 0..nv {
+                    s += ci[a] * minv[a * 6 + c] * cj[c];
+                }
+            }
+            let mut blk = [[0.0; 3]; 3];
+            blk[0][0] = s;
+            blk
+        });
         let g: Vec<f64> = rows.iter().map(|r| r.0).collect();
-        let lcp = LcpRef::new(n, &w, &g)?;
+        let lcp = LcpRef::new(n, self.delassus.dense(), &g)?;
         let sol = solve_lemke(&lcp, &LemkeSettings::default())?;
         if !sol.z.iter().all(|z| z.is_finite()) {
             return Ok(None);

@@ -26,6 +26,13 @@
 //! contact penetrates beyond the gap tolerance (a second impact in the same step, or a
 //! contact that stays closed, as after an inelastic impact under gravity). Otherwise the step
 //! is the plain one.
+//!
+//! When every active contact is open and no true gap vanishes on the free path within the
+//! step, the step is free: no impulse. The plain step's gap term `g + h J_n v >= 0` would
+//! push on its linearised gap instead: two spheres passing obliquely close the linearised gap
+//! a step before the true one (their normal turns, and the true gap stays above it by about
+//! `h^2 |v_t|^2 / (2 d)`), so the plain step landed them inelastically a step early and owed
+//! the rebound to the next one, which then fell back to the plain law (O(h) energy).
 
 use super::bodies::displace_body;
 use super::{frame, ContactRecord, Geometry, Restitution, StepRecord, Stepper};
@@ -37,6 +44,16 @@ const SAMPLES: usize = 16;
 
 /// bisection steps on the impact instant (to rounding of h).
 const BISECTIONS: usize = 64;
+
+/// What a located step did (module docs).
+pub(super) enum Located {
+    /// the impact is not isolated: the plain step follows, from the untouched state.
+    Plain,
+    /// no true gap vanishes within the step: the step is free of contact impulses.
+    Free,
+    /// the located impact's step, done.
+    Done(StepRecord),
+}
 
 /// the impact of a located step: contact, instant, impulse and velocities.
 struct Hit {
@@ -94,22 +111,19 @@ impl Stepper {
         best
     }
 
-    /// The located step (module docs): `Ok(None)`, with the state untouched, when the step's
-    /// impact is not isolated or there is none.
-    pub(super) fn located_step(
-        &mut self,
-        contacts: &mut Vec<ContactRecord>,
-    ) -> Result<Option<StepRecord>> {
+    /// The located step (module docs); for [`Located::Plain`] and [`Located::Free`] the state
+    /// is left untouched.
+    pub(super) fn located_step(&mut self, contacts: &mut Vec<ContactRecord>) -> Result<Located> {
         let h = self.settings.h;
         let tol_gap = self.settings.gap_tolerance;
         if self.active.is_empty() || self.active.iter().any(|a| a.closed) {
-            return Ok(None);
+            return Ok(Located::Plain);
         }
         self.saved_q.copy_from_slice(&self.q);
         self.saved_v.copy_from_slice(&self.v);
         let Some(s_star) = self.impact_instant() else {
             self.restore();
-            return Ok(None);
+            return Ok(Located::Free);
         };
         self.follow(s_star);
         let (_, which) = self.closest();
@@ -121,7 +135,7 @@ impl Stepper {
             .all(|(i, a)| i == which || self.geometry(a.cand).gap > tol_gap);
         if !others_open {
             self.restore();
-            return Ok(None);
+            return Ok(Located::Plain);
         }
         let hit = self.impact_at(which)?;
         // the rest of the step from the post-impact velocity
@@ -143,9 +157,23 @@ impl Stepper {
         let finite = self.q.iter().chain(&self.v).all(|x| x.is_finite());
         if penetrates || !finite {
             self.restore();
-            return Ok(None);
+            return Ok(Located::Plain);
         }
-        Ok(Some(self.finish_located(hit, contacts)))
+        Ok(Located::Done(self.finish_located(hit, contacts)))
+    }
+
+    /// the contact answer of a free located step (see [`Located::Free`]): zero impulses,
+    /// which the contact law on the true gaps (all positive through the step) admits.
+    pub(super) fn free_of_contacts(&mut self, record: &mut StepRecord) {
+        let n = self.active.len() * self.dim;
+        self.solve.impulse.clear();
+        self.solve.impulse.resize(n, 0.0);
+        self.solve.basis.clear();
+        self.solve.corrected = false;
+        for a in &mut self.active {
+            a.approach = a.vn_k;
+        }
+        record.status = Some(crate::contact::ContactStatus::Solved);
     }
 
     /// back to `(q_k, v_k)`, bodies frozen there.

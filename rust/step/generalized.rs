@@ -13,7 +13,9 @@
 //!
 //! with the same contact search (closed, owed a rebound, or closing within the step by its
 //! normal velocity), the same impact law (Newton's with the impact memory of module `impact`,
-//! or Poisson's with friction in both phases, module `poisson`), the same drift options, the
+//! or Poisson's with friction in both phases, module `poisson`), the same gap terms (with
+//! the gap's second-order remainder over the step, here `g(q_k + h v_free) - g(q_k) -
+//! h J_n v_free` from one more `contacts` call), the same drift options, the
 //! same contact solve (NSGS with its fallbacks, or Lemke, warm-started by contact) and the same
 //! records ([`Trajectory`], whose `scaled_error` carries each step's verdict). W is assembled
 //! by the one assembly, [`crate::contact::assembly::WAssembly`].
@@ -48,7 +50,9 @@ pub trait GeneralizedSystem {
     /// the generalized forces `f(q, v, t)` into `f` (`nv` entries).
     fn force(&mut self, q: &[f64], v: &[f64], t: f64, f: &mut [f64]) -> Result<()>;
     /// per contact i its gap `gaps[i]` (> 0 when separated) and the rows of its Jacobian,
-    /// normal first then the tangents, at `rows[(i dim + α) nv ..][..nv]`.
+    /// normal first then the tangents, at `rows[(i dim + α) nv ..][..nv]`. Called at each
+    /// state, and once more in a step with active contacts at the predicted state
+    /// `q_k + h v_free` (whose gaps give the gap's second-order term over the step).
     fn contacts(&mut self, q: &[f64], gaps: &mut [f64], rows: &mut [f64]) -> Result<()>;
     /// the potential energy `V(q)` of the forces, for the records (0 when not known).
     fn potential(&mut self, q: &[f64]) -> Result<f64>;
@@ -107,6 +111,10 @@ pub struct GeneralizedStepper<S: GeneralizedSystem> {
     v_free: Vec<f64>,
     gaps: Vec<f64>,
     rows: Vec<f64>,
+    /// the predicted state `q_k + h v_free` and the gaps and rows there (the curvature term).
+    q_pred: Vec<f64>,
+    gaps_pred: Vec<f64>,
+    rows_pred: Vec<f64>,
     state: Vec<CandState>,
     active: Vec<Active>,
     /// `M^{-1} G` of the active contacts, `(i dim + α) nv ..`.
@@ -178,6 +186,9 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
             v_free: vec![0.0; nv],
             gaps: vec![0.0; nc],
             rows: vec![0.0; nc * dim * nv],
+            q_pred: vec![0.0; nv],
+            gaps_pred: vec![0.0; nc],
+            rows_pred: vec![0.0; nc * dim * nv],
             state: vec![CandState::default(); nc],
             active: Vec::with_capacity(nc),
             mg: Vec::new(),
@@ -278,7 +289,7 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
         v_next.copy_from_slice(&self.v_free);
         self.gp.fill(0.0);
         if nc > 0 {
-            self.assemble(&mut record);
+            self.assemble(&mut record)?;
             self.solve_contacts(&mut record)?;
             self.apply_impulses(&mut v_next);
         }
@@ -337,8 +348,8 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
 
     /// `M^{-1} G` of the active contacts, W by the one assembly (one block), and the contact
     /// terms (as the scenes' step: Newton's `e v_n^-` with the impact memory, Poisson's impact
-    /// phase, the drift bias, the gap term).
-    fn assemble(&mut self, record: &mut StepRecord) {
+    /// phase, the drift bias, the gap term, the gap's curvature term).
+    fn assemble(&mut self, record: &mut StepRecord) -> Result<()> {
         let (dim, nv) = (self.dim, self.nv);
         let na = self.active.len();
         self.mg.clear();
@@ -383,7 +394,7 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
             self.active[i].sides[0].body = r;
         }
         self.coupling = link;
-        self.contact_terms(record);
+        self.contact_terms(record)
     }
 
     /// `v_{k+1} = v_free + M^{-1} G P` (into `v_next`, which holds `v_free`), and `G P`.
@@ -438,6 +449,7 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
             let p = &self.solve.impulse[i * dim..(i + 1) * dim];
             let st = &mut self.state[a.cand];
             st.warm[..dim].copy_from_slice(p);
+            st.corrected = self.solve.corrected;
             st.basis = self.solve.basis.get(i).copied().unwrap_or(0);
             st.impact = if !a.closed && p[0] > 0.0 {
                 ImpactMemory::landed(a.vn_k, p[0])

@@ -1,30 +1,33 @@
 //! The impact law and the contact solve of a [`GeneralizedSystem`]'s step, as the scenes'
-//! (module `law`): the contact terms (Newton's `e v_n^-` with the impact memory, Poisson's
-//! impact phase on `G^T v_k`, the drift bias, the gap term `g / h`), the warm start and
-//! Lemke's guessed basis by contact, then the same solve (NSGS with its fallbacks, or Lemke)
-//! over the dense or block-sparse W.
+//! (module `law`, whose functions both call): the contact terms (Newton's `e v_n^-` with the
+//! impact memory, Poisson's impact phase on `G^T v_k`, the drift bias, the gap term `g / h`,
+//! the gap's curvature term), the warm start and Lemke's guessed basis by contact, then the
+//! same solve (NSGS with its fallbacks, or Lemke) over the dense or block-sparse W.
 
-use super::super::law::{poisson_phase, PoissonInput};
-use super::super::solve::{solve_step_problem, step_problem, SPARSE_FROM};
+use super::super::law::{curvature_term, normal_term, solve_phases, warm_start_of, Phases};
+use super::super::solve::SPARSE_FROM;
 use super::super::Active;
 use super::{dot, GeneralizedStepper, GeneralizedSystem};
-use crate::error::Result;
+use crate::error::{check_finite, Result};
 use crate::step::StepRecord;
-use crate::step::{Drift, PolyhedralSettings, Restitution, StepSolver};
+use crate::step::{PolyhedralSettings, StepSolver};
 
 impl<S: GeneralizedSystem> GeneralizedStepper<S> {
-    /// `q_c = G^T v_free` plus each contact's restitution, bias or gap term, `q_1 = G^T v_k`
-    /// (open contacts separated) for Poisson's impact phase, and mu.
-    pub(super) fn contact_terms(&mut self, record: &mut StepRecord) {
+    /// `q_c = G^T v_free` plus each contact's restitution, bias or gap term
+    /// ([`normal_term`], as the scenes') and the gap's curvature term
+    /// ([`curvature_term`]), `q_1 = G^T v_k` (open contacts separated) for Poisson's impact
+    /// phase, and mu. The curvature `c = g(q_k + h v_free) - g(q_k) - h J_n v_free` takes one
+    /// more `contacts` callback, at the predicted state `q_k + h v_free` (`dq = v dt`).
+    pub(super) fn contact_terms(&mut self, record: &mut StepRecord) -> Result<()> {
         let dim = self.dim;
         let h = self.settings.h;
         let n = self.active.len() * dim;
+        self.predicted_gaps()?;
         self.qc.clear();
         self.qc.resize(n, 0.0);
         self.q1.clear();
         self.q1.resize(n, 0.0);
         self.mu.clear();
-        let poisson = self.settings.restitution == Restitution::Poisson;
         self.poisson_impact = false;
         for i in 0..self.active.len() {
             let ai = self.active[i];
@@ -39,35 +42,35 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
                 self.qc[i * dim + al] = a;
                 self.q1[i * dim + al] = b;
             }
-            let bound = if ai.closed {
-                // Newton: 0 <= P_n ⊥ J_n v_{k+1} + e v_n^- >= 0
-                let vminus = st.impact.approach_with(ai.vn_k);
-                if st.impact.pending {
-                    record.resumed = true;
-                }
-                self.active[i].approach = vminus;
-                let bias = match self.settings.drift {
-                    Drift::VelocityBias(beta) if ai.gap < 0.0 => beta * ai.gap / h,
-                    _ => 0.0,
-                };
-                if poisson {
-                    self.active[i].carried = st.impact.compression;
-                    self.poisson_impact |= ai.vn_k < 0.0 || st.impact.pending;
-                    bias
-                } else {
-                    e * vminus + bias
-                }
-            } else {
-                // imminent: 0 <= P_n ⊥ J_n v_{k+1} + g / h >= 0
-                self.active[i].approach = ai.vn_k;
-                self.q1[i * dim] = self.q1[i * dim].max(0.0) + ai.gap / h;
-                ai.gap / h
-            };
-            self.qc[i * dim] += bound;
+            let bound = normal_term(
+                &self.settings,
+                &mut self.active[i],
+                &st,
+                e,
+                &mut self.q1[i * dim],
+                &mut self.poisson_impact,
+                record,
+            );
+            let c = self.gaps_pred[ai.cand] - self.gaps[ai.cand] - h * self.qc[i * dim];
+            self.qc[i * dim] += bound + curvature_term(c, h);
         }
+        Ok(())
     }
 
-    /// The contact solve into `self.solve.impulse`: the warm start and Lemke's guessed basis
+    /// the gaps at the predicted state `q_k + h v_free` into `self.gaps_pred` (the rows the
+    /// callback also gives there are not used).
+    fn predicted_gaps(&mut self) -> Result<()> {
+        let h = self.settings.h;
+        for ((p, q), v) in self.q_pred.iter_mut().zip(&self.q).zip(&self.v_free) {
+            *p = q + h * v;
+        }
+        self.system
+            .contacts(&self.q_pred, &mut self.gaps_pred, &mut self.rows_pred)?;
+        check_finite("the contact gaps", &self.gaps_pred)
+    }
+
+    /// The contact solve into `self.solve.impulse` by the scenes' phases ([`solve_phases`]):
+    /// the warm start (polished once more after a correcting solve) and Lemke's guessed basis
     /// by contact, Poisson's impact phase when it has work, then the step's solve.
     pub(super) fn solve_contacts(&mut self, record: &mut StepRecord) -> Result<()> {
         let dim = self.dim;
@@ -78,67 +81,39 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
             None
         };
         let mut initial = std::mem::take(&mut self.initial);
-        initial.clear();
-        if self.settings.warm_start {
-            for a in &self.active {
-                initial.extend_from_slice(&self.state[a.cand].warm[..dim]);
-            }
-        }
+        let corrected = warm_start_of(&self.settings, dim, &self.active, &self.state, &mut initial);
         let mut basis = std::mem::take(&mut self.basis_guess);
         self.basis_of_active(&mut basis);
-        let warm = (!initial.is_empty()).then_some(initial.as_slice());
-        let mut p_impact = std::mem::take(&mut self.p_impact);
-        p_impact.clear();
-        let dense = self.delassus.dense();
+        self.restitution.clear();
         if self.poisson_impact {
-            let problem = step_problem(dim, dense, w_sparse.as_ref(), &self.q1, &self.mu)?;
-            self.restitution.clear();
             self.restitution
                 .extend(self.active.iter().map(|a| self.laws[a.cand].1));
-            poisson_phase(
-                &PoissonInput {
-                    settings: &self.settings,
-                    problem: &problem,
-                    active: &self.active,
-                    e: &self.restitution,
-                    warm,
-                    guess: &basis,
-                },
-                record,
-                &mut self.solve,
-                &mut p_impact,
-            )?;
-            let mut wp = std::mem::take(&mut self.solve.velocity);
-            wp.resize(nc * dim, 0.0);
-            problem.mul_w(&p_impact, &mut wp);
-            for (q, d) in self.qc.iter_mut().zip(&wp) {
-                *q += d;
-            }
-            self.solve.velocity = wp;
         }
-        let problem = step_problem(dim, dense, w_sparse.as_ref(), &self.qc, &self.mu)?;
-        let out = solve_step_problem(
-            &self.settings,
-            &problem,
-            warm,
-            &basis,
+        let mut p_impact = std::mem::take(&mut self.p_impact);
+        let out = solve_phases(
+            &Phases {
+                settings: &self.settings,
+                dim,
+                dense: self.delassus.dense(),
+                sparse: w_sparse.as_ref(),
+                active: &self.active,
+                e: &self.restitution,
+                q1: &self.q1,
+                mu: &self.mu,
+                warm: (!initial.is_empty()).then_some(initial.as_slice()),
+                corrected,
+                guess: &basis,
+                poisson_impact: self.poisson_impact,
+            },
+            &mut self.qc,
             record,
             &mut self.solve,
-        )?;
+            &mut p_impact,
+        );
         self.initial = initial;
         self.basis_guess = basis;
-        for (p, d) in self.solve.impulse.iter_mut().zip(&p_impact) {
-            *p += d;
-        }
         self.p_impact = p_impact;
-        record.status = Some(out.status);
-        record.error = out.measures.error;
-        record.scaled_error = out.measures.scaled_error;
-        record.iterations = out.iterations;
-        record.min_normal_impulse = out.measures.min_normal_impulse;
-        record.cone_violation = out.measures.cone_violation;
-        record.complementarity = out.measures.max_complementarity;
-        Ok(())
+        out
     }
 
     /// Lemke's guessed basis from the active contacts' last bases (as the scenes' stepper).

@@ -5,9 +5,10 @@
 //! `poisson`).
 
 use super::super::poisson::{restitution_with_friction, routh};
+use super::persistence::CandState;
 use super::solve::{solve_step_problem, step_problem, SolveBuffers, SPARSE_FROM};
 use super::{dot6, dot_v, Active, Drift, Restitution, StepRecord, StepSettings, Stepper};
-use crate::contact::{ContactProblem, Delassus};
+use crate::contact::{BlockCsr, ContactProblem, Delassus};
 use crate::error::Result;
 
 impl Stepper {
@@ -18,7 +19,6 @@ impl Stepper {
     pub(super) fn solve_contacts(&mut self, record: &mut StepRecord) -> Result<()> {
         let dim = self.dim;
         let nc = self.active.len();
-        let n = nc * dim;
         self.assemble(record);
         // W's storage: dense for few contacts, block CSR for many
         let w_sparse = if nc >= SPARSE_FROM {
@@ -28,80 +28,40 @@ impl Stepper {
             None
         };
         let mut initial = std::mem::take(&mut self.initial);
-        initial.clear();
-        if self.settings.warm_start {
-            for a in &self.active {
-                initial.extend_from_slice(&self.state[a.cand].warm[..dim]);
-            }
-        }
+        let corrected = warm_start_of(&self.settings, dim, &self.active, &self.state, &mut initial);
         let mut basis = std::mem::take(&mut self.basis_guess);
         self.basis_of_active(&mut basis);
-        let warm = (!initial.is_empty()).then_some(initial.as_slice());
-        let mut p_impact = std::mem::take(&mut self.p_impact);
-        p_impact.clear();
+        let mut restitution = std::mem::take(&mut self.restitution);
+        restitution.clear();
         if self.poisson_impact {
-            let problem = step_problem(
-                dim,
-                self.delassus.dense(),
-                w_sparse.as_ref(),
-                &self.q1,
-                &self.mu,
-            )?;
-            let mut restitution = std::mem::take(&mut self.restitution);
-            restitution.clear();
             restitution.extend(self.active.iter().map(|a| self.candidates[a.cand].e));
-            poisson_phase(
-                &PoissonInput {
-                    settings: &self.settings,
-                    problem: &problem,
-                    active: &self.active,
-                    e: &restitution,
-                    warm,
-                    guess: &basis,
-                },
-                record,
-                &mut self.solve,
-                &mut p_impact,
-            )?;
-            self.restitution = restitution;
-            // the smooth phase starts from v_free + M^{-1} G P_impact
-            let mut wp = std::mem::take(&mut self.solve.velocity);
-            wp.resize(n, 0.0);
-            problem.mul_w(&p_impact, &mut wp);
-            for (q, d) in self.qc.iter_mut().zip(&wp) {
-                *q += d;
-            }
-            self.solve.velocity = wp;
         }
-        let problem = step_problem(
-            dim,
-            self.delassus.dense(),
-            w_sparse.as_ref(),
-            &self.qc,
-            &self.mu,
-        )?;
-        let out = solve_step_problem(
-            &self.settings,
-            &problem,
-            warm,
-            &basis,
+        let mut p_impact = std::mem::take(&mut self.p_impact);
+        let out = solve_phases(
+            &Phases {
+                settings: &self.settings,
+                dim,
+                dense: self.delassus.dense(),
+                sparse: w_sparse.as_ref(),
+                active: &self.active,
+                e: &restitution,
+                q1: &self.q1,
+                mu: &self.mu,
+                warm: (!initial.is_empty()).then_some(initial.as_slice()),
+                corrected,
+                guess: &basis,
+                poisson_impact: self.poisson_impact,
+            },
+            &mut self.qc,
             record,
             &mut self.solve,
-        )?;
+            &mut p_impact,
+        );
         self.initial = initial;
         self.basis_guess = basis;
-        for (p, d) in self.solve.impulse.iter_mut().zip(&p_impact) {
-            *p += d;
-        }
+        self.restitution = restitution;
         self.p_impact = p_impact;
-        record.status = Some(out.status);
-        record.error = out.measures.error;
-        record.scaled_error = out.measures.scaled_error;
-        record.iterations = out.iterations;
-        record.min_normal_impulse = out.measures.min_normal_impulse;
-        record.cone_violation = out.measures.cone_violation;
-        record.complementarity = out.measures.max_complementarity;
-        Ok(())
+        out
     }
 
     /// The step's contact problem from the active contacts: W (dense below [`SPARSE_FROM`]
@@ -134,8 +94,9 @@ impl Stepper {
         });
     }
 
-    /// `q_c = G^T v_free` plus each contact's restitution, bias or gap term, `q_1 = G^T v_k`
-    /// (open contacts separated) for Poisson's impact phase, and mu.
+    /// `q_c = G^T v_free` plus each contact's restitution, bias or gap term and the gap's
+    /// curvature term `min(c, 0) / h` (`c = g(q_k ⊕ h v_free) - g(q_k) - h J_n v_free`),
+    /// `q_1 = G^T v_k` (open contacts separated) for Poisson's impact phase, and mu.
     fn contact_terms(&mut self, record: &mut StepRecord) {
         let dim = self.dim;
         let h = self.settings.h;
@@ -146,7 +107,6 @@ impl Stepper {
         self.q1.clear();
         self.q1.resize(n, 0.0);
         self.mu.clear();
-        let poisson = self.settings.restitution == Restitution::Poisson;
         self.poisson_impact = false;
         for i in 0..nc {
             let ai = self.active[i];
@@ -162,36 +122,182 @@ impl Stepper {
                     self.q1[i * dim + al] += dot_v(&si.g[al], &self.v, b.off_v, b.nv);
                 }
             }
-            let bound = if ai.closed {
-                // Newton: 0 <= P_n ⊥ J_n v_{k+1} + e v_n^- >= 0
-                let vminus = st.impact.approach_with(ai.vn_k);
-                if st.impact.pending {
-                    record.resumed = true;
-                }
-                self.active[i].approach = vminus;
-                let bias = match self.settings.drift {
-                    Drift::VelocityBias(beta) if ai.gap < 0.0 => beta * ai.gap / h,
-                    _ => 0.0,
-                };
-                if poisson {
-                    // the impact phase compresses on J_n v_k; what a landing step already
-                    // pushed counts in the compression impulse
-                    self.active[i].carried = st.impact.compression;
-                    self.poisson_impact |= ai.vn_k < 0.0 || st.impact.pending;
-                    bias
-                } else {
-                    cand.e * vminus + bias
-                }
-            } else {
-                // imminent: 0 <= P_n ⊥ J_n v_{k+1} + g / h >= 0; an open contact takes no
-                // impulse in Poisson's (instantaneous) impact phase
-                self.active[i].approach = ai.vn_k;
-                self.q1[i * dim] = self.q1[i * dim].max(0.0) + ai.gap / h;
-                ai.gap / h
-            };
-            self.qc[i * dim] += bound;
+            let bound = normal_term(
+                &self.settings,
+                &mut self.active[i],
+                &st,
+                cand.e,
+                &mut self.q1[i * dim],
+                &mut self.poisson_impact,
+                record,
+            );
+            // the gap's second-order remainder over the step on v_free (module `narrow`)
+            let c = self.gap_curvature(ai.cand, &self.geo_cache[ai.cand], &self.v_free);
+            self.qc[i * dim] += bound + curvature_term(c, h);
         }
     }
+}
+
+/// The normal term of active contact `a`'s condition `0 <= P_n ⊥ J_n v_{k+1} + b >= 0`,
+/// shared by the scenes' and the models' steps (Moreau; Stewart-Trinkle 1996): closed (or
+/// owed a rebound), Newton's restitution `b = e v_n^-` (module `impact`) plus the drift's
+/// bias `beta g / h` on a penetration, or for Poisson's law the bias alone (its impact phase
+/// then compresses on `J_n v_k`, counting what a landing step already pushed, `carried`);
+/// imminent, the gap term `b = g / h`, and `q1_n` (the normal of `G^T v_k` for Poisson's
+/// impact phase) separated by the gap, since an open contact takes no impulse in that
+/// instantaneous phase. Sets `a.approach` (and `a.carried`); `poisson_impact` becomes true
+/// when Poisson's impact phase has work.
+pub(super) fn normal_term(
+    settings: &StepSettings,
+    a: &mut Active,
+    st: &CandState,
+    e: f64,
+    q1_n: &mut f64,
+    poisson_impact: &mut bool,
+    record: &mut StepRecord,
+) -> f64 {
+    let h = settings.h;
+    if a.closed {
+        let vminus = st.impact.approach_with(a.vn_k);
+        if st.impact.pending {
+            record.resumed = true;
+        }
+        a.approach = vminus;
+        let bias = match settings.drift {
+            Drift::VelocityBias(beta) if a.gap < 0.0 => beta * a.gap / h,
+            _ => 0.0,
+        };
+        if settings.restitution == Restitution::Poisson {
+            a.carried = st.impact.compression;
+            *poisson_impact |= a.vn_k < 0.0 || st.impact.pending;
+            bias
+        } else {
+            e * vminus + bias
+        }
+    } else {
+        a.approach = a.vn_k;
+        *q1_n = q1_n.max(0.0) + a.gap / h;
+        a.gap / h
+    }
+}
+
+/// The gap's curvature term of a contact's normal condition, `min(c, 0) / h`, with `c` the
+/// second-order remainder of the gap over the step on `v_free`,
+/// `c = g(q_k ⊕ h v_free) - g(q_k) - h J_n v_free` (the linearised gap term `g / h + J_n v`
+/// of Stewart-Trinkle 1996 leaves it out). Where it would let the gap sink (`c < 0`) it is
+/// added: a turning body in lasting contact then keeps its gap to O(h^3) per step instead of
+/// sinking by O(h^2) every step. A remainder `c > 0` (two spheres' turning normal, or a
+/// predicted rotation that the step's impulse stops) is left out: `v_free` mispredicts it at
+/// an impact, where it would let the contact sink by `c`.
+#[inline]
+pub(super) fn curvature_term(c: f64, h: f64) -> f64 {
+    c.min(0.0) / h
+}
+
+/// The warm start of the active contacts into `initial` (their last impulses by identity,
+/// empty when warm starts are off), and whether it holds impulses that a solve changed
+/// ([`SolveBuffers::corrected`]: such a warm start is polished once more rather than reused
+/// as it is).
+pub(super) fn warm_start_of(
+    settings: &StepSettings,
+    dim: usize,
+    active: &[Active],
+    state: &[CandState],
+    initial: &mut Vec<f64>,
+) -> bool {
+    initial.clear();
+    if !settings.warm_start {
+        return false;
+    }
+    for a in active {
+        initial.extend_from_slice(&state[a.cand].warm[..dim]);
+    }
+    !initial.is_empty() && active.iter().any(|a| state[a.cand].corrected)
+}
+
+/// What a step's contact solve reads once W and the contact terms are built.
+pub(super) struct Phases<'a> {
+    pub(super) settings: &'a StepSettings,
+    /// 2 or 3.
+    pub(super) dim: usize,
+    /// W dense (used when `sparse` is `None`).
+    pub(super) dense: &'a [f64],
+    /// W in block CSR, for many contacts.
+    pub(super) sparse: Option<&'a BlockCsr>,
+    pub(super) active: &'a [Active],
+    /// each active contact's restitution coefficient (read by Poisson's impact phase).
+    pub(super) e: &'a [f64],
+    /// `G^T v_k` (open contacts separated), for Poisson's impact phase.
+    pub(super) q1: &'a [f64],
+    pub(super) mu: &'a [f64],
+    /// the warm start ([`warm_start_of`]).
+    pub(super) warm: Option<&'a [f64]>,
+    /// whether the warm start holds impulses a solve changed.
+    pub(super) corrected: bool,
+    /// Lemke's guessed basis.
+    pub(super) guess: &'a [usize],
+    /// whether Poisson's impact phase has work.
+    pub(super) poisson_impact: bool,
+}
+
+/// The contact solve of a step into `solve.impulse`, shared by the scenes' and the models'
+/// steps: Poisson's impact phase when it has work (the smooth phase then starts from
+/// `q_c + W P_impact`, and its impulses are added to the impact phase's), then the step's
+/// solve from the warm start; the solve's verdict goes into `record`.
+pub(super) fn solve_phases(
+    input: &Phases<'_>,
+    qc: &mut [f64],
+    record: &mut StepRecord,
+    solve: &mut SolveBuffers,
+    p_impact: &mut Vec<f64>,
+) -> Result<()> {
+    let dim = input.dim;
+    p_impact.clear();
+    if input.poisson_impact {
+        let problem = step_problem(dim, input.dense, input.sparse, input.q1, input.mu)?;
+        solve.corrected = input.corrected;
+        poisson_phase(
+            &PoissonInput {
+                settings: input.settings,
+                problem: &problem,
+                active: input.active,
+                e: input.e,
+                warm: input.warm,
+                guess: input.guess,
+            },
+            record,
+            solve,
+            p_impact,
+        )?;
+        let mut wp = std::mem::take(&mut solve.velocity);
+        wp.resize(qc.len(), 0.0);
+        problem.mul_w(p_impact, &mut wp);
+        for (q, d) in qc.iter_mut().zip(&wp) {
+            *q += d;
+        }
+        solve.velocity = wp;
+    }
+    let problem = step_problem(dim, input.dense, input.sparse, qc, input.mu)?;
+    solve.corrected = input.corrected;
+    let out = solve_step_problem(
+        input.settings,
+        &problem,
+        input.warm,
+        input.guess,
+        record,
+        solve,
+    )?;
+    for (p, d) in solve.impulse.iter_mut().zip(p_impact.iter()) {
+        *p += d;
+    }
+    record.status = Some(out.status);
+    record.error = out.measures.error;
+    record.scaled_error = out.measures.scaled_error;
+    record.iterations = out.iterations;
+    record.min_normal_impulse = out.measures.min_normal_impulse;
+    record.cone_violation = out.measures.cone_violation;
+    record.complementarity = out.measures.max_complementarity;
+    Ok(())
 }
 
 /// `G_{i,b}^T M_b^{-1} G_{j,b}` of side ki of contact i and side kj of contact j (same body).

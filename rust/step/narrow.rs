@@ -8,8 +8,10 @@
 //! contact's identity); the sphere pairs of [`Pair::Spheres`] are found each step by the broad
 //! phase (module `persistence`).
 
+use nalgebra::Vector3;
+
 use super::bodies::norm3;
-use super::{Pair, Scene, Stepper};
+use super::{BodyKind, Pair, Scene, Stepper};
 
 /// A contact candidate: a pair of features that may touch.
 #[derive(Clone, Copy, Debug)]
@@ -51,6 +53,25 @@ pub(super) fn frame(dim: usize, n: [f64; 3]) -> [[f64; 3]; 3] {
         [1.0 + s * n[0] * n[0] * a, s * b, -s * n[0]],
         [b, s + n[1] * n[1] * a, -n[1]],
     ]
+}
+
+/// `(R(φ) - I - [φ]×) p` for the rotation `R(φ)` by the rotation vector φ:
+/// `a φ × p + b φ × (φ × p)` with `a = sin θ / θ - 1`, `b = (1 - cos θ) / θ^2`, `θ = |φ|`
+/// (Rodrigues), by their series for small θ (no cancellation: zero for φ = 0).
+pub(super) fn rotation_remainder(phi: &Vector3<f64>, p: &Vector3<f64>) -> Vector3<f64> {
+    let t2 = phi.norm_squared();
+    let (a, b) = if t2 < 1e-4 {
+        (
+            -t2 / 6.0 * (1.0 - t2 / 20.0 * (1.0 - t2 / 42.0)),
+            0.5 * (1.0 - t2 / 12.0 * (1.0 - t2 / 30.0)),
+        )
+    } else {
+        let t = t2.sqrt();
+        let half = (0.5 * t).sin();
+        (t.sin() / t - 1.0, 2.0 * half * half / t2)
+    };
+    let c = phi.cross(p);
+    a * c + b * phi.cross(&c)
 }
 
 /// a body-frame point of a scene's coordinates, zero-padded to 3.
@@ -156,6 +177,59 @@ impl Stepper {
         }
     }
 
+    /// The second-order remainder of candidate c's gap over a step of the velocities v,
+    /// `g(q ⊕ h v) - g(q) - h J_n(q) v`, with `q ⊕ h v` the step's own integration (the
+    /// centres move by `h v`, a body turns by the rotation vector `φ = h ω`). The gap term
+    /// `g + h J_n v` is its first-order Taylor polynomial (Stewart and Trinkle 1996); the
+    /// remainder is the contact point's normal curvature: for a point at world offset p of a
+    /// turning body, `n . (R(φ) - I - [φ]×) p = (h^2 / 2) n . (ω × (ω × p)) + O(h^3)`, and
+    /// for two spheres `|d + Δ| - |d| - n . Δ ≈ |Δ_t|^2 / (2 |d|)`, their normal turning.
+    /// Zero for a particle against a plane and for bodies that do not turn.
+    pub(super) fn gap_curvature(&self, c: usize, geo: &Geometry, v: &[f64]) -> f64 {
+        let h = self.settings.h;
+        let cand = &self.candidates[c];
+        // the exact and linearised displacements of a body-frame point over the step
+        let moved = |(body, p, _): (usize, [f64; 3], f64)| -> (Vector3<f64>, Vector3<f64>) {
+            let b = &self.bodies[body];
+            let vb = &v[b.off_v..b.off_v + b.nv];
+            let (xc, xp) = self.world_point(body, p);
+            let arm = Vector3::from(xp) - Vector3::from(xc);
+            let (lin, phi) = match b.kind {
+                BodyKind::Particle => (Vector3::from(pad(vb)), Vector3::zeros()),
+                BodyKind::Planar => (
+                    Vector3::new(vb[0], vb[1], 0.0),
+                    Vector3::new(0.0, 0.0, h * vb[2]),
+                ),
+                BodyKind::Spatial => (
+                    Vector3::new(vb[0], vb[1], vb[2]),
+                    Vector3::new(h * vb[3], h * vb[4], h * vb[5]),
+                ),
+            };
+            (h * lin + phi.cross(&arm), rotation_remainder(&phi, &arm))
+        };
+        let n = Vector3::from(geo.normal);
+        let (lin_a, rem_a) = moved(cand.a);
+        match cand.b {
+            None => n.dot(&rem_a),
+            Some(b) => {
+                let (lin_b, rem_b) = moved(b);
+                let (_, wa) = self.world_point(cand.a.0, cand.a.1);
+                let (_, wb) = self.world_point(b.0, b.1);
+                let d = Vector3::from(wa) - Vector3::from(wb);
+                let dist = d.norm();
+                let delta = (lin_a + rem_a) - (lin_b + rem_b);
+                let s = (d + delta).norm() + dist;
+                if !(dist > 0.0 && s > 0.0) {
+                    return 0.0;
+                }
+                // |d + Δ| - |d| - n . Δ without cancellation (n = d / |d|)
+                let grow = (2.0 * d.dot(&delta) + delta.norm_squared()) / s;
+                let turn = (delta.norm_squared() - n.dot(&delta) * grow) / s;
+                turn + n.dot(&(rem_a - rem_b))
+            }
+        }
+    }
+
     /// `J_n v` of a geometry for a velocity vector.
     pub(super) fn normal_velocity(&self, g: &Geometry, v: &[f64]) -> f64 {
         let mut s = 0.0;
@@ -185,7 +259,30 @@ impl Stepper {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use nalgebra::Vector3;
+    use nalgebra::Rotation3;
+
+    #[test]
+    fn rotation_remainder_is_rodrigues_less_its_linear_part() {
+        let p = Vector3::new(0.3, -0.2, 0.7);
+        for phi in [
+            Vector3::new(1e-3, -2e-3, 5e-4),
+            Vector3::new(0.02, 0.01, -0.03),
+            Vector3::new(0.4, -1.1, 0.7),
+        ] {
+            let exact = Rotation3::from_scaled_axis(phi) * p - p - phi.cross(&p);
+            let got = rotation_remainder(&phi, &p);
+            assert!(
+                (got - exact).norm() <= 1e-15 + 1e-12 * exact.norm(),
+                "{phi}"
+            );
+        }
+        assert_eq!(rotation_remainder(&Vector3::zeros(), &p), Vector3::zeros());
+        // the leading term -(1/2) φ × (φ × p) . n is the centripetal one
+        let phi = Vector3::new(0.0, 0.0, 1e-5);
+        let got = rotation_remainder(&phi, &p);
+        let lead = 0.5 * phi.cross(&phi.cross(&p));
+        assert!((got - lead).norm() < 1e-5 * lead.norm());
+    }
 
     #[test]
     fn frames_are_orthonormal_and_right_handed() {

@@ -13,6 +13,9 @@ use super::{dot_v, ContactRecord, Pair, PolyhedralSettings, Scene, StepSolver, S
 pub(super) struct CandState {
     /// the last impulse, `dim` used entries, for warm starts.
     pub(super) warm: [f64; 3],
+    /// whether the last impulse came from a solve that changed its warm start (see
+    /// [`super::solve::SolveBuffers::corrected`]).
+    pub(super) corrected: bool,
     /// the impact the last step stopped with the gap term, owed its rebound by this step.
     pub(super) impact: ImpactMemory,
     /// the contact's variables in the last polyhedral LCP's final basis, for Lemke's warm
@@ -72,6 +75,7 @@ impl Stepper {
             let p = &sol.impulse[i * dim..(i + 1) * dim];
             let st = &mut self.state[a.cand];
             st.warm[..dim].copy_from_slice(p);
+            st.corrected = sol.corrected;
             st.basis = sol.basis.get(i).copied().unwrap_or(0);
             st.impact = if !a.closed && p[0] > 0.0 {
                 ImpactMemory::landed(a.vn_k, p[0])

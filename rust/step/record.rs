@@ -201,6 +201,7 @@ impl StepRecord {
         }
         self.active = self.active.max(earlier.active);
         self.error = self.error.max(earlier.error);
+        self.scaled_error = self.scaled_error.max(earlier.scaled_error);
         self.iterations = self.iterations.max(earlier.iterations);
         self.momentum_residual = self.momentum_residual.max(earlier.momentum_residual);
         self.min_normal_impulse = self.min_normal_impulse.min(earlier.min_normal_impulse);
@@ -209,5 +210,50 @@ impl StepRecord {
         self.resumed |= earlier.resumed;
         self.fallback |= earlier.fallback;
         self.projection = self.projection.max(earlier.projection);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// a record whose every checked measure is `x` (and the status `status`).
+    fn record(x: f64, status: ContactStatus) -> StepRecord {
+        StepRecord {
+            active: 1,
+            status: Some(status),
+            error: x,
+            scaled_error: x,
+            iterations: 1,
+            momentum_residual: x,
+            min_normal_impulse: x,
+            cone_violation: x,
+            complementarity: x,
+            resumed: false,
+            fallback: false,
+            projection: x,
+        }
+    }
+
+    #[test]
+    fn a_folded_record_keeps_the_worst_of_every_measure_including_the_scaled_error() {
+        for (later, earlier) in [(0.25, 4.0), (4.0, 0.25), (0.0, 1e-300), (1e300, 0.0)] {
+            let mut rec = record(later, ContactStatus::Solved);
+            rec.fold(&record(earlier, ContactStatus::Solved));
+            let worst = f64::max(later, earlier);
+            // the verdict's own measure is folded as the others: a row standing for several
+            // steps shows the worst step's scaled error, not the last one's
+            assert_eq!(rec.scaled_error, worst);
+            assert_eq!(rec.error, worst);
+            assert_eq!(rec.momentum_residual, worst);
+            assert_eq!(rec.cone_violation, worst);
+            assert_eq!(rec.complementarity, worst);
+            assert_eq!(rec.projection, worst);
+            assert_eq!(rec.min_normal_impulse, f64::min(later, earlier));
+        }
+        // a failed earlier status is kept over a later success
+        let mut rec = record(0.0, ContactStatus::Solved);
+        rec.fold(&record(1.0, ContactStatus::IterationLimit));
+        assert_eq!(rec.status, Some(ContactStatus::IterationLimit));
     }
 }

@@ -66,6 +66,12 @@ pub(super) struct SolveBuffers {
     pub(super) basis: Vec<u64>,
     /// Lemke's tableau, reused while the LCP keeps its size.
     pub(super) lemke: Option<LemkeWorkspace>,
+    /// on entry to [`solve_step_problem`], whether the warm start holds impulses that a solve
+    /// changed (the contacts' [`CandState::corrected`](super::persistence::CandState)); on
+    /// exit, whether this solve changed its warm start (NSGS sweeps or Lemke pivots). Such
+    /// impulses also cancel the residual velocity the reused impulses had let build up, see
+    /// [`reuse_warm_start`].
+    pub(super) corrected: bool,
 }
 
 /// What a step's contact solve reports besides the impulses.
@@ -154,6 +160,20 @@ pub(super) fn solve_step_problem(
     record: &mut StepRecord,
     ws: &mut SolveBuffers,
 ) -> Result<Outcome> {
+    let out = solve_or_reuse(settings, problem, initial, guess, record, ws)?;
+    ws.corrected = out.iterations > 0;
+    Ok(out)
+}
+
+/// see [`solve_step_problem`].
+fn solve_or_reuse(
+    settings: &StepSettings,
+    problem: &ContactProblem<'_>,
+    initial: Option<&[f64]>,
+    guess: &[usize],
+    record: &mut StepRecord,
+    ws: &mut SolveBuffers,
+) -> Result<Outcome> {
     ws.basis.clear();
     // r = 0 solves the problem exactly when no contact's normal would close
     // (u = q, u_n >= 0, and 0 lies in every cone): no solve needed
@@ -219,6 +239,15 @@ enum Warm {
 /// then NSGS (which would stop after 0 sweeps) need not be set up; nearly so (within
 /// [`POLISH_NEAR`] times the tolerance), a few sweeps towards [`POLISH_TOL`] times it, so that
 /// the next steps' impulses stay within the tolerance for longer.
+///
+/// Reused as they are, impulses `r` leave the contact velocity `u_{k+1} = u_k + (W r + b)`
+/// with `b` the step's load term: the residual `W r + b` builds up step after step. Impulses
+/// that a solve changed ([`SolveBuffers::corrected`]) also cancelled the residual `u_{k-1}`
+/// built up before: `W r + b = u_k - u_{k-1} ≈ -u_{k-1}`, so reusing them as they are
+/// replays that cancellation (an overshoot as large as the residual that called for the
+/// solve, and a reuse/solve cycle of period two). After a solve the warm start is therefore
+/// polished even when within the tolerance: the polish's impulses cancel a residual that is
+/// already small, and their own build-up is slow.
 fn reuse_warm_start(
     s: &NsgsSettings,
     problem: &ContactProblem<'_>,
@@ -230,7 +259,10 @@ fn reuse_warm_start(
     };
     ws.velocity.resize(problem.size(), 0.0);
     let m = measure_into(problem, init, &mut ws.velocity);
-    if m.passes(s.tol) && m.cone_violation == 0.0 {
+    // up to LEMKE_FALLBACK_MAX contacts the polish below is tried; above, NSGS starts from
+    // the warm start
+    let few = problem.nc <= LEMKE_FALLBACK_MAX;
+    if m.passes(s.tol) && m.cone_violation == 0.0 && !(ws.corrected && few) {
         ws.impulse.clear();
         ws.impulse.extend_from_slice(init);
         return Ok(Warm::Done(Outcome {
@@ -239,7 +271,7 @@ fn reuse_warm_start(
             measures: m,
         }));
     }
-    if m.passes(POLISH_NEAR * s.tol) && problem.nc <= LEMKE_FALLBACK_MAX {
+    if m.passes(POLISH_NEAR * s.tol) && few {
         let polish = NsgsSettings {
             initial: Some(init.to_vec()),
             max_iter: s.max_iter.min(POLISH_SWEEPS),

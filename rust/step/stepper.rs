@@ -27,6 +27,7 @@ mod record;
 mod solve;
 
 use self::bodies::{bodies_of, norm3, BodyInfo, Frozen};
+use self::event::Located;
 use self::narrow::{declared_candidates, frame, Candidate, Geometry};
 use self::persistence::{sphere_points, CandState};
 pub use self::record::{simulate, simulate_recorded, ContactRecord, StepRecord, Trajectory};
@@ -109,6 +110,8 @@ pub struct Stepper {
     active: Vec<Active>,
     /// the assembly of W (dense, or COO triplets for block CSR), kept from step to step.
     delassus: WAssembly,
+    /// the drift projection's contact rows, kept from step to step.
+    proj_rows: Vec<drift::Row>,
     /// the step index whose state `prepare` has done (M, v_free, speed bounds, pairs,
     /// geometry), so the record of a state and the step from it share that work.
     prepared: Option<usize>,
@@ -182,6 +185,7 @@ impl Stepper {
             step_index: 0,
             active: Vec::with_capacity(nc),
             delassus: WAssembly::new(),
+            proj_rows: Vec::new(),
             prepared: None,
             geo_cache: Vec::new(),
             speed_bounds: vec![[0.0; 2]; scene.bodies.len()],
@@ -282,9 +286,12 @@ impl Stepper {
     pub fn step(&mut self, contacts: &mut Vec<ContactRecord>) -> Result<StepRecord> {
         self.prepare();
         self.search_contacts();
+        let mut free = false;
         if self.settings.locate_impacts {
-            if let Some(record) = self.located_step(contacts)? {
-                return Ok(record);
+            match self.located_step(contacts)? {
+                Located::Done(record) => return Ok(record),
+                Located::Free => free = true,
+                Located::Plain => {}
             }
         }
         let nc = self.active.len();
@@ -293,7 +300,11 @@ impl Stepper {
         v_next.copy_from_slice(&self.v_free);
         self.gp.fill(0.0);
         if nc > 0 {
-            self.solve_contacts(&mut record)?;
+            if free {
+                self.free_of_contacts(&mut record);
+            } else {
+                self.solve_contacts(&mut record)?;
+            }
             self.apply_impulses(&mut v_next);
         }
         record.momentum_residual = self.momentum_residual(&v_next);

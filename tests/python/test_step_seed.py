@@ -190,14 +190,15 @@ def test_painleve_rod_falls_flat_every_step_solved(h):
 
 
 def test_drift_corrections_measured_effect():
-    # the falling rod (h = 1e-3, 3 s): none leaves the sticking end 5.3e-9 m deep; the velocity
-    # bias pushes it out again; the projection keeps every gap >= 0 with no energy gain. The
-    # bouncing ball's rebound (apex ratio e^2) is the same under all three.
+    # the falling rod (h = 1e-3, 3 s): every gap >= 0 to rounding with each option (without
+    # correction the sticking end sank 5.3e-9 m before the contact conditions carried the
+    # gap's curvature term); the projection gains no energy. The bouncing ball's rebound (apex
+    # ratio e^2) is the same under all three.
     none = painleve_scene().simulate(3.0, 1e-3)
     bias = painleve_scene().simulate(3.0, 1e-3, drift="bias", drift_bias=0.2)
     proj = painleve_scene().simulate(3.0, 1e-3, drift="projection")
-    assert -1e-8 < none.min_gap.min() < -1e-9
-    assert bias.min_gap[-1] > -1e-12
+    assert none.min_gap.min() > -1e-12
+    assert bias.min_gap.min() > -1e-12
     assert proj.min_gap.min() > -1e-12
     assert proj.check(strict=True).ok
     assert np.max(proj.energy_gain()) < 1e-12
