@@ -334,30 +334,44 @@ impl BlockCsr {
     /// give bitwise equal products.
     #[inline]
     pub fn row_mul(&self, i: usize, x: &[f64], skip_diag: bool) -> [f64; 3] {
-        let d = self.dim;
-        let mut out = [0.0; 3];
         let (lo, hi) = (self.row_ptr[i], self.row_ptr[i + 1]);
-        if d == 3 {
-            for t in lo..hi {
-                let j = self.cols[t];
-                if skip_diag && j == i {
-                    continue;
-                }
-                let b = &self.values[t * 9..t * 9 + 9];
+        if !skip_diag {
+            return self.tiles_mul(lo, hi, x);
+        }
+        // the tiles left and right of the diagonal one, continuing the same running sums
+        let d = self.diag[i];
+        let left = self.tiles_mul(lo, d, x);
+        self.tiles_mul_into(d + 1, hi, x, left)
+    }
+
+    /// `Σ_t W_t x_{cols[t]}` over the tiles `t in lo..hi` of one block row.
+    #[inline]
+    fn tiles_mul(&self, lo: usize, hi: usize, x: &[f64]) -> [f64; 3] {
+        self.tiles_mul_into(lo, hi, x, [0.0; 3])
+    }
+
+    /// `out + Σ_t W_t x_{cols[t]}`, each component summed in tile order (one running sum per
+    /// component, three products per tile, left to right).
+    #[inline]
+    fn tiles_mul_into(&self, lo: usize, hi: usize, x: &[f64], mut out: [f64; 3]) -> [f64; 3] {
+        let cols = &self.cols[lo..hi];
+        if self.dim == 3 {
+            let values = &self.values[lo * 9..hi * 9];
+            for (&j, b) in cols.iter().zip(values.chunks_exact(9)) {
                 let xj = &x[3 * j..3 * j + 3];
-                for (a, o) in out.iter_mut().enumerate() {
-                    *o += b[3 * a] * xj[0];
-                    *o += b[3 * a + 1] * xj[1];
-                    *o += b[3 * a + 2] * xj[2];
-                }
+                out[0] += b[0] * xj[0];
+                out[0] += b[1] * xj[1];
+                out[0] += b[2] * xj[2];
+                out[1] += b[3] * xj[0];
+                out[1] += b[4] * xj[1];
+                out[1] += b[5] * xj[2];
+                out[2] += b[6] * xj[0];
+                out[2] += b[7] * xj[1];
+                out[2] += b[8] * xj[2];
             }
         } else {
-            for t in lo..hi {
-                let j = self.cols[t];
-                if skip_diag && j == i {
-                    continue;
-                }
-                let b = &self.values[t * 4..t * 4 + 4];
+            let values = &self.values[lo * 4..hi * 4];
+            for (&j, b) in cols.iter().zip(values.chunks_exact(4)) {
                 let xj = &x[2 * j..2 * j + 2];
                 out[0] += b[0] * xj[0];
                 out[0] += b[1] * xj[1];

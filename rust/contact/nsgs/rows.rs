@@ -1,0 +1,229 @@
+//! What an NSGS sweep reads of W: for contact i, `Σ_{j != i} W_ij r_j`.
+//!
+//! A block-sparse W is read in place. A dense W whose `dim x dim` tiles are mostly zero (a
+//! mechanism's `W = G^T M^-1 G` has `W_ij != 0` only when contacts i and j share a body) is
+//! copied once into block CSR (its nonzero off-diagonal tiles), so a sweep reads O(nnz)
+//! memory instead of `(dim nc)^2` doubles; a dense W with more nonzero tiles than half, or
+//! whose copy would exceed the memory budget, is read row by row. Each component is summed left to right in column order
+//! whichever the storage (a zero tile adds exactly nothing), so the three give bitwise equal
+//! sums.
+
+use super::super::{BlockCsr, ContactProblem, Delassus};
+
+/// the storage an NSGS sweep reads W from.
+pub(super) enum OffDiagonal<'a> {
+    /// the caller's block CSR.
+    Tiles(&'a BlockCsr),
+    /// the nonzero off-diagonal tiles of a dense W.
+    Copied(OffTiles),
+    /// a row-major dense W.
+    Dense(&'a [f64]),
+}
+
+impl<'a> OffDiagonal<'a> {
+    /// the storage for `problem` (see the module notes).
+    pub(super) fn of(problem: &ContactProblem<'a>) -> Self {
+        match problem.storage() {
+            Delassus::BlockSparse(b) => Self::Tiles(b),
+            Delassus::Dense(w) => {
+                let (dim, nc) = (problem.dim, problem.nc);
+                let tiles = offdiagonal_tiles(w, dim, nc);
+                let bytes = tiles.saturating_mul(dim * dim * 8 + 8);
+                if tiles.saturating_mul(2) <= nc.saturating_mul(nc)
+                    && bytes <= crate::limits::memory_budget()
+                {
+                    Self::Copied(OffTiles::of(w, dim, nc, tiles))
+                } else {
+                    Self::Dense(w)
+                }
+            }
+        }
+    }
+
+    /// `Σ_{j != i} W_ij x_j`, the `dim` components of contact i zero-padded to 3.
+    #[inline]
+    pub(super) fn mul(&self, i: usize, dim: usize, x: &[f64]) -> [f64; 3] {
+        match self {
+            Self::Tiles(b) => b.row_mul(i, x, true),
+            Self::Copied(t) => t.row_mul(i, dim, x),
+            Self::Dense(w) => dense_row_mul_offdiag(w, dim, i, x),
+        }
+    }
+}
+
+/// whether tile (bi, bj) of a dense W has a nonzero entry.
+fn tile_is_nonzero(w: &[f64], dim: usize, n: usize, bi: usize, bj: usize) -> bool {
+    (0..dim).any(|a| {
+        let row = (bi * dim + a) * n + bj * dim;
+        w[row..row + dim].iter().any(|&v| v != 0.0)
+    })
+}
+
+/// the number of off-diagonal `dim x dim` tiles of a dense W with a nonzero entry.
+fn offdiagonal_tiles(w: &[f64], dim: usize, nc: usize) -> usize {
+    let n = dim * nc;
+    (0..nc)
+        .map(|bi| {
+            (0..nc)
+                .filter(|&bj| bj != bi && tile_is_nonzero(w, dim, n, bi, bj))
+                .count()
+        })
+        .sum()
+}
+
+/// The nonzero off-diagonal tiles of a dense W in block CSR (three allocations, sized
+/// exactly): block row i holds the tiles `j in cols[ptr[i]..ptr[i+1]]`, increasing, each
+/// `dim * dim` scalars row-major in `values`.
+pub(super) struct OffTiles {
+    ptr: Vec<usize>,
+    cols: Vec<usize>,
+    values: Vec<f64>,
+}
+
+impl OffTiles {
+    fn of(w: &[f64], dim: usize, nc: usize, tiles: usize) -> Self {
+        let n = dim * nc;
+        let mut ptr = Vec::with_capacity(nc + 1);
+        let mut cols = Vec::with_capacity(tiles);
+        let mut values = Vec::with_capacity(tiles * dim * dim);
+        ptr.push(0);
+        for bi in 0..nc {
+            for bj in (0..nc).filter(|&bj| bj != bi && tile_is_nonzero(w, dim, n, bi, bj)) {
+                cols.push(bj);
+                for a in 0..dim {
+                    let row = (bi * dim + a) * n + bj * dim;
+                    values.extend_from_slice(&w[row..row + dim]);
+                }
+            }
+            ptr.push(cols.len());
+        }
+        Self { ptr, cols, values }
+    }
+
+    /// `Σ_{j != i} W_ij x_j`, each component summed in tile order, three products per tile
+    /// left to right (as [`BlockCsr::row_mul`]).
+    #[inline]
+    fn row_mul(&self, i: usize, dim: usize, x: &[f64]) -> [f64; 3] {
+        let (lo, hi) = (self.ptr[i], self.ptr[i + 1]);
+        let cols = &self.cols[lo..hi];
+        let mut out = [0.0; 3];
+        if dim == 3 {
+            for (&j, b) in cols.iter().zip(self.values[lo * 9..hi * 9].chunks_exact(9)) {
+                let xj = &x[3 * j..3 * j + 3];
+                out[0] += b[0] * xj[0];
+                out[0] += b[1] * xj[1];
+                out[0] += b[2] * xj[2];
+                out[1] += b[3] * xj[0];
+                out[1] += b[4] * xj[1];
+                out[1] += b[5] * xj[2];
+                out[2] += b[6] * xj[0];
+                out[2] += b[7] * xj[1];
+                out[2] += b[8] * xj[2];
+            }
+        } else {
+            for (&j, b) in cols.iter().zip(self.values[lo * 4..hi * 4].chunks_exact(4)) {
+                let xj = &x[2 * j..2 * j + 2];
+                out[0] += b[0] * xj[0];
+                out[0] += b[1] * xj[1];
+                out[1] += b[2] * xj[0];
+                out[1] += b[3] * xj[1];
+            }
+        }
+        out
+    }
+}
+
+/// `Σ_{j != i} W_ij x_j` from a dense row-major W: the `dim` rows of contact i are walked
+/// together, tile by tile, each component in column order.
+fn dense_row_mul_offdiag(w: &[f64], dim: usize, i: usize, x: &[f64]) -> [f64; 3] {
+    let n = x.len();
+    let o = i * dim;
+    let mut out = [0.0; 3];
+    if dim == 3 {
+        let rows = &w[o * n..(o + 3) * n];
+        let (r0, rest) = rows.split_at(n);
+        let (r1, r2) = rest.split_at(n);
+        for part in [0..o, o + 3..n] {
+            let xs = &x[part.clone()];
+            let tiles = r0[part.clone()]
+                .chunks_exact(3)
+                .zip(r1[part.clone()].chunks_exact(3))
+                .zip(r2[part].chunks_exact(3))
+                .zip(xs.chunks_exact(3));
+            for (((a, b), c), xj) in tiles {
+                out[0] += a[0] * xj[0];
+                out[0] += a[1] * xj[1];
+                out[0] += a[2] * xj[2];
+                out[1] += b[0] * xj[0];
+                out[1] += b[1] * xj[1];
+                out[1] += b[2] * xj[2];
+                out[2] += c[0] * xj[0];
+                out[2] += c[1] * xj[1];
+                out[2] += c[2] * xj[2];
+            }
+        }
+    } else {
+        for (a, v) in out.iter_mut().enumerate().take(dim) {
+            let row = &w[(o + a) * n..(o + a + 1) * n];
+            let mut acc = 0.0;
+            for (p, q) in row[..o].iter().zip(&x[..o]) {
+                acc += p * q;
+            }
+            for (p, q) in row[o + dim..].iter().zip(&x[o + dim..]) {
+                acc += p * q;
+            }
+            *v = acc;
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testing::SplitMix64;
+
+    /// the three storages give bitwise equal off-diagonal products, on W with zero tiles and
+    /// without.
+    #[test]
+    fn dense_copied_and_sparse_rows_agree_bitwise() {
+        let mut rng = SplitMix64::new(5);
+        for (dim, nc, density) in [(3, 9, 0.2), (3, 6, 1.0), (2, 11, 0.3), (2, 5, 1.0)] {
+            let n = dim * nc;
+            let mut w = vec![0.0; n * n];
+            for bi in 0..nc {
+                for bj in 0..nc {
+                    if bi == bj || rng.uniform() < density {
+                        for a in 0..dim {
+                            for c in 0..dim {
+                                w[(bi * dim + a) * n + bj * dim + c] = rng.normal();
+                            }
+                        }
+                    }
+                }
+            }
+            let x: Vec<f64> = (0..n).map(|_| rng.normal()).collect();
+            let q = vec![0.0; n];
+            let mu = vec![0.5; nc];
+            let p = ContactProblem::new(dim, &w, &q, &mu).unwrap();
+            let rows = OffDiagonal::of(&p);
+            assert_eq!(matches!(rows, OffDiagonal::Copied(_)), density < 1.0);
+            let sparse = BlockCsr::from_dense(dim, n, &w).unwrap();
+            for i in 0..nc {
+                let a = rows.mul(i, dim, &x);
+                let b = sparse.row_mul(i, &x, true);
+                let c = dense_row_mul_offdiag(&w, dim, i, &x);
+                assert_eq!(a, b);
+                assert_eq!(a, c);
+                let o = i * dim;
+                for k in 0..dim {
+                    let e: f64 = (0..n)
+                        .filter(|&c| c / dim != i)
+                        .map(|c| w[(o + k) * n + c] * x[c])
+                        .sum();
+                    assert!((a[k] - e).abs() <= 1e-13 * (1.0 + e.abs()));
+                }
+            }
+        }
+    }
+}
