@@ -41,7 +41,7 @@
 //!   solved as above in the eigenbasis of `E S E` (precomputed). When `S = t I` this minimiser
 //!   is the ellipse projection of `-g / t` ([`super::super::projection::project_ellipse`]).
 
-use super::super::projection::{secular, solve_secular};
+use super::super::projection::secular;
 
 /// passes of the normal / tangential block descent inside one contact (dim 3, and the 2D
 /// fallback).
@@ -68,6 +68,8 @@ pub(super) struct LocalBlock {
     /// anisotropic friction: `E = diag(mu_1, mu_2)`, the tangential impulse is `r_t = E s`
     /// with `||s|| <= r_n`.
     pub(super) scale: Option<[f64; 2]>,
+    /// `A^-1` row-major (3D, when A is safely invertible): the sticking solution `-A^-1 b`.
+    pub(super) inverse: Option<[f64; 9]>,
     /// whether the normal and tangential parts are coupled (`c_n`, `c_t` or k nonzero): if not,
     /// one pass of the descent is exact.
     pub(super) coupled: bool,
@@ -101,9 +103,71 @@ impl LocalBlock {
             None => Eig2::of(b.t),
         };
         b.rho = if b.a > 0.0 { 1.0 / b.a } else { 0.0 };
+        if dim == 3 {
+            b.inverse = inverse3(wb);
+        }
         b.coupled = b.cn != [0.0; 2] || b.ct != [0.0; 2] || b.k != 0.0;
         b
     }
+}
+
+/// `A^-1` of a 3x3 block by its cofactors, when `det A` is at least 1e-10 times the product of
+/// the row norms (a block far from singular: its sticking solution is then accurate).
+fn inverse3(m: &[[f64; 3]; 3]) -> Option<[f64; 9]> {
+    let c = [
+        m[1][1] * m[2][2] - m[1][2] * m[2][1],
+        m[1][2] * m[2][0] - m[1][0] * m[2][2],
+        m[1][0] * m[2][1] - m[1][1] * m[2][0],
+    ];
+    let det = m[0][0] * c[0] + m[0][1] * c[1] + m[0][2] * c[2];
+    let norms: f64 = m
+        .iter()
+        .map(|r| (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt())
+        .product();
+    if !(det.abs() > 1e-10 * norms) || !det.is_finite() {
+        return None;
+    }
+    let inv = [
+        c[0] / det,
+        (m[0][2] * m[2][1] - m[0][1] * m[2][2]) / det,
+        (m[0][1] * m[1][2] - m[0][2] * m[1][1]) / det,
+        c[1] / det,
+        (m[0][0] * m[2][2] - m[0][2] * m[2][0]) / det,
+        (m[0][2] * m[1][0] - m[0][0] * m[1][2]) / det,
+        c[2] / det,
+        (m[0][1] * m[2][0] - m[0][0] * m[2][1]) / det,
+        (m[0][0] * m[1][1] - m[0][1] * m[1][0]) / det,
+    ];
+    inv.iter().all(|v| v.is_finite()).then_some(inv)
+}
+
+/// The one-contact solution in 3D when it is separation or sticking, or `None` (sliding, or
+/// a block without a safe inverse): separation when `b_n >= 0` (r = 0 gives `u = b`, which
+/// satisfies Signorini's condition and is in the dual cone), sticking when `r = -A^-1 b` is
+/// inside the friction disk (ellipse), where `u = 0`.
+pub(super) fn local_3d_closed(blk: &LocalBlock, mu: f64, b: &[f64; 3]) -> Option<[f64; 3]> {
+    if b[0] >= 0.0 {
+        return Some([0.0; 3]);
+    }
+    let m = blk.inverse?;
+    let r = [
+        -(m[0] * b[0] + m[1] * b[1] + m[2] * b[2]),
+        -(m[3] * b[0] + m[4] * b[1] + m[5] * b[2]),
+        -(m[6] * b[0] + m[7] * b[1] + m[8] * b[2]),
+    ];
+    if !(r[0] > 0.0) {
+        return None;
+    }
+    let inside = match blk.scale {
+        None => r[1] * r[1] + r[2] * r[2] < (mu * r[0]) * (mu * r[0]),
+        Some(e) if e[0] > 0.0 && e[1] > 0.0 => {
+            let (x, y) = (r[1] / e[0], r[2] / e[1]);
+            x * x + y * y < r[0] * r[0]
+        }
+        Some(_) => false,
+    };
+    // a non-finite square (huge impulses) compares false: the passes decide
+    inside.then_some(r)
 }
 
 /// `S = Q diag(small, large) Q^T` with `Q = [(-sn, cs), (cs, sn)]` (columns: the eigenvectors
@@ -135,7 +199,15 @@ impl Eig2 {
 /// `argmin 1/2 x^T S x + g . x  over ||x|| <= radius` for positive semidefinite S given by its
 /// eigendecomposition (the trust-region subproblem in 2D). In the hard case (S singular, g
 /// orthogonal to the null direction) the minimum-norm minimiser is returned.
+#[cfg(test)]
 pub(super) fn disk_qp(e: &Eig2, g: [f64; 2], radius: f64) -> [f64; 2] {
+    let mut hint = f64::NAN;
+    disk_qp_from(e, g, radius, &mut hint)
+}
+
+/// [`disk_qp`] with the multiplier λ of a nearby problem as the secular solver's start (NaN:
+/// none); on return `lambda` holds this problem's multiplier.
+pub(super) fn disk_qp_from(e: &Eig2, g: [f64; 2], radius: f64, lambda_hint: &mut f64) -> [f64; 2] {
     if radius <= 0.0 {
         return [0.0, 0.0];
     }
@@ -147,8 +219,9 @@ pub(super) fn disk_qp(e: &Eig2, g: [f64; 2], radius: f64) -> [f64; 2] {
     let lambda = if secular(d, gg, 0.0) <= radius * radius {
         0.0
     } else {
-        solve_secular(d, gg, radius, 0.0)
+        secular_root(d, gg, radius, *lambda_hint)
     };
+    *lambda_hint = lambda;
     let mut x = [0.0; 2];
     for k in 0..2 {
         let den = d[k] + lambda;
@@ -161,6 +234,61 @@ pub(super) fn disk_qp(e: &Eig2, g: [f64; 2], radius: f64) -> [f64; 2] {
         x[1] *= radius / norm;
     }
     [-e.sn * x[0] + e.cs * x[1], e.cs * x[0] + e.sn * x[1]]
+}
+
+/// The root `λ > 0` of the secular equation `Σ_k g_k^2 / (d_k + λ)^2 = radius^2` when its
+/// left side exceeds `radius^2` at 0 (Moré and Sorensen 1983): Newton on
+/// `ψ(λ) = 1 / sqrt(S(λ)) - 1 / radius`, which is exactly linear for `d_0 = d_1` (the disk),
+/// safeguarded by the bracket `[||g|| / radius - max d, ||g|| / radius - min d]` (bisection
+/// when a step leaves it), started from `hint` when it lies inside the bracket (the previous
+/// pass's multiplier: a step or two), else from the bracket's right end.
+fn secular_root(d: [f64; 2], g: [f64; 2], radius: f64, hint: f64) -> f64 {
+    let gnorm = g[0].hypot(g[1]);
+    let mut lo = (gnorm / radius - d[0].max(d[1])).max(0.0);
+    let mut hi = (gnorm / radius - d[0].min(d[1])).max(lo);
+    let mut lambda = if hint > lo && hint < hi { hint } else { hi };
+    for _ in 0..100 {
+        let mut s = 0.0;
+        let mut ds = 0.0;
+        for k in 0..2 {
+            let den = d[k] + lambda;
+            if den > 0.0 {
+                let p = g[k] / den;
+                s += p * p;
+                ds -= 2.0 * p * p / den;
+            }
+        }
+        if !(s > 0.0 && s.is_finite()) {
+            break;
+        }
+        let root = s.sqrt();
+        let psi = 1.0 / root - 1.0 / radius;
+        if psi.abs() <= f64::EPSILON / radius {
+            break;
+        }
+        if psi < 0.0 {
+            lo = lambda;
+        } else {
+            hi = lambda;
+        }
+        let dpsi = -0.5 * ds / (s * root);
+        let mut next = if dpsi > 0.0 {
+            lambda - psi / dpsi
+        } else {
+            f64::NAN
+        };
+        if !(next > lo && next < hi) {
+            next = 0.5 * (lo + hi);
+        }
+        let step = (next - lambda).abs();
+        lambda = next;
+        if step <= 4.0 * f64::EPSILON * lambda.abs().max(f64::MIN_POSITIVE)
+            || hi - lo <= 4.0 * f64::EPSILON * hi.abs()
+        {
+            break;
+        }
+    }
+    lambda
 }
 
 /// The exact one-contact solution in 2D by the case split, or `None` when no case is
@@ -199,6 +327,7 @@ pub(super) fn local_2d_exact(blk: &LocalBlock, mu: f64, bn: f64, bt: f64) -> Opt
 /// impulse on entry and the update on exit.
 pub(super) fn local_descent(blk: &LocalBlock, mu: f64, b: &[f64; 3], dim: usize, r: &mut [f64; 3]) {
     let passes = if blk.coupled { LOCAL_ITERS } else { 1 };
+    let mut lambda = f64::NAN;
     for _ in 0..passes {
         let old = *r;
         let ct = blk.cn[0] * r[1] + blk.cn[1] * r[2];
@@ -226,11 +355,11 @@ pub(super) fn local_descent(blk: &LocalBlock, mu: f64, b: &[f64; 3], dim: usize,
             };
         } else if let Some(e) = blk.scale {
             // r_t = E s, ||s|| <= r_n: min 1/2 s^T (E S E) s + (E g) . s over the disk
-            let x = disk_qp(&blk.eig, [e[0] * g[0], e[1] * g[1]], rn);
+            let x = disk_qp_from(&blk.eig, [e[0] * g[0], e[1] * g[1]], rn, &mut lambda);
             r[1] = e[0] * x[0];
             r[2] = e[1] * x[1];
         } else {
-            let x = disk_qp(&blk.eig, g, radius);
+            let x = disk_qp_from(&blk.eig, g, radius, &mut lambda);
             r[1] = x[0];
             r[2] = x[1];
         }
