@@ -31,7 +31,7 @@ mod schedule;
 
 pub use local::LOCAL_ITERS;
 
-use local::{local_2d_exact, local_descent, LocalBlock};
+use local::{local_2d_exact, local_3d_closed, local_descent, LocalBlock};
 use rows::OffDiagonal;
 use schedule::CheckSchedule;
 
@@ -82,33 +82,27 @@ impl Default for NsgsSettings {
     }
 }
 
-/// the visiting sequence of one sweep for `order` (checked: a custom order must be a
-/// permutation of 0..nc).
-fn sweep_sequence(order: &ContactOrder, nc: usize) -> Result<Vec<usize>> {
-    Ok(match order {
-        ContactOrder::Forward => (0..nc).collect(),
-        ContactOrder::Backward => (0..nc).rev().collect(),
-        ContactOrder::Symmetric => (0..nc).chain((0..nc).rev()).collect(),
-        ContactOrder::Custom(p) => {
-            let mut seen = vec![false; nc];
-            if p.len() != nc {
-                return Err(CoulombError::Shape(format!(
-                    "the contact order has {} entries, expected nc = {nc}",
-                    p.len()
+/// `order`, checked: a custom order must be a permutation of 0..nc.
+fn checked_order(order: &ContactOrder, nc: usize) -> Result<&ContactOrder> {
+    if let ContactOrder::Custom(p) = order {
+        let mut seen = vec![false; nc];
+        if p.len() != nc {
+            return Err(CoulombError::Shape(format!(
+                "the contact order has {} entries, expected nc = {nc}",
+                p.len()
+            )));
+        }
+        for &i in p {
+            if i >= nc || seen[i] {
+                return Err(CoulombError::InvalidParameter(format!(
+                    "the contact order must be a permutation of 0..{nc}: {i} is out of \
+                     range or repeated"
                 )));
             }
-            for &i in p {
-                if i >= nc || seen[i] {
-                    return Err(CoulombError::InvalidParameter(format!(
-                        "the contact order must be a permutation of 0..{nc}: {i} is out of \
-                         range or repeated"
-                    )));
-                }
-                seen[i] = true;
-            }
-            p.clone()
+            seen[i] = true;
         }
-    })
+    }
+    Ok(order)
 }
 
 /// Projects contact i's impulse in place onto its friction cone: the Coulomb cone, or for
@@ -156,12 +150,12 @@ pub(crate) fn project_friction_cone(problem: &ContactProblem<'_>, i: usize, ri: 
 }
 
 /// One NSGS sweep's data: the problem, where W's off-diagonal tiles are read from, the local
-/// blocks, the visiting order and the relaxation.
+/// blocks, the visiting order (checked) and the relaxation.
 struct Sweep<'s, 'a> {
     problem: &'s ContactProblem<'a>,
     rows: &'s OffDiagonal<'a>,
     blocks: &'s [LocalBlock],
-    sequence: &'s [usize],
+    order: &'s ContactOrder,
     omega: f64,
 }
 
@@ -171,11 +165,22 @@ impl Sweep<'_, '_> {
     /// ||b_i||_∞ / W_nn,i)` (b_i the velocity the contact saw without itself, in impulse
     /// units), NaN when an update was not finite.
     fn run(&self, r: &mut [f64]) -> f64 {
+        let nc = self.problem.nc;
+        match self.order {
+            ContactOrder::Forward => self.visit(0..nc, r),
+            ContactOrder::Backward => self.visit((0..nc).rev(), r),
+            ContactOrder::Symmetric => self.visit((0..nc).chain((0..nc).rev()), r),
+            ContactOrder::Custom(p) => self.visit(p.iter().copied(), r),
+        }
+    }
+
+    /// the updates of the contacts of `sequence`, in turn (see [`Self::run`]).
+    fn visit(&self, sequence: impl Iterator<Item = usize>, r: &mut [f64]) -> f64 {
         let problem = self.problem;
         let dim = problem.dim;
         let omega = self.omega;
         let mut change: f64 = 0.0;
-        for &i in self.sequence {
+        for i in sequence {
             let blk = &self.blocks[i];
             // W is finite, so this is the degenerate test of the setup
             if blk.a <= 0.0 {
@@ -193,15 +198,12 @@ impl Sweep<'_, '_> {
             }
             let mut new = old;
             let exact = if dim == 2 {
-                local_2d_exact(blk, mu, b[0], b[1])
+                local_2d_exact(blk, mu, b[0], b[1]).map(|(rn, rt)| [rn, rt, 0.0])
             } else {
-                None
+                local_3d_closed(blk, mu, &b)
             };
             match exact {
-                Some((rn, rt)) => {
-                    new[0] = rn;
-                    new[1] = rt;
-                }
+                Some(x) => new = x,
                 None => local_descent(blk, mu, &b, dim, &mut new),
             }
             let mut diff: f64 = 0.0;
@@ -239,6 +241,18 @@ pub fn solve_nsgs(problem: &ContactProblem<'_>, s: &NsgsSettings) -> Result<Cont
             "max_iter must be at least 1".into(),
         ));
     }
+    // a dense W with mostly zero tiles: the whole solve runs on its block CSR copy
+    let copy = rows::tiled(problem);
+    let tiled_problem;
+    let problem = match &copy {
+        Some(tiles) => {
+            let mut p = ContactProblem::with_block_sparse(tiles, problem.q, problem.mu)?;
+            p.mu_pair = problem.mu_pair;
+            tiled_problem = p;
+            &tiled_problem
+        }
+        None => problem,
+    };
     let dim = problem.dim;
     let nc = problem.nc;
     let n = problem.size();
@@ -258,7 +272,7 @@ pub fn solve_nsgs(problem: &ContactProblem<'_>, s: &NsgsSettings) -> Result<Cont
         problem,
         rows: &rows,
         blocks: &blocks,
-        sequence: &sweep_sequence(&s.order, nc)?,
+        order: checked_order(&s.order, nc)?,
         omega: s.relaxation,
     };
 

@@ -58,6 +58,14 @@ fn check_dims(dim: usize, n: usize) -> Result<usize> {
     Ok(n / dim)
 }
 
+/// whether tile (bi, bj) of a dense row-major `n x n` W has a nonzero entry.
+fn dense_tile_nonzero(w: &[f64], dim: usize, n: usize, bi: usize, bj: usize) -> bool {
+    (0..dim).any(|a| {
+        let row = (bi * dim + a) * n + bj * dim;
+        w[row..row + dim].iter().any(|&v| v != 0.0)
+    })
+}
+
 fn check_data(data: &[f64]) -> Result<()> {
     crate::error::check_finite("W's data", data)
 }
@@ -223,6 +231,55 @@ impl BlockCsr {
             }
         };
         Self::from_entries(dim, nc, nnz, &entries)
+    }
+
+    /// From a dense row-major `(dim nc)^2` W already checked for size and finiteness: the
+    /// tiles with a nonzero entry and the diagonal ones, in four allocations sized exactly
+    /// (no scratch). `tiles` is [`Self::dense_tile_count`] of the same W.
+    pub(crate) fn from_dense_counted(dim: usize, nc: usize, w: &[f64], tiles: usize) -> Self {
+        let n = dim * nc;
+        let bs = dim * dim;
+        let mut row_ptr = Vec::with_capacity(nc + 1);
+        let mut cols = Vec::with_capacity(tiles);
+        let mut values = Vec::with_capacity(tiles * bs);
+        let mut diag = Vec::with_capacity(nc);
+        row_ptr.push(0);
+        for bi in 0..nc {
+            for bj in 0..nc {
+                if bj == bi || dense_tile_nonzero(w, dim, n, bi, bj) {
+                    if bj == bi {
+                        diag.push(cols.len());
+                    }
+                    cols.push(bj);
+                    for a in 0..dim {
+                        let row = (bi * dim + a) * n + bj * dim;
+                        values.extend_from_slice(&w[row..row + dim]);
+                    }
+                }
+            }
+            row_ptr.push(cols.len());
+        }
+        Self {
+            dim,
+            nc,
+            row_ptr,
+            cols,
+            values,
+            diag,
+        }
+    }
+
+    /// the number of tiles [`Self::from_dense_counted`] stores for a dense W: those with a
+    /// nonzero entry and the diagonal ones. O(n^2), no allocation.
+    pub(crate) fn dense_tile_count(dim: usize, nc: usize, w: &[f64]) -> usize {
+        let n = dim * nc;
+        (0..nc)
+            .map(|bi| {
+                (0..nc)
+                    .filter(|&bj| bj == bi || dense_tile_nonzero(w, dim, n, bi, bj))
+                    .count()
+            })
+            .sum()
     }
 
     /// the bucketing described in the module notes; indices are already checked.
@@ -501,6 +558,8 @@ mod tests {
             assert_eq!(c.to_dense(), w);
             let d = BlockCsr::from_dense(dim, n, &w).unwrap();
             assert_eq!(a, d);
+            let tiles = BlockCsr::dense_tile_count(dim, nc, &w);
+            assert_eq!(BlockCsr::from_dense_counted(dim, nc, &w, tiles), d);
             assert_eq!(a, c);
             // every diagonal tile is stored, sorted columns
             for i in 0..nc {

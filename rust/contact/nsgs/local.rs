@@ -47,6 +47,10 @@ use super::super::projection::secular;
 /// fallback).
 pub const LOCAL_ITERS: usize = 8;
 
+/// a pass that changes the impulse by at most this fraction of the first pass's change ends
+/// the passes.
+const INNER: f64 = 1e-2;
+
 /// The diagonal block of one contact as stored (see the module notes), with the
 /// eigendecomposition of its tangential symmetric part.
 #[derive(Clone, Copy, Debug, Default)]
@@ -228,12 +232,24 @@ pub(super) fn disk_qp_from(e: &Eig2, g: [f64; 2], radius: f64, lambda_hint: &mut
         x[k] = if den > 0.0 { -gg[k] / den } else { 0.0 };
     }
     // rounding in λ can leave x a hair outside the disk
-    let norm = x[0].hypot(x[1]);
+    let norm = norm2(x);
     if norm > radius {
         x[0] *= radius / norm;
         x[1] *= radius / norm;
     }
     [-e.sn * x[0] + e.cs * x[1], e.cs * x[0] + e.sn * x[1]]
+}
+
+/// `||x||` of a 2-vector: the square root of the sum of squares where that neither overflows
+/// nor underflows to a loss of accuracy, `hypot` otherwise.
+#[inline]
+fn norm2(x: [f64; 2]) -> f64 {
+    let ss = x[0] * x[0] + x[1] * x[1];
+    if ss > 1e-290 && ss < 1e290 {
+        ss.sqrt()
+    } else {
+        x[0].hypot(x[1])
+    }
 }
 
 /// The root `λ > 0` of the secular equation `Σ_k g_k^2 / (d_k + λ)^2 = radius^2` when its
@@ -243,7 +259,7 @@ pub(super) fn disk_qp_from(e: &Eig2, g: [f64; 2], radius: f64, lambda_hint: &mut
 /// when a step leaves it), started from `hint` when it lies inside the bracket (the previous
 /// pass's multiplier: a step or two), else from the bracket's right end.
 fn secular_root(d: [f64; 2], g: [f64; 2], radius: f64, hint: f64) -> f64 {
-    let gnorm = g[0].hypot(g[1]);
+    let gnorm = norm2(g);
     let mut lo = (gnorm / radius - d[0].max(d[1])).max(0.0);
     let mut hi = (gnorm / radius - d[0].min(d[1])).max(lo);
     let mut lambda = if hint > lo && hint < hi { hint } else { hi };
@@ -328,6 +344,7 @@ pub(super) fn local_2d_exact(blk: &LocalBlock, mu: f64, bn: f64, bt: f64) -> Opt
 pub(super) fn local_descent(blk: &LocalBlock, mu: f64, b: &[f64; 3], dim: usize, r: &mut [f64; 3]) {
     let passes = if blk.coupled { LOCAL_ITERS } else { 1 };
     let mut lambda = f64::NAN;
+    let mut first = f64::NAN;
     for _ in 0..passes {
         let old = *r;
         let ct = blk.cn[0] * r[1] + blk.cn[1] * r[2];
@@ -369,7 +386,12 @@ pub(super) fn local_descent(blk: &LocalBlock, mu: f64, b: &[f64; 3], dim: usize,
             change = change.max((r[k] - old[k]).abs());
             size = size.max(r[k].abs());
         }
-        if change <= 1e-15 * size {
+        if first.is_nan() {
+            first = change;
+        }
+        // converged, or this pass refined the sweep's update of the contact to 1e-2 of it
+        // (the outer sweeps absorb the rest: the fixed points are the exact local solutions)
+        if change <= 1e-15 * size || change <= INNER * first {
             break;
         }
     }

@@ -2,41 +2,41 @@
 //!
 //! A block-sparse W is read in place. A dense W whose `dim x dim` tiles are mostly zero (a
 //! mechanism's `W = G^T M^-1 G` has `W_ij != 0` only when contacts i and j share a body) is
-//! copied once into block CSR (its nonzero off-diagonal tiles), so a sweep reads O(nnz)
-//! memory instead of `(dim nc)^2` doubles; a dense W with more nonzero tiles than half, or
-//! whose copy would exceed the memory budget, is read row by row. Each component is summed left to right in column order
-//! whichever the storage (a zero tile adds exactly nothing), so the three give bitwise equal
-//! sums.
+//! copied once into block CSR ([`tiled`]) and the whole solve, sweeps and measures, runs on
+//! the copy, so each reads O(nnz) memory instead of `(dim nc)^2` doubles; a dense W with more
+//! nonzero tiles than half, or whose copy would exceed the memory budget, is read row by row.
+//! Each component is summed left to right in column order whichever the storage (a zero tile
+//! adds exactly nothing), so the storages give bitwise equal sums.
 
 use super::super::{BlockCsr, ContactProblem, Delassus};
 
+/// the block CSR copy of a dense W whose tiles are mostly zero (see the module notes), or
+/// `None`: block-sparse already, mostly nonzero, or over the memory budget.
+pub(super) fn tiled(problem: &ContactProblem<'_>) -> Option<BlockCsr> {
+    let Delassus::Dense(w) = problem.storage() else {
+        return None;
+    };
+    let (dim, nc) = (problem.dim, problem.nc);
+    let tiles = BlockCsr::dense_tile_count(dim, nc, w);
+    let bytes = tiles.saturating_mul(dim * dim * 8 + 8);
+    (tiles.saturating_mul(2) <= nc.saturating_mul(nc) && bytes <= crate::limits::memory_budget())
+        .then(|| BlockCsr::from_dense_counted(dim, nc, w, tiles))
+}
+
 /// the storage an NSGS sweep reads W from.
 pub(super) enum OffDiagonal<'a> {
-    /// the caller's block CSR.
+    /// block CSR.
     Tiles(&'a BlockCsr),
-    /// the nonzero off-diagonal tiles of a dense W.
-    Copied(OffTiles),
     /// a row-major dense W.
     Dense(&'a [f64]),
 }
 
 impl<'a> OffDiagonal<'a> {
-    /// the storage for `problem` (see the module notes).
+    /// the storage of `problem`.
     pub(super) fn of(problem: &ContactProblem<'a>) -> Self {
         match problem.storage() {
             Delassus::BlockSparse(b) => Self::Tiles(b),
-            Delassus::Dense(w) => {
-                let (dim, nc) = (problem.dim, problem.nc);
-                let tiles = offdiagonal_tiles(w, dim, nc);
-                let bytes = tiles.saturating_mul(dim * dim * 8 + 8);
-                if tiles.saturating_mul(2) <= nc.saturating_mul(nc)
-                    && bytes <= crate::limits::memory_budget()
-                {
-                    Self::Copied(OffTiles::of(w, dim, nc, tiles))
-                } else {
-                    Self::Dense(w)
-                }
-            }
+            Delassus::Dense(w) => Self::Dense(w),
         }
     }
 
@@ -45,91 +45,8 @@ impl<'a> OffDiagonal<'a> {
     pub(super) fn mul(&self, i: usize, dim: usize, x: &[f64]) -> [f64; 3] {
         match self {
             Self::Tiles(b) => b.row_mul(i, x, true),
-            Self::Copied(t) => t.row_mul(i, dim, x),
             Self::Dense(w) => dense_row_mul_offdiag(w, dim, i, x),
         }
-    }
-}
-
-/// whether tile (bi, bj) of a dense W has a nonzero entry.
-fn tile_is_nonzero(w: &[f64], dim: usize, n: usize, bi: usize, bj: usize) -> bool {
-    (0..dim).any(|a| {
-        let row = (bi * dim + a) * n + bj * dim;
-        w[row..row + dim].iter().any(|&v| v != 0.0)
-    })
-}
-
-/// the number of off-diagonal `dim x dim` tiles of a dense W with a nonzero entry.
-fn offdiagonal_tiles(w: &[f64], dim: usize, nc: usize) -> usize {
-    let n = dim * nc;
-    (0..nc)
-        .map(|bi| {
-            (0..nc)
-                .filter(|&bj| bj != bi && tile_is_nonzero(w, dim, n, bi, bj))
-                .count()
-        })
-        .sum()
-}
-
-/// The nonzero off-diagonal tiles of a dense W in block CSR (three allocations, sized
-/// exactly): block row i holds the tiles `j in cols[ptr[i]..ptr[i+1]]`, increasing, each
-/// `dim * dim` scalars row-major in `values`.
-pub(super) struct OffTiles {
-    ptr: Vec<usize>,
-    cols: Vec<usize>,
-    values: Vec<f64>,
-}
-
-impl OffTiles {
-    fn of(w: &[f64], dim: usize, nc: usize, tiles: usize) -> Self {
-        let n = dim * nc;
-        let mut ptr = Vec::with_capacity(nc + 1);
-        let mut cols = Vec::with_capacity(tiles);
-        let mut values = Vec::with_capacity(tiles * dim * dim);
-        ptr.push(0);
-        for bi in 0..nc {
-            for bj in (0..nc).filter(|&bj| bj != bi && tile_is_nonzero(w, dim, n, bi, bj)) {
-                cols.push(bj);
-                for a in 0..dim {
-                    let row = (bi * dim + a) * n + bj * dim;
-                    values.extend_from_slice(&w[row..row + dim]);
-                }
-            }
-            ptr.push(cols.len());
-        }
-        Self { ptr, cols, values }
-    }
-
-    /// `Σ_{j != i} W_ij x_j`, each component summed in tile order, three products per tile
-    /// left to right (as [`BlockCsr::row_mul`]).
-    #[inline]
-    fn row_mul(&self, i: usize, dim: usize, x: &[f64]) -> [f64; 3] {
-        let (lo, hi) = (self.ptr[i], self.ptr[i + 1]);
-        let cols = &self.cols[lo..hi];
-        let mut out = [0.0; 3];
-        if dim == 3 {
-            for (&j, b) in cols.iter().zip(self.values[lo * 9..hi * 9].chunks_exact(9)) {
-                let xj = &x[3 * j..3 * j + 3];
-                out[0] += b[0] * xj[0];
-                out[0] += b[1] * xj[1];
-                out[0] += b[2] * xj[2];
-                out[1] += b[3] * xj[0];
-                out[1] += b[4] * xj[1];
-                out[1] += b[5] * xj[2];
-                out[2] += b[6] * xj[0];
-                out[2] += b[7] * xj[1];
-                out[2] += b[8] * xj[2];
-            }
-        } else {
-            for (&j, b) in cols.iter().zip(self.values[lo * 4..hi * 4].chunks_exact(4)) {
-                let xj = &x[2 * j..2 * j + 2];
-                out[0] += b[0] * xj[0];
-                out[0] += b[1] * xj[1];
-                out[1] += b[2] * xj[0];
-                out[1] += b[3] * xj[1];
-            }
-        }
-        out
     }
 }
 
@@ -183,8 +100,8 @@ mod tests {
     use super::*;
     use crate::testing::SplitMix64;
 
-    /// the three storages give bitwise equal off-diagonal products, on W with zero tiles and
-    /// without.
+    /// the storages give bitwise equal off-diagonal products, on W with zero tiles and
+    /// without; a W with mostly zero tiles is copied, a mostly nonzero one is not.
     #[test]
     fn dense_copied_and_sparse_rows_agree_bitwise() {
         let mut rng = SplitMix64::new(5);
@@ -206,15 +123,17 @@ mod tests {
             let q = vec![0.0; n];
             let mu = vec![0.5; nc];
             let p = ContactProblem::new(dim, &w, &q, &mu).unwrap();
-            let rows = OffDiagonal::of(&p);
-            assert_eq!(matches!(rows, OffDiagonal::Copied(_)), density < 1.0);
+            let copy = tiled(&p);
+            assert_eq!(copy.is_some(), density < 1.0);
             let sparse = BlockCsr::from_dense(dim, n, &w).unwrap();
+            let dense = OffDiagonal::of(&p);
             for i in 0..nc {
-                let a = rows.mul(i, dim, &x);
+                let a = dense.mul(i, dim, &x);
                 let b = sparse.row_mul(i, &x, true);
-                let c = dense_row_mul_offdiag(&w, dim, i, &x);
                 assert_eq!(a, b);
-                assert_eq!(a, c);
+                if let Some(c) = &copy {
+                    assert_eq!(c.row_mul(i, &x, true), b);
+                }
                 let o = i * dim;
                 for k in 0..dim {
                     let e: f64 = (0..n)
