@@ -128,7 +128,8 @@ fn inverse3(m: &[[f64; 3]; 3]) -> Option<[f64; 9]> {
         .iter()
         .map(|r| (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt())
         .product();
-    if !(det.abs() > 1e-10 * norms) || !det.is_finite() {
+    // NaN fails the test
+    if det.is_nan() || det.abs() <= 1e-10 * norms || !det.is_finite() {
         return None;
     }
     let inv = [
@@ -159,7 +160,7 @@ pub(super) fn local_3d_closed(blk: &LocalBlock, mu: f64, b: &[f64; 3]) -> Option
         -(m[3] * b[0] + m[4] * b[1] + m[5] * b[2]),
         -(m[6] * b[0] + m[7] * b[1] + m[8] * b[2]),
     ];
-    if !(r[0] > 0.0) {
+    if r[0].is_nan() || r[0] <= 0.0 {
         return None;
     }
     let inside = match blk.scale {
