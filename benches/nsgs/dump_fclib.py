@@ -22,7 +22,8 @@ def main() -> None:
 
     out = Path(sys.argv[1])
     out.mkdir(parents=True, exist_ok=True)
-    root = Path(os.environ.get("COULOMB_DATA", Path(__file__).resolve().parents[3] / "shared" / "data"))
+    default = Path(__file__).resolve().parents[3] / "shared" / "data"
+    root = Path(os.environ.get("COULOMB_DATA", default))
     for f in sorted((root / "fclib").glob("**/*.hdf5")):
         try:
             p = read_fclib(f)

@@ -259,7 +259,7 @@ pub fn solve_nsgs(problem: &ContactProblem<'_>, s: &NsgsSettings) -> Result<Cont
     let mut r = initial_impulses(problem, s.initial.as_deref())?;
 
     // the diagonal blocks, once
-    let blocks: Vec<LocalBlock> = (0..nc)
+    let mut blocks: Vec<LocalBlock> = (0..nc)
         .map(|i| LocalBlock::of(&problem.w_block(i, i), dim, problem.anisotropy(i)))
         .collect();
     let degenerate: Vec<usize> = (0..nc).filter(|&i| blocks[i].a <= 0.0).collect();
@@ -268,6 +268,9 @@ pub fn solve_nsgs(problem: &ContactProblem<'_>, s: &NsgsSettings) -> Result<Cont
         r[i * dim..(i + 1) * dim].fill(0.0);
     }
     let rows = OffDiagonal::of(problem);
+    for (i, b) in blocks.iter_mut().enumerate() {
+        b.isolated = rows.isolated(i, dim);
+    }
     let sweep = Sweep {
         problem,
         rows: &rows,

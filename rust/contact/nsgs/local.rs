@@ -74,6 +74,9 @@ pub(super) struct LocalBlock {
     pub(super) scale: Option<[f64; 2]>,
     /// `A^-1` row-major (3D, when A is safely invertible): the sticking solution `-A^-1 b`.
     pub(super) inverse: Option<[f64; 9]>,
+    /// whether no other contact's impulse enters this contact's velocity (no off-diagonal tile
+    /// in its block row): its local solution is then final, and the passes run to convergence.
+    pub(super) isolated: bool,
     /// whether the normal and tangential parts are coupled (`c_n`, `c_t` or k nonzero): if not,
     /// one pass of the descent is exact.
     pub(super) coupled: bool,
@@ -390,9 +393,10 @@ pub(super) fn local_descent(blk: &LocalBlock, mu: f64, b: &[f64; 3], dim: usize,
         if first.is_nan() {
             first = change;
         }
-        // converged, or this pass refined the sweep's update of the contact to 1e-2 of it
-        // (the outer sweeps absorb the rest: the fixed points are the exact local solutions)
-        if change <= 1e-15 * size || change <= INNER * first {
+        // converged, or this pass refined the sweep's update of a contact that others act on
+        // to 1e-2 of it (the outer sweeps absorb the rest: the fixed points are the exact
+        // local solutions)
+        if change <= 1e-15 * size || (!blk.isolated && change <= INNER * first) {
             break;
         }
     }

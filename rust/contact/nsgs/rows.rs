@@ -40,6 +40,23 @@ impl<'a> OffDiagonal<'a> {
         }
     }
 
+    /// whether block row i (of contacts of dimension `dim`) has no nonzero off-diagonal tile.
+    pub(super) fn isolated(&self, i: usize, dim: usize) -> bool {
+        match self {
+            Self::Tiles(b) => b.row_cols(i).len() <= 1,
+            Self::Dense(w) => {
+                let n = w.len().isqrt();
+                (i * dim..(i + 1) * dim).all(|row| {
+                    let r = &w[row * n..(row + 1) * n];
+                    r[..i * dim]
+                        .iter()
+                        .chain(&r[(i + 1) * dim..])
+                        .all(|&v| v == 0.0)
+                })
+            }
+        }
+    }
+
     /// `Σ_{j != i} W_ij x_j`, the `dim` components of contact i zero-padded to 3.
     #[inline]
     pub(super) fn mul(&self, i: usize, dim: usize, x: &[f64]) -> [f64; 3] {
