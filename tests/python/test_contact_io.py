@@ -174,13 +174,14 @@ def test_rover_is_solved_by_nsgs_with_its_diagonal_blocks_as_stored(problems):
 def test_one_object_is_solved_by_nsgs_with_its_diagonal_blocks_as_stored(problems):
     """OneObject-i1028-138 stalled under NSGS (a contact off the law by 9.5e-6 of its own
     scale after 1e3 and 1e5 sweeps) while NSGS symmetrised the diagonal blocks of its slightly
-    unsymmetric W. Solved with the blocks as stored, every contact obeys the law to 1e-6 of
-    its scale (contact_gen.law_violation, independent of coulomb's measures), as the robust
+    unsymmetric W. Solved with the blocks as stored (to 1e-8), every contact obeys the law to
+    1e-6 of its scale (contact_gen.law_violation, independent of coulomb's measures), as the robust
     mode's answer does."""
     from contact_gen import law_violation
 
     p = problems["OneObject-i1028-138.hdf5"]
-    r = contact.solve(p.W, p.q, p.mu, p.dim, tol=TOL, max_iter=MAX_ITER)
+    # at 1e-2 TOL: the two per-contact measures differ in their scales by a small factor
+    r = contact.solve(p.W, p.q, p.mu, p.dim, tol=1e-2 * TOL, max_iter=MAX_ITER)
     assert r.success and r.status == "solved", r.message
     assert law_violation(p.W, p.q, p.mu, p.dim, r.impulse) <= 1e-6
     s = contact.solve(p.W, p.q, p.mu, p.dim, tol=TOL, method="prox")
