@@ -1,4 +1,4 @@
-"""Normal impact on a floor (seed, "Worked example: normal impact on a floor"): m = 0.5 kg,
+"""Normal impact on a floor (Satici's chapter 11 worked example): m = 0.5 kg,
 v_n^- = -3 m/s, e = 0.6, wherever in the step the impact falls."""
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ def impact(h: float, frac: float, speed: float = 3.0) -> tuple[float, float, flo
 
 
 def main() -> None:
-    print("seed: v_n^+ = 1.8 m/s, P_n = 2.4 N s, loss 1.44 J")
+    print("analytic: v_n^+ = 1.8 m/s, P_n = 2.4 N s, loss 1.44 J")
     print(f"{'h':>8} {'impact at':>10} {'v_n^+':>10} {'P_n':>10} {'loss':>10}")
     for h in (1e-2, 1e-3, 1e-4):
         for frac in (0.0, 0.3, 0.9):

@@ -1,5 +1,5 @@
-"""Painleve's rod (seed, "Painleve's problem: a sliding rod"): m = 1, l = 1, J = 1/12,
-mu = 2, theta = 45 deg, the lower end sliding left at 1 m/s. No sliding mode with N >= 0 exists
+"""Painleve's rod (Stewart 2000; Satici's chapter 11): m = 1, l = 1, J = 1/12, mu = 2,
+theta = 45 deg, the lower end sliding left at 1 m/s. No sliding mode with N >= 0 exists
 (A = -0.5, b = -9.81); the impulse step jams the end through a tangential impulse."""
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ def main() -> None:
     th = math.radians(45.0)
     m, l, j, mu = 1.0, 1.0, 1.0 / 12.0, 2.0
     a = 1 / m - l**2 / (4 * j) * math.cos(th) * (mu * math.sin(th) - math.cos(th))
-    print(f"A = {a:.4f} 1/kg (seed -0.5), b = {-9.81:.2f} m/s^2 (seed -9.81)")
+    print(f"A = {a:.4f} 1/kg (analytic -0.5), b = {-9.81:.2f} m/s^2 (analytic -9.81)")
     print("jam impulse per step size (limit P_n = 0.375, P_t = 0.625 N s):")
     for h in (1e-2, 1e-3, 1e-4):
         scene = Scene(dim=2, gravity=(0.0, -9.81))

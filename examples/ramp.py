@@ -1,5 +1,5 @@
-"""Block on a ramp (seed, "Ramp example: stopping and sticking"): theta = 20 deg, mu = 0.4,
-v0 = 1 m/s downhill. Prints the deceleration, stop time and distance against the seed's
+"""Block on a ramp (Satici's chapter 11, "stopping and sticking"): theta = 20 deg, mu = 0.4,
+v0 = 1 m/s downhill. Prints the deceleration, stop time and distance against the analytic
 figures, and the motion after the stop."""
 
 from __future__ import annotations
@@ -23,10 +23,10 @@ def main(h: float = 1e-3) -> None:
     k = int(np.flatnonzero(np.all(np.abs(tr.v) < 1e-12, axis=1))[0])
     creep = float(np.max(np.hypot(*(tr.q[k:] - tr.q[k]).T)))
     print(f"h = {h:g} s")
-    print(f"deceleration   {(v[1] - v[0]) / h:+.4f} m/s^2   (seed -0.3321)")
-    print(f"stop time      {tr.t[k]:.4f} s        (seed 3.011, within h)")
-    print(f"stop distance  {s[k]:.4f} m        (seed 1.505, within O(h))")
-    print(f"motion after the stop through t = 10 s: {creep:.1e} m (seed: none)")
+    print(f"deceleration   {(v[1] - v[0]) / h:+.4f} m/s^2   (analytic -0.3321)")
+    print(f"stop time      {tr.t[k]:.4f} s        (analytic 3.011, within h)")
+    print(f"stop distance  {s[k]:.4f} m        (analytic 1.505, within O(h))")
+    print(f"motion after the stop through t = 10 s: {creep:.1e} m (analytic: none)")
     print(tr.check())
 
 

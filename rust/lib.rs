@@ -5,7 +5,7 @@
 //!
 //! - [`lcp`]: linear complementarity problems `0 <= z ⊥ M z + q >= 0` — Lemke's complementary
 //!   pivoting (the certified default), projected Gauss-Seidel, and complete enumeration.
-//! - [`step`]: the impulse time stepper (the seed's "One impulse-based time step") over
+//! - [`step`]: the impulse time stepper (Stewart and Trinkle 1996; Stewart 2000) over
 //!   particles and rigid bodies with contact, friction and restitution.
 //! - [`io`]: readers for the standard benchmark formats (Siconos text files).
 //!
@@ -14,11 +14,13 @@
 
 pub mod contact;
 pub mod error;
+pub mod geometry;
 pub mod interrupt;
 pub mod io;
 pub mod lcp;
 pub mod limits;
 pub mod matrix;
+pub(crate) mod readable;
 pub mod step;
 /// Reproducible problem generators for the tests, benches and profiling programs (the
 /// `testing` feature, which `cargo test` and `cargo bench` enable); not part of the API.

@@ -24,6 +24,9 @@ regularized
     The tanh-smoothed friction law on a ramp (stiff ODE), to compare with exact Coulomb friction.
 extremes
     The stability suite at the extremes (mass ratios, friction, restitution, steps, units).
+settings
+    Settings objects (``NSGSSettings``, ``LemkeSettings``, ``StepSettings``, ...) that the
+    solvers and the stepper take as ``settings=`` in place of their keywords.
 study
     Sweeps of the settings a user trades (error against cost, Pareto fronts, orders).
 errors
@@ -48,6 +51,7 @@ from . import (
     model,
     painleve,
     regularized,
+    settings,
     study,
     trajectory,
 )
@@ -71,6 +75,14 @@ from .model import (
     Segment,
     Sphere,
 )
+from .settings import (
+    LemkeSettings,
+    NSGSSettings,
+    PGSSettings,
+    PolyhedralSettings,
+    ProxSettings,
+    StepSettings,
+)
 from .trajectory import Trajectory
 
 __all__ = [
@@ -80,10 +92,15 @@ __all__ = [
     "GapContact",
     "HalfSpace",
     "LcpResult",
+    "LemkeSettings",
     "Model",
+    "NSGSSettings",
+    "PGSSettings",
     "Particle",
     "Point",
     "Polygon",
+    "PolyhedralSettings",
+    "ProxSettings",
     "Result",
     "RigidBody2D",
     "RigidBody3D",
@@ -91,6 +108,7 @@ __all__ = [
     "Segment",
     "Sphere",
     "Status",
+    "StepSettings",
     "Trajectory",
     "__version__",
     "contact",
@@ -103,6 +121,7 @@ __all__ = [
     "painleve",
     "regularized",
     "set_memory_budget",
+    "settings",
     "study",
     "trajectory",
 ]

@@ -137,17 +137,26 @@ def world_points(scene: Scene, q: np.ndarray) -> list[tuple[int, Any, np.ndarray
     return out
 
 
+def _scene_of(tr: Trajectory) -> Scene:
+    """The scene a trajectory simulated (a generalized-coordinate Model has none to draw)."""
+    if tr.scene is None:
+        raise TypeError(
+            "animate() draws a Scene's bodies; a generalized-coordinate Model has no geometry "
+            "to draw: plot its coordinates against time with Trajectory.plot()")
+    return tr.scene
+
+
 def auto_limits(tr: Trajectory, states: np.ndarray, margin: float = 0.1) -> np.ndarray:
     """``dim x 2`` axis limits holding every shape (points and radii) and every body centre
     over ``states``, and each half-space's reference point, widened by ``margin`` of the
     largest extent on each side."""
-    scene = tr._scene
+    scene = _scene_of(tr)
     lo = np.full(scene.dim, np.inf)
     hi = np.full(scene.dim, -np.inf)
     for k in states:
-        for x, _ in poses(scene, tr["q"][k]):
+        for x, _ in poses(scene, tr.q[k]):
             lo, hi = np.minimum(lo, x), np.maximum(hi, x)
-        for _, _, pts, r in world_points(scene, tr["q"][k]):
+        for _, _, pts, r in world_points(scene, tr.q[k]):
             lo = np.minimum(lo, pts.min(axis=0) - r)
             hi = np.maximum(hi, pts.max(axis=0) + r)
     for hs in scene.half_spaces:
@@ -185,7 +194,7 @@ class SceneAnimation:
         from matplotlib.figure import Figure
 
         self.trajectory = tr
-        self.scene: Scene = tr._scene
+        self.scene: Scene = _scene_of(tr)
         self.states = states
         self.fps = float(fps)
         self.limits = limits
@@ -253,12 +262,12 @@ class SceneAnimation:
         for artist in self._moving:
             artist.remove()
         k = int(self.states[frame])
-        q = self.trajectory["q"][k]
+        q = self.trajectory.q[k]
         if self.scene.dim == 2:
             self._moving = self._draw_2d(q)
         else:
             self._moving = self._draw_3d(q)
-        text = _title_text(self.title, float(self.trajectory["t"][k]))
+        text = _title_text(self.title, float(self.trajectory.t[k]))
         self.ax.set_title(text)
         return self._moving
 
@@ -406,18 +415,15 @@ def animate(
 ) -> Any:
     """See :meth:`coulomb.Trajectory.animate`."""
     require("matplotlib", extra="plot", what="Trajectory.animate")
-    if tr._scene is None:
-        raise TypeError(
-            "animate() draws a Scene's bodies; a generalized-coordinate Model has no geometry "
-            "to draw: plot its coordinates against time with Trajectory.plot()")
+    scene = _scene_of(tr)
     fps = float(fps)
     if not (math.isfinite(fps) and fps > 0):
         raise InvalidParameterError(f"fps must be > 0, got {fps}")
     if path is not None:
         _writer(Path(path), fps)  # an unknown type or a missing ffmpeg, before any work
-    t = np.asarray(tr["t"])
+    t = np.asarray(tr.t)
     if every is None:
-        h = float(tr["h"])
+        h = float(tr.h)
         every = max(1, round(1.0 / (fps * h)))  # real time
     if int(every) < 1:
         raise InvalidParameterError(f"every must be >= 1, got {every}")
@@ -432,7 +438,7 @@ def animate(
         raise InvalidParameterError(
             f"no state in t_range {t_range} (the trajectory spans {t[0]:g} to {t[-1]:g} s)")
     states = rows[::int(every)]
-    dim = tr._scene.dim
+    dim = scene.dim
     if limits is None:
         lim = auto_limits(tr, states)
     else:

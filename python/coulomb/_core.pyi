@@ -6,6 +6,7 @@ hence private names).
 """
 
 import os
+from collections.abc import Callable
 from typing import Any, Literal, TypedDict
 
 import numpy as np
@@ -19,6 +20,7 @@ __all__ = [
     "lcp_measures",
     "lcp_solve",
     "memory_budget",
+    "model_simulate",
     "read_siconos_fc",
     "read_siconos_lcp",
     "set_memory_budget",
@@ -139,6 +141,11 @@ class _StepSimulateDict(TypedDict):
     stopped: str | None
     solve_time: float
 
+class _ModelSimulateDict(_StepSimulateDict):
+    """``model_simulate``: a scene's trajectory dict and ``f . v`` per recorded state."""
+
+    load_power: _F64
+
 def lcp_solve(
     m: _F64,
     q: _F64,
@@ -207,3 +214,27 @@ def step_simulate(
     record_every: int = 1,
     locate_impacts: bool = False,
 ) -> _StepSimulateDict: ...
+def model_simulate(
+    dim: int,
+    laws: list[tuple[float, float]],
+    mass: Callable[[_F64], _F64],
+    force: Callable[[_F64, _F64, float], _F64] | None,
+    contacts: Callable[[_F64], _F64] | None,
+    potential: Callable[[_F64], float] | None,
+    q0: list[float],
+    v0: list[float],
+    h: float,
+    steps: int,
+    solver: str = "nsgs",
+    tol: float = 1e-12,
+    max_iter: int | None = None,
+    relaxation: float = 1.0,
+    facets: int | None = None,
+    gap_tolerance: float = 1e-9,
+    warm_start: bool = True,
+    fallback: bool = True,
+    drift: str = "none",
+    drift_bias: float = 0.2,
+    restitution: str = "newton",
+    record_every: int = 1,
+) -> _ModelSimulateDict: ...

@@ -1,13 +1,13 @@
 """User-defined models in generalized coordinates: ``M(q)``, forces and gap functions given in
-Python, stepped by the same impulse step as scenes (a Python loop around the Rust contact
-solver)."""
+Python, stepped by the scenes' impulse time stepper in Rust, which calls them back at each
+state."""
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
@@ -17,7 +17,6 @@ from .errors import (
     ArgumentTypeError,
     InvalidParameterError,
     NonFiniteError,
-    ProblemTooLargeError,
     ShapeError,
 )
 from .trajectory import Trajectory
@@ -59,9 +58,10 @@ class Model:
     ``M(q) dv = f(q, v, t) dt + J_n^T dP_n + J_t^T dP_t``
 
     with the mass matrix ``mass_matrix`` (an SPD array or a callable ``M(q)``), the forces
-    ``force(q, v, t)`` (default none) and the contacts (:class:`GapContact`). The same impulse
-    step as :meth:`Scene.simulate`, run as a Python loop around the Rust contact solver
-    (:func:`coulomb.contact.solve`). ``potential(q)`` (optional) adds the potential energy to
+    ``force(q, v, t)`` (default none) and the contacts (:class:`GapContact`). Stepped by the
+    same Rust impulse time stepper as :meth:`Scene.simulate` (the same contact search, impact
+    laws, impact memory, drift options, fallback and per-step verdict), which calls these
+    functions back at each state. ``potential(q)`` (optional) adds the potential energy to
     the trajectory's total energy.
     """
 
@@ -115,10 +115,10 @@ class Model:
             raise InvalidParameterError("M(q) must be positive definite") from exc
         return m
 
-    def _frame(self, c: GapContact, q: np.ndarray) -> tuple[float, np.ndarray]:
-        """The gap and the rows ``[J_n; J_t]`` (dim x nv) of one contact at q."""
+    def _frame(self, i: int, q: np.ndarray) -> tuple[float, np.ndarray]:
+        """The gap and the rows ``[J_n; J_t]`` (dim x nv) of contact i at q."""
+        c = self.contacts[i]
         n = q.size
-        i = next(k for k, x in enumerate(self.contacts) if x is c)
         try:
             g = float(c.gap(q))
         except (TypeError, ValueError) as exc:
@@ -149,6 +149,40 @@ class Model:
                 f"q = {q.tolist()}")
         return g, rows
 
+    # the callbacks of the Rust stepper (flat float64 arrays; errors raised here stop the
+    # run and surface as they are)
+
+    def _mass_values(self, q: np.ndarray) -> np.ndarray:
+        """``M(q)`` row-major, its shape and values checked (symmetry and positive
+        definiteness are checked by the stepper)."""
+        m = self.mass_matrix(q) if callable(self.mass_matrix) else self.mass_matrix
+        m = np.asarray(m, dtype=np.float64)
+        n = q.size
+        if m.shape != (n, n):
+            raise ShapeError(f"M(q) must be {n} x {n}, got {m.shape}")
+        if not np.all(np.isfinite(m)):
+            raise NonFiniteError("M(q) has a non-finite entry")
+        return np.ascontiguousarray(m).reshape(-1)
+
+    def _force_values(self, q: np.ndarray, v: np.ndarray, t: float) -> np.ndarray:
+        assert self.force is not None
+        f = np.asarray(self.force(q, v, t), dtype=np.float64)
+        if f.size != q.size:
+            raise ShapeError(f"force(q, v, t) must have {q.size} entries, got shape {f.shape}")
+        return np.ascontiguousarray(f).reshape(-1)
+
+    def _contact_values(self, q: np.ndarray) -> np.ndarray:
+        frames = [self._frame(i, q) for i in range(len(self.contacts))]
+        return np.concatenate([np.array([g for g, _ in frames], dtype=np.float64)]
+                              + [rows.reshape(-1) for _, rows in frames])
+
+    def _potential_value(self, q: np.ndarray) -> float:
+        assert self.potential is not None
+        v = float(self.potential(q))
+        if not math.isfinite(v):
+            raise NonFiniteError(f"potential(q) returned {v} at q = {q.tolist()}")
+        return v
+
     def simulate(
         self,
         t_end: float,
@@ -157,169 +191,47 @@ class Model:
         *,
         tol: float | None = None,
         max_iter: int | None = None,
+        relaxation: float = 1.0,
         facets: int | None = None,
         gap_tolerance: float = 1e-9,
         warm_start: bool = True,
         fallback: bool = True,
+        drift: Literal["none", "bias", "projection"] = "none",
+        drift_bias: float = 0.2,
+        restitution: Literal["newton", "poisson"] = "newton",
+        record_every: int = 1,
     ) -> Trajectory:
-        """Runs ``ceil(t_end / h)`` impulse steps; options as :meth:`Scene.simulate`."""
-        from . import contact as _contact
-
+        """Runs ``ceil(t_end / h)`` impulse steps; options as :meth:`Scene.simulate`
+        (Newton's or Poisson's law, the drift corrections, the fallback, ``record_every``),
+        except ``locate_impacts`` (scenes only). The Rust stepper runs the loop and calls
+        ``mass_matrix``, ``force``, the contacts' functions and ``potential`` back at each
+        state (holding the GIL only then); an exception raised in one of them stops the run
+        and is raised as it is."""
         t_end, h = _positive("t_end", t_end), _positive("h", h)
         steps = _steps(t_end, h)
-        solver, tol, max_iter, _, facets = _solver_options(
-            self.dim, solver, tol, max_iter, 1.0, facets)
+        solver, tol, max_iter, relaxation, facets = _solver_options(
+            self.dim, solver, tol, max_iter, relaxation, facets)
         gap_tolerance = _validate.real("gap_tolerance", gap_tolerance, low=0.0)
         warm_start = _validate.boolean("warm_start", warm_start)
         fallback = _validate.boolean("fallback", fallback)
-        row_bytes = 8 * (2 * self.q0.size + 16)
-        if (steps + 1) * row_bytes > _core.memory_budget():
-            raise ProblemTooLargeError(
-                f"recording {steps + 1} states of {self.q0.size} coordinates needs about "
-                f"{(steps + 1) * row_bytes} bytes, over the memory budget of "
-                f"{_core.memory_budget()} bytes (coulomb.set_memory_budget raises it): "
-                "simulate a shorter span per call")
-        dim, nc = self.dim, len(self.contacts)
-        q, v = self.q0.copy(), self.v0.copy()
-        warm = np.zeros((nc, dim))
-        approach = np.zeros(nc)
-        landed = np.zeros(nc, dtype=bool)
-        rec: dict[str, list[Any]] = {k: [] for k in (
-            "t", "q", "v", "kinetic_energy", "potential_energy", "min_gap", "negative_gaps",
-            "active", "status", "error", "scaled_error", "iterations", "momentum_residual",
-            "min_normal_impulse", "cone_violation", "complementarity", "resumed", "fallback",
-            "contact_step", "contact_id", "contact_impulse", "contact_velocity",
-            "contact_approach", "contact_gap", "contact_closed", "load_power")}
-
-        def push_state(t: float, m: np.ndarray, gaps: list[float]) -> None:
-            rec["t"].append(t)
-            rec["q"].append(q.copy())
-            rec["v"].append(v.copy())
-            rec["kinetic_energy"].append(0.5 * float(v @ m @ v))
-            rec["potential_energy"].append(float(self.potential(q)) if self.potential else 0.0)
-            rec["min_gap"].append(min(gaps, default=math.inf))
-            rec["negative_gaps"].append(sum(g < -gap_tolerance for g in gaps))
-
-        stopped = None
-        m = self._mass(q)
-        frames = [self._frame(c, q) for c in self.contacts]
-        push_state(0.0, m, [g for g, _ in frames])
-        for k in range(steps):
-            t = k * h
-            f = (np.asarray(self.force(q, v, t), dtype=np.float64).reshape(q.size)
-                 if self.force else np.zeros(q.size))
-            rec["load_power"].append(float(f @ v))
-            v_free = v + h * np.linalg.solve(m, f)
-            active = []
-            for i, (g, rows) in enumerate(frames):
-                vn_k, vn_free = float(rows[0] @ v), float(rows[0] @ v_free)
-                # a contact owed the rebound of the impact the last step stopped stays active
-                if g > gap_tolerance + 2 * h * max(0.0, -vn_k, -vn_free) and not landed[i]:
-                    approach[i], landed[i], warm[i] = 0.0, False, 0.0
-                    continue
-                active.append((i, g, rows, vn_k, g <= gap_tolerance or bool(landed[i])))
-            resumed = used_fallback = False
-            v_next = v_free.copy()
-            gp = np.zeros(q.size)
-            status, err, iters, mn, cone, comp = "no_contact", 0.0, 0, 0.0, 0.0, 0.0
-            serr = 0.0
-            if active:
-                G = np.vstack([rows for _, _, rows, _, _ in active])  # (dim na, nv)
-                minv_gt = np.linalg.solve(m, G.T)
-                W = G @ minv_gt
-                W = 0.5 * (W + W.T)
-                qc = G @ v_free
-                used = []
-                for a, (i, g, _, vn_k, closed) in enumerate(active):
-                    if closed:
-                        vminus = min(vn_k, approach[i], 0.0)
-                        resumed = resumed or bool(landed[i])
-                        qc[a * dim] += self.contacts[i].e * vminus
-                        used.append(vminus)
-                    else:
-                        qc[a * dim] += g / h
-                        used.append(vn_k)
-                mus = np.array([self.contacts[i].mu for i, *_ in active])
-                if np.all(qc[::dim] >= 0.0):
-                    r = np.zeros(len(active) * dim)
-                    status = "solved"
-                else:
-                    init = np.concatenate([warm[i] for i, *_ in active])
-                    res = _contact.solve(W, qc, mus, dim=dim, method=solver, tol=tol,
-                                         max_iter=max_iter, facets=facets,
-                                         initial=init if (warm_start and solver == "nsgs")
-                                         else None)
-                    if not res.success and fallback and solver == "nsgs":
-                        alt = _contact.solve(W, qc, mus, dim=dim, method="lemke",
-                                             tol=max(tol, 1e-9))
-                        if alt.scaled_error < res.scaled_error:
-                            used_fallback = True
-                            first_status, res = res.status, alt
-                            if alt.scaled_error <= max(tol, 1e-9):
-                                res["status"] = "solved"
-                            elif alt.status == "solved":
-                                # a polygon's answer (3D) that misses the exact cone
-                                res["status"] = first_status
-                    r = res.impulse.reshape(-1)
-                    status, err, iters = res.status, res.error, res.iterations
-                    serr = res.scaled_error
-                    mn, cone = res.min_normal_impulse, res.cone_violation
-                    comp = res.max_complementarity
-                gp = G.T @ r
-                v_next = v_free + minv_gt @ r
-                for a, (i, g, rows, vn_k, closed) in enumerate(active):
-                    p = r[a * dim:(a + 1) * dim]
-                    warm[i] = p
-                    # the impact record: made by an open contact that pushed, consumed by
-                    # the next step, never replayed
-                    landed[i] = not closed and p[0] > 0.0
-                    approach[i] = min(vn_k, 0.0) if landed[i] else 0.0
-                    rec["contact_step"].append(k)
-                    rec["contact_id"].append(i)
-                    rec["contact_impulse"].append(p.copy())
-                    rec["contact_velocity"].append(rows @ v_next)
-                    rec["contact_approach"].append(used[a])
-                    rec["contact_gap"].append(g)
-                    rec["contact_closed"].append(closed)
-            mdv = m @ (v_next - v_free)
-            scale = max(np.linalg.norm(gp), np.linalg.norm(m @ v_free),
-                        np.linalg.norm(m @ v_next))
-            res_norm = float(np.linalg.norm(mdv - gp))
-            rec["momentum_residual"].append(res_norm / scale if scale > 1e-300 else res_norm)
-            for key, val in (("active", len(active)), ("status", status), ("error", err),
-                             ("scaled_error", serr),
-                             ("iterations", iters), ("min_normal_impulse", mn),
-                             ("cone_violation", cone), ("complementarity", comp),
-                             ("resumed", resumed), ("fallback", used_fallback)):
-                rec[key].append(val)
-            v = v_next
-            q = q + h * v
-            if not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))):
-                stopped = f"step {k} produced a non-finite state"
-                break
-            m = self._mass(q)
-            frames = [self._frame(c, q) for c in self.contacts]
-            push_state((k + 1) * h, m, [g for g, _ in frames])
-        # f . v of the last state, for the step's energy E_h = T + V + (h/2) f . v (a stopped
-        # run recorded one per state already: its last step's state was not kept)
-        if stopped is None:
-            f = (np.asarray(self.force(q, v, (len(rec["t"]) - 1) * h),
-                            dtype=np.float64).reshape(q.size)
-                 if self.force else np.zeros(q.size))
-            rec["load_power"].append(float(f @ v))
-        raw: dict[str, Any] = {"dim": dim, "stopped": stopped, "solve_time": float("nan")}
-        for key, val in rec.items():
-            if key in ("q", "v"):
-                raw[key] = np.array(val, dtype=np.float64).reshape(len(val), q.size)
-            elif key in ("contact_impulse", "contact_velocity"):
-                raw[key] = np.array(val, dtype=np.float64).reshape(len(val), dim)
-            elif key == "status":
-                raw[key] = list(val)
-            elif key in ("resumed", "fallback", "contact_closed"):
-                raw[key] = np.array(val, dtype=bool)
-            elif key in ("active", "iterations", "negative_gaps", "contact_step", "contact_id"):
-                raw[key] = np.array(val, dtype=np.int64)
-            else:
-                raw[key] = np.array(val, dtype=np.float64)
+        _validate.choice("drift", drift, ("none", "bias", "projection"), "drift correction")
+        drift_bias = _validate.real("drift_bias", drift_bias, low=0.0, high=1.0, low_open=True)
+        _validate.choice("restitution", restitution, ("newton", "poisson"), "impact law")
+        record_every = _validate.count("record_every", record_every)
+        raw = _core.model_simulate(
+            self.dim,
+            [(float(c.mu), float(c.e)) for c in self.contacts],
+            self._mass_values,
+            self._force_values if self.force is not None else None,
+            self._contact_values if self.contacts else None,
+            self._potential_value if self.potential is not None else None,
+            [float(x) for x in self.q0],
+            [float(x) for x in self.v0],
+            h, steps, solver=solver, tol=tol, max_iter=max_iter, relaxation=relaxation,
+            facets=facets, gap_tolerance=gap_tolerance, warm_start=warm_start,
+            fallback=fallback, drift=drift, drift_bias=float(drift_bias),
+            restitution=restitution, record_every=record_every,
+        )
         return Trajectory._from_core(raw, scene=None, h=h, solver=solver,
+                                     record_every=record_every,
                                      gap_tolerance=gap_tolerance, tol=tol)

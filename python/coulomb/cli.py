@@ -10,6 +10,7 @@ from pathlib import Path
 
 from . import __version__
 from ._extras import MissingExtraError, require
+from ._readable import readable
 from .errors import CoulombError
 
 
@@ -69,7 +70,7 @@ def _study(args: argparse.Namespace) -> int:
     print(s)
     worst = max(r["error"] for r in s.records)
     if worst <= 1e-12:
-        print(f"the error is at most {worst:.1e} at every point: exact, no order to measure")
+        print(f"the error is at most {readable(worst)} at every point: exact, no order to measure")
     else:
         order = s.order(preset["order"], where=preset.get("order_where"))
         print(f"measured order of the error in {preset['order']}: {order:.3f}")

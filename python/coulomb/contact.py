@@ -80,7 +80,10 @@ that same test.
     for a large mu: ``mu ||u_t||`` hides an approaching contact, so with mu = 1e8 the answer
     r = 0 of a contact that must push looked solved). ``scaled_error`` is the worst contact's
     ``max(||e_i||, ||a_i||)`` divided by its own impulse scale
-    ``max(||r_i||, rho_i ||(|W| |r| + |q|)_i||)``. Multiplying impulse units by a and velocity
+    ``max(||r_i||, rho_i ||(|W| |r| + |q|)_i||)``. A slip ``s = ||u_t,i||`` below its own
+    rounding ``f = (n + 3) eps ||(|W| |r| + |q|)_t,i||`` counts as none (above it, as
+    ``s - f^2/s``), so a sticking contact with mu up to 1e12 solved to rounding is solved in
+    every unit system instead of turning ``mu`` times its rounding into an error. Multiplying impulse units by a and velocity
     units by b (``W -> (b/a) W``, ``q -> b q``) leaves it unchanged, and so ``success`` and
     ``status``; ``error`` and ``error_q`` add velocities to impulses and change with the
     units, so they are reported, never used for the verdict (at W of order 1e-5 they accepted
@@ -127,11 +130,11 @@ from ._result import Result
 from ._status import Status
 from .errors import InvalidInputError, InvalidParameterError, NonFiniteError, ShapeError
 from .lcp import _as_array
+from .settings import NSGSSettings, PolyhedralSettings, ProxSettings, accepts
 
 __all__ = ["ContactResult", "assemble", "post_velocity", "solve"]
 
 Method = Literal["nsgs", "lemke", "prox"]
-_METHODS = ("nsgs", "lemke", "prox")
 
 
 class ContactResult(Result):
@@ -147,7 +150,8 @@ class ContactResult(Result):
         True exactly when ``scaled_error <= tol`` (for ``"lemke"`` in 3D: when the polyhedral
         LCP was solved).
     status : str
-        ``"solved"``, ``"iteration_limit"`` or ``"numerical_failure"``.
+        ``"solved"``, ``"iteration_limit"`` (the budget was spent: ``max_iter`` sweeps, or
+        every restart of ``"prox"`` stalled) or ``"numerical_failure"``.
     message : str
         One line for a person.
     iterations : int
@@ -181,6 +185,7 @@ class ContactResult(Result):
     solve_time: float
 
 
+@accepts("method", (NSGSSettings, PolyhedralSettings, ProxSettings))
 def solve(
     W: ArrayLike,
     q: ArrayLike,
@@ -195,6 +200,7 @@ def solve(
     facets: int | None = None,
     eta: float | None = None,
     order: str | ArrayLike = "forward",
+    settings: NSGSSettings | PolyhedralSettings | ProxSettings | None = None,
 ) -> ContactResult:
     """Solve the friction-contact problem ``u = W r + q`` with Coulomb's law at every contact.
 
@@ -240,6 +246,11 @@ def solve(
         ``"nsgs"`` only: the order in which a sweep visits the contacts; ``"symmetric"`` is a
         forward then a backward pass (no directional bias in stacks and chains, twice the cost
         per sweep); an array is a permutation of the contacts.
+    settings : NSGSSettings, PolyhedralSettings or ProxSettings, optional
+        The method and its options as one object (:mod:`coulomb.settings`), in place of
+        ``method`` and ``tol``, ``max_iter``, ``relaxation``, ``order``, ``facets``, ``eta``;
+        ``initial`` combines with it. A keyword also given in it raises
+        :class:`~coulomb.errors.SettingsConflictError`.
 
     Returns
     -------
@@ -252,31 +263,19 @@ def solve(
         ``dim`` not 2 or 3, an unknown method, ``tol <= 0``, ``max_iter < 1``, ``relaxation``
         outside (0, 2), ``facets`` odd or too small, or an option the method does not take).
     """
+    # type and range of every option, method, relaxation and facets only with their method
     dim, tol, max_iter, relaxation, facets, eta = _validate.contact_options(
         dim, method, tol, max_iter, relaxation, facets, eta)
-    if method not in _METHODS:
-        raise InvalidParameterError(
-            f"unknown method {method!r}: expected 'nsgs' (exact friction disk), 'lemke' "
-            "(polyhedral cone) or 'prox' (robust mode)"
-        )
-    if method == "prox" and relaxation != 1.0:
-        raise InvalidParameterError("relaxation applies to method='nsgs' only")
     if method != "prox" and eta is not None:
         raise InvalidParameterError("eta applies to method='prox' only")
-    if eta is not None and not (np.isfinite(eta) and eta > 0):
-        raise InvalidParameterError(f"eta must be a positive finite number, got {eta}")
     if method == "lemke":
         if initial is not None:
             raise InvalidParameterError(
                 "initial (warm start impulses) applies to method='nsgs' only"
             )
-        if relaxation != 1.0:
-            raise InvalidParameterError("relaxation applies to method='nsgs' only")
         if facets is None:
             facets = 8 if dim == 3 else 2
-        if isinstance(facets, bool) or not isinstance(facets, (int, np.integer)):
-            raise InvalidParameterError(f"facets must be an integer, got {facets!r}")
-        facets = int(facets)
+        # checked here, not left to the core: the core checks facets after rescaling W
         if dim == 2 and facets != 2:
             raise InvalidParameterError(
                 f"facets must be 2 in 2D (the tangent directions +1 and -1, which are exact), "
@@ -287,8 +286,6 @@ def solve(
                 f"facets must be even and at least 4 in 3D (tangent directions in +/- pairs), "
                 f"got {facets}"
             )
-    elif facets is not None:
-        raise InvalidParameterError("facets applies to method='lemke' only")
     qa = _as_array(q, "q", 1)
     n = qa.shape[0]
     if n % dim != 0:
@@ -305,12 +302,6 @@ def solve(
         init = np.ascontiguousarray(r0.reshape(n))
         if not np.isfinite(init).all():
             raise NonFiniteError("initial contains NaN or infinity")
-    if not (np.isfinite(tol) and tol > 0):
-        raise InvalidParameterError(f"tol must be a positive finite number, got {tol}")
-    if max_iter is not None and max_iter < 1:
-        raise InvalidParameterError(f"max_iter must be at least 1, got {max_iter}")
-    if not 0 < relaxation < 2:
-        raise InvalidParameterError(f"relaxation must lie in (0, 2), got {relaxation}")
     order_name, permutation = _order(order, nc, method)
     out = _core.contact_solve(
         Wa,

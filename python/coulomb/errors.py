@@ -16,6 +16,7 @@ __all__ = [
     "NonFiniteError",
     "ProblemFormatError",
     "ProblemTooLargeError",
+    "SettingsConflictError",
     "ShapeError",
 ]
 
@@ -38,6 +39,11 @@ class NonFiniteError(InvalidInputError):
 
 class InvalidParameterError(InvalidInputError):
     """An option outside its domain (for example ``tol <= 0`` or an unknown method)."""
+
+
+class SettingsConflictError(InvalidParameterError):
+    """A settings object (:mod:`coulomb.settings`) given together with a keyword for one of its
+    fields, or with a method it does not stand for: each setting must be given once."""
 
 
 class ArgumentTypeError(InvalidParameterError, TypeError):

@@ -38,6 +38,7 @@ from . import _core, _validate
 from ._result import Result
 from ._status import Status
 from .errors import ArgumentTypeError, InvalidParameterError, ShapeError
+from .settings import LemkeSettings, PGSSettings, accepts
 
 __all__ = ["LcpResult", "check", "solve"]
 
@@ -146,6 +147,7 @@ def _basis_indices(warm_start: Any, n: int) -> list[int] | None:
     return [int(i) for i in arr]
 
 
+@accepts("method", (LemkeSettings, PGSSettings))
 def solve(
     M: ArrayLike,
     q: ArrayLike,
@@ -161,6 +163,7 @@ def solve(
     relaxation: float | None = None,
     initial: ArrayLike | None = None,
     engine: Engine | None = None,
+    settings: LemkeSettings | PGSSettings | None = None,
 ) -> LcpResult:
     """Solve the LCP ``0 <= z ⊥ M z + q >= 0``.
 
@@ -200,6 +203,10 @@ def solve(
         O(n k) for the k-th pivot, ``"tableau"`` O(n^2). ``"auto"`` takes the product form for
         16 <= n <= 1024 and re-runs the path on the tableau if it does not end in a solution
         within 2n + 16 pivots (the message then says so).
+    settings : LemkeSettings or PGSSettings, optional
+        The method and its options as one object (:mod:`coulomb.settings`), in place of
+        ``method`` and the keywords above; ``warm_start`` and ``initial`` combine with it. A
+        keyword also given in it raises :class:`~coulomb.errors.SettingsConflictError`.
 
     Returns
     -------
@@ -231,9 +238,8 @@ def solve(
     else:
         Ma = _as_array(M, "M", 2)
         qa = _as_array(q, "q", 1)
-    n = qa.shape[0]
-    if Ma.shape != (n, n):
-        raise ShapeError(f"M must have shape ({n}, {n}) to match q of length {n}, got {Ma.shape}")
+    # M square and q of its size: checked by the core before any work (ShapeError)
+    n = Ma.shape[0]
     if type(tol) is not float or not 0.0 < tol < 1.0:
         tol = _validate.tolerance("tol", tol)
     if method == "lemke":

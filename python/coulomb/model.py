@@ -34,8 +34,8 @@ loses ``m g y_k`` (``y_k`` the height there, at most ``m g h |v_n^-|``: first or
 removes that loss.
 
 :class:`Model` takes a user-defined model in generalized coordinates instead (``M(q)``,
-``f(q, v, t)`` and :class:`GapContact` gap functions with Jacobians), stepped by a Python loop
-around the same Rust contact solver.
+``f(q, v, t)`` and :class:`GapContact` gap functions with Jacobians), stepped by the same Rust
+stepper, which calls those functions back at each state.
 """
 
 from __future__ import annotations
@@ -55,6 +55,7 @@ from .errors import (
     NonFiniteError,
     ShapeError,
 )
+from .settings import StepSettings, accepts
 from .trajectory import Trajectory
 
 __all__ = [
@@ -406,6 +407,7 @@ class Scene:
             iq, iv = iq + nq, iv + nv
         return out
 
+    @accepts(None, (StepSettings,))
     def simulate(
         self,
         t_end: float,
@@ -424,6 +426,7 @@ class Scene:
         restitution: Literal["newton", "poisson"] = "newton",
         record_every: int = 1,
         locate_impacts: bool = False,
+        settings: StepSettings | None = None,
     ) -> Trajectory:
         """Runs ``ceil(t_end / h)`` steps of the impulse time stepper from the initial state.
 
@@ -488,6 +491,11 @@ class Scene:
             ``coulomb.memory_budget()`` and a run that would exceed it is refused
             (:class:`~coulomb.errors.ProblemTooLargeError`, saying which ``record_every``
             fits).
+        settings : StepSettings, optional
+            Every option above as one object (:mod:`coulomb.settings`; its ``solver`` field an
+            :class:`~coulomb.settings.NSGSSettings` or
+            :class:`~coulomb.settings.PolyhedralSettings`). A keyword also given in it raises
+            :class:`~coulomb.errors.SettingsConflictError`.
 
         Notes
         -----
@@ -518,7 +526,6 @@ class Scene:
             restitution=restitution, record_every=record_every,
             locate_impacts=locate_impacts,
         )
-        tr = Trajectory._from_core(raw, scene=self, h=h, solver=solver,
-                                   gap_tolerance=gap_tolerance, tol=tol)
-        tr["record_every"] = record_every
-        return tr
+        return Trajectory._from_core(raw, scene=self, h=h, solver=solver,
+                                     gap_tolerance=gap_tolerance, tol=tol,
+                                     record_every=record_every)

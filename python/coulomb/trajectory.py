@@ -1,11 +1,7 @@
-r"""The result of :meth:`coulomb.Scene.simulate`: states, impulses and the seed's per-step
-checks ("Time-step accuracy and validation").
-
-States (``N + 1`` rows, times ``t_0 .. t_N``): ``t``, ``q``, ``v``, ``kinetic_energy``,
-``potential_energy`` (of gravity and the constant forces, ``-sum (m g + F) . x``),
-``total_energy``, ``load_power`` (``f . v`` of those constant loads, W; for a
-:class:`~coulomb.Model`, of its ``force(q, v, t)``), ``min_gap`` (over every candidate
-contact) and ``negative_gaps`` (how many candidates are below ``-gap_tolerance``).
+r"""The result of :meth:`coulomb.Scene.simulate` (and :meth:`coulomb.Model.simulate`): a
+:class:`Trajectory` holds the states, the impulses and the per-step checks of the impulse time
+stepper (Stewart and Trinkle 1996; Stewart 2000): momentum balance, gaps, normal impulses,
+friction cone, complementarity and energy.
 
 The energy the impulse step keeps is not ``T + V`` but ``E_h = T + V + (h/2) f . v``: with
 ``v_{k+1} = v_k + h M^{-1} f + M^{-1} G P`` and ``x_{k+1} = x_k + h v_{k+1}``, the identity
@@ -18,39 +14,22 @@ the work of the contact impulses at the mean velocity (Moreau's energy balance),
 itself moves by ``-(h/2) f . (v_{k+1} - v_k)`` more: the loads' O(h) work over the step, about
 ``m g h |v_n|`` at each bounce under gravity (``T + V`` rises when the ball leaves the floor
 and falls back in flight), which is the integrator's and not a gain of the contact law.
-
-Steps (``N`` rows, step k from ``t_k`` to ``t_{k+1}``): ``active`` contacts, the contact
-solver's ``solver_status`` (``"no_contact"`` when none was active), ``solver_error`` (the
-literature's natural-map residual), ``solver_scaled_error`` (the unit-consistent measure the
-verdict is taken on, see :mod:`coulomb.contact`: a step is solved when it is at most ``tol``)
-and ``iterations``, ``momentum_residual``
-(``||M (v_{k+1} - v_free) - G P||`` over ``max(||G P||, ||M v_free||, ||M v_{k+1}||)``),
-``min_normal_impulse``, ``cone_violation``
-(``max(||P_t|| - mu P_n, 0)``), ``complementarity`` (``max |P_n (J_n v_{k+1} + e v_n^-)|``,
-or with the gap term ``g / h`` for an open contact) and ``resumed`` (a closed contact took its
-restitution from the approach velocity of the step that closed it) and ``fallback`` (NSGS missed
-its tolerance and the polyhedral Lemke's better answer was used), and ``projection`` (the
-largest coordinate change of the drift projection, 0 without it).
-
-Contacts (one row per active contact per step): ``contact_step``, ``contact_id`` (stable over
-steps: the candidate pair of features), ``contact_impulse`` (normal first, N s),
-``contact_velocity`` (``J v_{k+1}`` in the contact frame), ``contact_approach``,
-``contact_gap`` and ``contact_closed``.
-
-Like every coulomb result it has ``success``, ``status`` (``"completed"``,
-``"solver_failures"`` or ``"stopped"``) and a one-line ``message``.
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ._extras import require
+from ._readable import readable
 from ._result import Result
-from .errors import CoulombError
+from ._status import Status
+from .errors import CoulombError, InternalError
 
 if TYPE_CHECKING:
     from .model import Scene
@@ -77,68 +56,281 @@ class TrajectoryCheckError(CoulombError, AssertionError):
     """A trajectory failed :meth:`Trajectory.check` with ``strict=True``."""
 
 
-class Trajectory(Result):
-    """States, impulses and per-step checks of a simulation (see the module documentation)."""
+#: the arrays the stepper records, by the name the core gives them (its ``status``, ``error``
+#: and ``scaled_error`` are a step's, renamed ``solver_*`` here).
+_CORE_NAMES = frozenset({
+    "dim", "t", "q", "v", "kinetic_energy", "potential_energy", "load_power", "min_gap",
+    "negative_gaps", "active", "status", "error", "scaled_error", "iterations",
+    "momentum_residual", "min_normal_impulse", "cone_violation", "complementarity", "resumed",
+    "fallback", "projection", "contact_step", "contact_id", "contact_impulse",
+    "contact_velocity", "contact_approach", "contact_gap", "contact_closed", "stopped",
+    "solve_time",
+})
+
+
+class Trajectory:
+    """States, impulses and per-step checks of a simulation.
+
+    Made by :meth:`coulomb.Scene.simulate` and :meth:`coulomb.Model.simulate`; every array is a
+    NumPy array. ``N`` is the number of recorded rows of steps (of the ``ceil(t_end / h)``
+    steps, every ``record_every``-th and the last; fewer if the run stopped), the states are
+    the ``N + 1`` instants ``t_0 .. t_N``, and the contact records have one row per active
+    contact per recorded step.
+
+    Attributes
+    ----------
+    success : bool
+        Every step ran and every contact solve succeeded (``status == "completed"``).
+    status : Status
+        ``Status.COMPLETED``, ``Status.SOLVER_FAILURES`` (some contact solve missed its
+        tolerance) or ``Status.STOPPED`` (the run stopped early); equal to its string.
+    message : str
+        One line for a person.
+    t : ndarray, shape (N + 1,)
+        Times (s).
+    q : ndarray, shape (N + 1, nq)
+        Coordinates of every body in the order added (:meth:`body` slices one out): a
+        particle's position, a planar body's ``(x, y, theta)``, a spatial body's position and
+        unit quaternion ``(w, x, y, z)``.
+    v : ndarray, shape (N + 1, nv)
+        Velocities: a planar body's ``(vx, vy, omega)``, a spatial body's velocity and angular
+        velocity (world frame).
+    kinetic_energy : ndarray, shape (N + 1,)
+        ``T`` (J).
+    potential_energy : ndarray, shape (N + 1,)
+        ``V`` of gravity and the constant forces, ``-sum (m g + F) . x`` (J).
+    total_energy : ndarray, shape (N + 1,)
+        ``T + V`` (J).
+    load_power : ndarray, shape (N + 1,)
+        ``f . v`` of those constant loads (W; for a :class:`~coulomb.Model`, of its
+        ``force(q, v, t)``).
+    min_gap : ndarray, shape (N + 1,)
+        The smallest gap over every candidate contact (m).
+    negative_gaps : ndarray of int, shape (N + 1,)
+        How many candidates are below ``-gap_tolerance``.
+    active : ndarray of int, shape (N,)
+        Contacts that carried unknowns in step k (from ``t_k`` to ``t_{k+1}``).
+    solver_status : ndarray of Status, shape (N,)
+        The contact solver's verdict on step k; ``Status.NO_CONTACT`` when none was active.
+    solver_error : ndarray, shape (N,)
+        The literature's natural-map residual of step k's contact solve.
+    solver_scaled_error : ndarray, shape (N,)
+        The unit-consistent residual the verdict is taken on (see :mod:`coulomb.contact`):
+        a step is solved when it is at most ``tol``.
+    iterations : ndarray of int, shape (N,)
+        Sweeps, Newton steps or pivots of step k's solve.
+    momentum_residual : ndarray, shape (N,)
+        ``||M (v_{k+1} - v_free) - G P||`` over ``max(||G P||, ||M v_free||, ||M v_{k+1}||)``.
+    min_normal_impulse : ndarray, shape (N,)
+        ``min P_n`` over the step's contacts (N s).
+    cone_violation : ndarray, shape (N,)
+        ``max(||P_t|| - mu P_n, 0)`` (N s).
+    complementarity : ndarray, shape (N,)
+        ``max |P_n (J_n v_{k+1} + e v_n^-)|``, with the gap term ``g / h`` for an open contact
+        (N m).
+    resumed : ndarray of bool, shape (N,)
+        A closed contact took its restitution from the approach velocity of the step that
+        closed it.
+    fallback : ndarray of bool, shape (N,)
+        NSGS missed its tolerance and the fallback's better answer was used.
+    projection : ndarray, shape (N,)
+        The largest coordinate change of the drift projection (0 without it).
+    contact_step : ndarray of int, shape (n_records,)
+        The step (row of the step arrays) of each contact record.
+    contact_id : ndarray of int, shape (n_records,)
+        The contact's id, stable over steps (the candidate pair of features).
+    contact_impulse : ndarray, shape (n_records, dim)
+        The impulse, normal first (N s).
+    contact_velocity : ndarray, shape (n_records, dim)
+        ``J v_{k+1}`` in the contact frame (m/s).
+    contact_approach : ndarray, shape (n_records,)
+        The approach velocity the impact law used (m/s).
+    contact_gap : ndarray, shape (n_records,)
+        The gap at ``t_k`` (m).
+    contact_closed : ndarray of bool, shape (n_records,)
+        Whether the contact was closed (restitution applied) rather than closing.
+    dim : int
+        2 (planar) or 3 (spatial).
+    h : float
+        The time step (s).
+    solver : str
+        ``"nsgs"`` or ``"lemke"``.
+    tol : float
+        The contact solver's tolerance.
+    gap_tolerance : float
+        The gap (m) at or below which a contact is closed.
+    record_every : int
+        Steps per recorded row (the checks of a row are the worst over its steps).
+    stopped : str or None
+        Why the run stopped early, or None.
+    solve_time : float
+        Seconds spent in the stepper (NaN for a :class:`~coulomb.Model`, stepped in Python).
+    scene : Scene or None
+        The simulated scene (None for a :class:`~coulomb.Model`).
+    """
+
+    __slots__ = (
+        "active",
+        "complementarity",
+        "cone_violation",
+        "contact_approach",
+        "contact_closed",
+        "contact_gap",
+        "contact_id",
+        "contact_impulse",
+        "contact_step",
+        "contact_velocity",
+        "dim",
+        "fallback",
+        "gap_tolerance",
+        "h",
+        "iterations",
+        "kinetic_energy",
+        "load_power",
+        "message",
+        "min_gap",
+        "min_normal_impulse",
+        "momentum_residual",
+        "negative_gaps",
+        "potential_energy",
+        "projection",
+        "q",
+        "record_every",
+        "resumed",
+        "scene",
+        "solve_time",
+        "solver",
+        "solver_error",
+        "solver_scaled_error",
+        "solver_status",
+        "status",
+        "stopped",
+        "success",
+        "t",
+        "tol",
+        "total_energy",
+        "v",
+    )
+
+    success: bool
+    status: Status
+    message: str
+    t: NDArray[np.float64]
+    q: NDArray[np.float64]
+    v: NDArray[np.float64]
+    kinetic_energy: NDArray[np.float64]
+    potential_energy: NDArray[np.float64]
+    total_energy: NDArray[np.float64]
+    load_power: NDArray[np.float64]
+    min_gap: NDArray[np.float64]
+    negative_gaps: NDArray[np.int64]
+    active: NDArray[np.int64]
+    solver_status: NDArray[np.object_]
+    solver_error: NDArray[np.float64]
+    solver_scaled_error: NDArray[np.float64]
+    iterations: NDArray[np.int64]
+    momentum_residual: NDArray[np.float64]
+    min_normal_impulse: NDArray[np.float64]
+    cone_violation: NDArray[np.float64]
+    complementarity: NDArray[np.float64]
+    resumed: NDArray[np.bool_]
+    fallback: NDArray[np.bool_]
+    projection: NDArray[np.float64]
+    contact_step: NDArray[np.int64]
+    contact_id: NDArray[np.int64]
+    contact_impulse: NDArray[np.float64]
+    contact_velocity: NDArray[np.float64]
+    contact_approach: NDArray[np.float64]
+    contact_gap: NDArray[np.float64]
+    contact_closed: NDArray[np.bool_]
+    dim: int
+    h: float
+    solver: str
+    tol: float
+    gap_tolerance: float
+    record_every: int
+    stopped: str | None
+    solve_time: float
+    scene: Scene | None
+
+    def __init__(self) -> None:
+        raise TypeError("a Trajectory is made by Scene.simulate or Model.simulate")
 
     @classmethod
-    def _from_core(cls, raw: dict[str, Any], scene: Scene | None, h: float, solver: str,
-                   gap_tolerance: float, tol: float) -> Trajectory:
-        tr = cls(raw)
-        tr["gap_tolerance"] = gap_tolerance
-        tr["tol"] = tol
-        tr["total_energy"] = tr["kinetic_energy"] + tr["potential_energy"]
-        if "load_power" not in tr:
-            tr["load_power"] = _load_power(scene, tr["v"])
-        tr["h"] = h
-        tr["solver"] = solver
-        tr["solver_status"] = np.asarray(tr.pop("status"), dtype=object)
-        tr["solver_error"] = tr.pop("error")
-        tr["solver_scaled_error"] = tr.pop("scaled_error")
-        failed = int(np.sum([s not in ("solved", "no_contact") for s in tr["solver_status"]]))
-        n = len(tr["t"]) - 1
-        if tr["stopped"] is not None:
-            tr["status"], tr["message"] = "stopped", f"stopped early: {tr['stopped']}"
+    def _from_core(cls, raw: Mapping[str, Any], scene: Scene | None, h: float, solver: str,
+                   gap_tolerance: float, tol: float, record_every: int = 1) -> Trajectory:
+        """The trajectory of the arrays a stepper recorded (``raw``, by the core's names)."""
+        unknown = set(raw) - _CORE_NAMES
+        if unknown:
+            raise InternalError(f"the stepper recorded unknown arrays {sorted(unknown)}")
+        tr = object.__new__(cls)
+        for name in ("t", "q", "v", "kinetic_energy", "potential_energy", "min_gap",
+                     "negative_gaps", "active", "iterations", "momentum_residual",
+                     "min_normal_impulse", "cone_violation", "complementarity", "resumed",
+                     "fallback", "contact_step", "contact_id", "contact_impulse",
+                     "contact_velocity", "contact_approach", "contact_gap", "contact_closed"):
+            setattr(tr, name, np.asarray(raw[name]))
+        n = len(tr.t) - 1
+        tr.dim = int(raw["dim"])
+        tr.stopped = raw["stopped"]
+        tr.solve_time = float(raw["solve_time"])
+        tr.scene = scene
+        tr.h, tr.solver, tr.tol = float(h), str(solver), float(tol)
+        tr.gap_tolerance, tr.record_every = float(gap_tolerance), int(record_every)
+        tr.total_energy = tr.kinetic_energy + tr.potential_energy
+        tr.load_power = (np.asarray(raw["load_power"]) if "load_power" in raw
+                         else _load_power(scene, tr.v))
+        tr.projection = (np.asarray(raw["projection"]) if "projection" in raw
+                         else np.zeros(len(tr.active)))
+        statuses = np.empty(len(raw["status"]), dtype=object)
+        statuses[:] = [Status(s) for s in raw["status"]]
+        tr.solver_status = statuses
+        tr.solver_error = np.asarray(raw["error"])
+        tr.solver_scaled_error = np.asarray(raw["scaled_error"])
+        failed = sum(s not in (Status.SOLVED, Status.NO_CONTACT) for s in statuses)
+        if tr.stopped is not None:
+            tr.status, tr.message = Status.STOPPED, f"stopped early: {tr.stopped}"
         elif failed:
-            tr["status"] = "solver_failures"
-            tr["message"] = f"{n} steps; {failed} contact solves missed their tolerance"
+            tr.status = Status.SOLVER_FAILURES
+            tr.message = f"{n} steps; {failed} contact solves missed their tolerance"
         else:
-            tr["status"], tr["message"] = "completed", f"{n} steps, every contact solve solved"
-        tr["success"] = tr["status"] == "completed"
-        object.__setattr__(tr, "_scene", scene)
+            tr.status = Status.COMPLETED
+            tr.message = f"{n} steps, every contact solve solved"
+        tr.success = tr.status == Status.COMPLETED
         return tr
 
     # -- access ----------------------------------------------------------------------------
 
     def body(self, index: int) -> Result:
         """Coordinates ``q`` and velocities ``v`` of one body (in the order added)."""
-        if self._scene is None:
+        if self.scene is None:
             raise TypeError("body() needs a Scene; a generalized-coordinate Model has none")
-        sq, sv = self._scene.layout()[index]
-        return Result(q=self["q"][:, sq], v=self["v"][:, sv])
+        sq, sv = self.scene.layout()[index]
+        return Result(q=self.q[:, sq], v=self.v[:, sv])
 
     def normal_impulse_per_step(self) -> np.ndarray:
         """The sum of the normal impulses of every step (``N`` entries, N s)."""
-        out = np.zeros(len(self["t"]) - 1)
-        np.add.at(out, self["contact_step"], self["contact_impulse"][:, 0])
+        out = np.zeros(len(self.t) - 1)
+        np.add.at(out, self.contact_step, self.contact_impulse[:, 0])
         return out
 
     def __repr__(self) -> str:
-        n = len(self["t"]) - 1
-        statuses, counts = np.unique(self["solver_status"], return_counts=True)
+        n = len(self.t) - 1
+        statuses, counts = np.unique(self.solver_status, return_counts=True)
         st = ", ".join(f"{s}: {c}" for s, c in zip(statuses, counts, strict=True))
         worst = self._worst()
         lines = [
-            f"Trajectory({n} steps of h = {self['h']:.3g} s to t = {self['t'][-1]:.6g} s, "
-            f"solver {self['solver']!r}",
-            f"  bodies: {len(self._scene.bodies) if self._scene else 'generalized model'}, "
-            f"q: {self['q'].shape}, v: {self['v'].shape}",
-            f"  contact records: {len(self['contact_step'])}, steps by status: {{{st}}}",
-            f"  min gap: {np.min(self['min_gap']):.3e} m, energy: "
-            f"{self['total_energy'][0]:.6g} J -> {self['total_energy'][-1]:.6g} J",
-            "  worst: " + ", ".join(f"{k} {v:.2e}" for k, v in worst.items()),
+            f"Trajectory({n} steps of h = {self.h:.3g} s to t = {self.t[-1]:.6g} s, "
+            f"solver {self.solver!r}",
+            f"  bodies: {len(self.scene.bodies) if self.scene else 'generalized model'}, "
+            f"q: {self.q.shape}, v: {self.v.shape}",
+            f"  contact records: {len(self.contact_step)}, steps by status: {{{st}}}",
+            f"  min gap: {np.min(self.min_gap):.3e} m, energy: "
+            f"{self.total_energy[0]:.6g} J -> {self.total_energy[-1]:.6g} J",
+            "  worst: " + ", ".join(f"{k} {readable(v)}" for k, v in worst.items()),
         ]
-        if self["stopped"] is not None:
-            lines.append(f"  STOPPED: {self['stopped']}")
+        if self.stopped is not None:
+            lines.append(f"  STOPPED: {self.stopped}")
         return "\n".join(lines) + ")"
 
     __str__ = __repr__
@@ -150,18 +342,18 @@ class Trajectory(Result):
             return float(np.max(a)) if len(a) else 0.0
 
         return {
-            "momentum_residual": mx(self["momentum_residual"]),
-            "solver_error": mx(self["solver_error"]),
-            "solver_scaled_error": mx(self["solver_scaled_error"]),
-            "cone_violation": mx(self["cone_violation"]),
-            "complementarity": mx(self["complementarity"]),
+            "momentum_residual": mx(self.momentum_residual),
+            "solver_error": mx(self.solver_error),
+            "solver_scaled_error": mx(self.solver_scaled_error),
+            "cone_violation": mx(self.cone_violation),
+            "complementarity": mx(self.complementarity),
             "energy_gain": float(np.max(self.energy_gain(), initial=0.0)),
         }
 
     def step_energy(self) -> np.ndarray:
         """The energy the impulse step keeps, ``E_h = T + V + (h/2) f . v`` per state (J; see
         the module documentation)."""
-        return self["total_energy"] + 0.5 * self["h"] * self["load_power"]
+        return self.total_energy + 0.5 * self.h * self.load_power
 
     def energy_gain(self) -> np.ndarray:
         """Per step, how much ``T + V`` rose beyond the loads' O(h) work of the step,
@@ -172,9 +364,9 @@ class Trajectory(Result):
         pivoting contact whose Jacobian turns with the step). A step that gives back a
         rebound (``resumed``) is judged across it and the step that closed the contact (the
         landing step takes the approach energy, the rebound step returns it)."""
-        e, w = self["total_energy"], 0.5 * self["h"] * self["load_power"]
+        e, w = self.total_energy, 0.5 * self.h * self.load_power
         gain = np.diff(e) - np.abs(np.diff(w))
-        for k in np.flatnonzero(self["resumed"]):
+        for k in np.flatnonzero(self.resumed):
             if k >= 1:
                 gain[k] = e[k + 1] - e[k - 1] - abs(w[k + 1] - w[k - 1])
         return gain
@@ -184,8 +376,8 @@ class Trajectory(Result):
         ``|T| + |V| + |(h/2) f . v|`` over its states (the terms ``E_h`` is summed from, so
         the rounding of ``E_h`` and of the contact solves' residuals is in proportion):
         unit-consistent, with no absolute floor."""
-        t, p = self["kinetic_energy"], self["potential_energy"]
-        w = 0.5 * self["h"] * self["load_power"]
+        t, p = self.kinetic_energy, self.potential_energy
+        w = 0.5 * self.h * self.load_power
         if len(t) == 0:
             return 0.0
         return energy_tol * float(np.max(np.abs(t) + np.abs(p) + np.abs(w)))
@@ -198,7 +390,7 @@ class Trajectory(Result):
         energy_tol: float = 1e-9,
         gap_tol: float | None = None,
     ) -> Result:
-        """Every violation of the seed's checks, as a summary.
+        """Every violation of the per-step checks, as a summary.
 
         The contact law of each step (normal impulses ``>= 0``, friction cone,
         complementarity, sticking or sliding) is judged by the rule and the measure of the
@@ -229,44 +421,44 @@ class Trajectory(Result):
         ``strict=True`` a violation raises :class:`TrajectoryCheckError`.
         """
         v: list[str] = []
-        if self["stopped"] is not None:
-            v.append(f"stopped early: {self['stopped']}")
+        if self.stopped is not None:
+            v.append(f"stopped early: {self.stopped}")
         for name in ("q", "v", "contact_impulse"):
-            if not np.all(np.isfinite(self[name])):
+            if not np.all(np.isfinite(getattr(self, name))):
                 v.append(f"{name} has non-finite values")
-        status = self["solver_status"]
+        status = self.solver_status
         bad = [(k, s) for k, s in enumerate(status) if s not in ("solved", "no_contact")]
         if bad:
             k, s = bad[0]
             v.append(f"{len(bad)} contact solves did not succeed (first: step {k}, {s}, "
-                     f"scaled_error {self['solver_scaled_error'][k]:.2e})")
+                     f"scaled_error {readable(self.solver_scaled_error[k])})")
         # the verdict's own rule on the recorded measure (see the docstring)
-        exact = self["solver"] != "lemke" or self._planar()
+        exact = self.solver != "lemke" or self._planar()
         if exact:
-            tol = np.where(self["fallback"], max(self["tol"], 1e-9), self["tol"])
-            se = self["solver_scaled_error"]
+            tol = np.where(self.fallback, max(self.tol, 1e-9), self.tol)
+            se = self.solver_scaled_error
             solved = np.array([s == "solved" for s in status], dtype=bool)
             wrong = np.flatnonzero(solved & ~(se <= tol))
             if len(wrong):
                 k = int(wrong[0])
                 v.append(f"{len(wrong)} steps reported solved whose scaled_error exceeds tol "
-                         f"(first: step {k}, {se[k]:.2e} > {tol[k]:.1e})")
-        res = self["momentum_residual"]
+                         f"(first: step {k}, {readable(se[k])} > {readable(tol[k])})")
+        res = self.momentum_residual
         if np.any(res > momentum_tol):
-            v.append(f"momentum residual up to {res.max():.2e} > {momentum_tol:.1e}")
+            v.append(f"momentum residual up to {readable(res.max())} > {readable(momentum_tol)}")
         if gap_tol is None:
-            gap_tol = self["gap_tolerance"]
-        gaps = self["min_gap"]
+            gap_tol = self.gap_tolerance
+        gaps = self.min_gap
         if np.any(gaps < -gap_tol):
             k = int(np.argmin(gaps))
-            v.append(f"penetration: min gap {gaps[k]:.3e} m at t = {self['t'][k]:.6g} s "
+            v.append(f"penetration: min gap {gaps[k]:.3e} m at t = {self.t[k]:.6g} s "
                      f"({int(np.sum(gaps < -gap_tol))} states)")
         etol = self._energy_tolerance(energy_tol)
         gain = self.energy_gain()
         if np.any(gain > etol):
             k = int(np.argmax(gain))
             v.append(f"energy gained in {int(np.sum(gain > etol))} steps, up to "
-                     f"{gain[k]:.3e} J (step {k}, t = {self['t'][k]:.6g} s)")
+                     f"{gain[k]:.3e} J (step {k}, t = {self.t[k]:.6g} s)")
         out = Result(ok=not v, violations=v, **self._worst())
         if strict and v:
             raise TrajectoryCheckError("; ".join(v))
@@ -274,7 +466,7 @@ class Trajectory(Result):
 
     def _planar(self) -> bool:
         """Whether the contacts are planar (dim 2), where the polyhedral cone is exact."""
-        return int(self.get("dim", 0)) == 2
+        return self.dim == 2
 
     # -- plots -----------------------------------------------------------------------------
 
@@ -292,20 +484,20 @@ class Trajectory(Result):
             fig, axes = plt.subplots(3, 1, sharex=True, figsize=(7, 8))
         else:
             fig = axes[0].figure
-        t = self["t"]
-        labels = coordinate_labels(self._scene, self["q"].shape[1])
-        for column, label in zip(self["q"].T, labels, strict=True):
+        t = self.t
+        labels = coordinate_labels(self.scene, self.q.shape[1])
+        for column, label in zip(self.q.T, labels, strict=True):
             axes[0].plot(t, column, label=label)
-        if self._scene is None:
+        if self.scene is None:
             axes[0].set_ylabel("q (generalized)")
         else:
             units = sorted({lb[lb.rfind("[") + 1:-1] for lb in labels})
             axes[0].set_ylabel(f"q [{', '.join(units)}]")
         if len(labels) <= 21:
             axes[0].legend(fontsize=7, ncol=1 + (len(labels) - 1) // 7, loc="best")
-        axes[1].plot(t, self["kinetic_energy"], label="kinetic")
-        axes[1].plot(t, self["potential_energy"], label="potential")
-        axes[1].plot(t, self["total_energy"], label="total")
+        axes[1].plot(t, self.kinetic_energy, label="kinetic")
+        axes[1].plot(t, self.potential_energy, label="potential")
+        axes[1].plot(t, self.total_energy, label="total")
         axes[1].set_ylabel("energy [J]")
         axes[1].legend(fontsize=7)
         axes[2].step(t[:-1], self.normal_impulse_per_step(), where="post",

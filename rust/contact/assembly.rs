@@ -1,5 +1,5 @@
 //! From a mechanism to its contact problem: the Delassus matrix and the free contact velocity
-//! (DESIGN.md conventions; the seed's "inelastic step"):
+//! (the inelastic step of Stewart 2000, with Acary and Brogliato's 2008 sign conventions):
 //!
 //! ```text
 //!     W = G^T M^{-1} G,        q = G^T v_free + w,        v = v_free + M^{-1} G r,
@@ -25,6 +25,7 @@ use faer::sparse::linalg::solvers::Llt;
 use faer::sparse::{SparseColMat, Triplet};
 use faer::Side;
 
+use crate::contact::BlockCsr;
 use crate::error::{check_finite, CoulombError, Result};
 
 /// blocks of M up to this many dofs are factored densely, block by block.
@@ -198,28 +199,32 @@ impl MassFactor {
         Ok(MassFactor::Sparse(llt))
     }
 
+    /// the diagonal blocks `(offset, size)` the factor works on: one per block of a block
+    /// diagonal M, the whole of M for the sparse factor.
+    pub fn block_ranges(&self, ndof: usize) -> Vec<(usize, usize)> {
+        match self {
+            MassFactor::Blocks(blocks) => blocks.iter().map(|(o, s, _)| (*o, *s)).collect(),
+            MassFactor::Sparse(_) => vec![(0, ndof)],
+        }
+    }
+
+    /// `x <- M_b^{-1} x` on block `b` of [`Self::block_ranges`] (`x` its entries).
+    pub fn solve_block_in_place(&self, b: usize, x: &mut [f64]) {
+        match self {
+            MassFactor::Blocks(blocks) => {
+                let (_, s, l) = &blocks[b];
+                solve_cholesky(l, *s, x);
+            }
+            MassFactor::Sparse(_) => self.solve_in_place(x),
+        }
+    }
+
     /// `x <- M^{-1} x`.
     pub fn solve_in_place(&self, x: &mut [f64]) {
         match self {
             MassFactor::Blocks(blocks) => {
                 for (o, s, l) in blocks {
-                    let xb = &mut x[*o..*o + *s];
-                    let s = *s;
-                    // L y = x, then L^T z = y
-                    for i in 0..s {
-                        let mut v = xb[i];
-                        for k in 0..i {
-                            v -= l[i * s + k] * xb[k];
-                        }
-                        xb[i] = v / l[i * s + i];
-                    }
-                    for i in (0..s).rev() {
-                        let mut v = xb[i];
-                        for k in i + 1..s {
-                            v -= l[k * s + i] * xb[k];
-                        }
-                        xb[i] = v / l[i * s + i];
-                    }
+                    solve_cholesky(l, *s, &mut x[*o..*o + *s]);
                 }
             }
             MassFactor::Sparse(llt) => {
@@ -230,9 +235,32 @@ impl MassFactor {
     }
 }
 
+/// `x <- (L L^T)^{-1} x` for a row-major `s x s` lower-triangular factor L: `L y = x`, then
+/// `L^T z = y`.
+pub(crate) fn solve_cholesky(l: &[f64], s: usize, x: &mut [f64]) {
+    for i in 0..s {
+        let mut v = x[i];
+        for k in 0..i {
+            v -= l[i * s + k] * x[k];
+        }
+        x[i] = v / l[i * s + i];
+    }
+    for i in (0..s).rev() {
+        let mut v = x[i];
+        for k in i + 1..s {
+            v -= l[k * s + i] * x[k];
+        }
+        x[i] = v / l[i * s + i];
+    }
+}
+
 /// dense Cholesky `A = L L^T` in place (row-major s x s, L in the lower triangle, the upper
 /// triangle zeroed); `Err(k)` when pivot k is at most `floor`.
-fn cholesky_in_place(a: &mut [f64], s: usize, floor: f64) -> std::result::Result<(), usize> {
+pub(crate) fn cholesky_in_place(
+    a: &mut [f64],
+    s: usize,
+    floor: f64,
+) -> std::result::Result<(), usize> {
     for j in 0..s {
         let mut d = a[j * s + j];
         for k in 0..j {
@@ -257,6 +285,133 @@ fn cholesky_in_place(a: &mut [f64], s: usize, floor: f64) -> std::result::Result
     Ok(())
 }
 
+/// The one assembly of the Delassus matrix `W = G^T M^{-1} G` (Moreau; Jean 1999; Acary and
+/// Brogliato 2008, ch. 10) when M is block diagonal (one block per body, or one block for a
+/// whole mechanism in generalized coordinates):
+///
+/// ```text
+///     W_ij = Σ_b G_{i,b}^T M_b^{-1} G_{j,b}
+/// ```
+///
+/// over the blocks b that contacts i and j both act on, with `G_{i,b}` contact i's `dim`
+/// columns of G restricted to block b (a *side* of the contact). Each block lists the sides
+/// acting on it ([`WAssembly::side`]); each pair of sides sharing a block is multiplied once
+/// (`O(Σ_b k_b^2)` products, not `O(nc^2)`) by the caller's `dim x dim` product and mirrored
+/// (the blocks between two contacts are symmetric by construction; a contact's own block is
+/// the caller's product, symmetric to rounding). W is stored dense (row-major) or as COO triplets for
+/// [`BlockCsr`]. The workspaces are kept from one assembly to the next: assembling a W of a
+/// size seen before allocates nothing.
+///
+/// Used by the time stepper (rigid bodies: sides are body blocks of at most 6 velocities), by
+/// the generalized-coordinate stepper (one block) and by [`assemble_with`] (G and M given).
+#[derive(Clone, Debug, Default)]
+pub struct WAssembly {
+    /// per block, the sides `(contact, side)` acting on it; the first `blocks` are in use.
+    incidence: Vec<Vec<(usize, usize)>>,
+    blocks: usize,
+    /// the dense W, row-major `n x n` (empty after a sparse assembly).
+    w: Vec<f64>,
+    rows: Vec<usize>,
+    cols: Vec<usize>,
+    vals: Vec<f64>,
+    dim: usize,
+    n: usize,
+}
+
+impl WAssembly {
+    /// an empty workspace.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// starts an assembly over `blocks` blocks (bodies), forgetting the previous sides.
+    pub fn begin(&mut self, blocks: usize) {
+        if self.incidence.len() < blocks {
+            self.incidence.resize_with(blocks, Vec::new);
+        }
+        for list in &mut self.incidence[..blocks] {
+            list.clear();
+        }
+        self.blocks = blocks;
+    }
+
+    /// contact `contact`'s side `side` acts on block `block` (`< blocks` of [`Self::begin`]);
+    /// sides are given in contact order.
+    #[inline]
+    pub fn side(&mut self, contact: usize, side: usize, block: usize) {
+        self.incidence[block].push((contact, side));
+    }
+
+    /// W over `nc` contacts of `dim` (1 to 3) components, dense or as COO triplets when
+    /// `sparse`: `product((i, ki), (j, kj))` is `G_{i,b}^T M_b^{-1} G_{j,b}` for side ki of
+    /// contact i and side kj of contact j on their common block b (entry `[α][β]` for
+    /// components α of i and β of j); it is called once per pair of sides on a block, `i <=
+    /// j` in block order, and its block is added at `(i, j)` and mirrored at `(j, i)`.
+    // index loops mirror W's layout (α: a component of contact i, β: of contact j)
+    #[allow(clippy::needless_range_loop)]
+    pub fn assemble<F>(&mut self, dim: usize, nc: usize, sparse: bool, mut product: F)
+    where
+        F: FnMut((usize, usize), (usize, usize)) -> [[f64; 3]; 3],
+    {
+        let n = nc * dim;
+        self.dim = dim;
+        self.n = n;
+        self.w.clear();
+        if !sparse {
+            self.w.resize(n * n, 0.0);
+        }
+        self.rows.clear();
+        self.cols.clear();
+        self.vals.clear();
+        for list in &self.incidence[..self.blocks] {
+            for (p, &(i, ki)) in list.iter().enumerate() {
+                for &(j, kj) in &list[p..] {
+                    let blk = product((i, ki), (j, kj));
+                    let mirror = i != j;
+                    if sparse {
+                        for al in 0..dim {
+                            for be in 0..dim {
+                                self.rows.push(i * dim + al);
+                                self.cols.push(j * dim + be);
+                                self.vals.push(blk[al][be]);
+                                if mirror {
+                                    self.rows.push(j * dim + be);
+                                    self.cols.push(i * dim + al);
+                                    self.vals.push(blk[al][be]);
+                                }
+                            }
+                        }
+                    } else {
+                        for al in 0..dim {
+                            for be in 0..dim {
+                                self.w[(i * dim + al) * n + j * dim + be] += blk[al][be];
+                                if mirror {
+                                    self.w[(j * dim + be) * n + i * dim + al] += blk[al][be];
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// the dense W of the last assembly (row-major `n x n`; empty after a sparse one).
+    pub fn dense(&self) -> &[f64] {
+        &self.w
+    }
+
+    /// the dense W, taken out of the workspace (the next dense assembly allocates it anew).
+    pub fn take_dense(&mut self) -> Vec<f64> {
+        std::mem::take(&mut self.w)
+    }
+
+    /// the W of the last (sparse) assembly in block CSR.
+    pub fn block_csr(&self) -> Result<BlockCsr> {
+        BlockCsr::from_coo(self.dim, self.n, &self.rows, &self.cols, &self.vals)
+    }
+}
+
 /// G by columns: `(row, value)` lists, one per column.
 fn columns(g: &Triplets<'_>) -> Vec<Vec<(usize, f64)>> {
     let mut cols = vec![Vec::new(); g.ncols];
@@ -271,7 +426,8 @@ fn columns(g: &Triplets<'_>) -> Vec<Vec<(usize, f64)>> {
 /// The contact problem of a mechanism (see the module notes).
 #[derive(Clone, Debug)]
 pub struct Assembled {
-    /// `W = G^T M^{-1} G`, row-major `(dim nc)^2`, symmetrized (`(W + W^T) / 2`).
+    /// `W = G^T M^{-1} G`, row-major `(dim nc)^2`, symmetric by construction (each pair of
+    /// columns sharing a block of M is multiplied once and mirrored: [`WAssembly`]).
     pub w: Vec<f64>,
     /// `q = G^T v_free + w`.
     pub q: Vec<f64>,
@@ -359,25 +515,7 @@ pub fn assemble_with(
         check_finite("the extra contact term", e)?;
     }
     let cols = columns(g);
-    let mut w = vec![0.0; n * n];
-    let mut x = vec![0.0; ndof];
-    for (k, ck) in cols.iter().enumerate() {
-        x.fill(0.0);
-        for &(r, v) in ck {
-            x[r] = v;
-        }
-        factor.solve_in_place(&mut x);
-        for (j, cj) in cols.iter().enumerate() {
-            w[j * n + k] = cj.iter().map(|&(r, v)| v * x[r]).sum();
-        }
-    }
-    for i in 0..n {
-        for j in i + 1..n {
-            let s = 0.5 * (w[i * n + j] + w[j * n + i]);
-            w[i * n + j] = s;
-            w[j * n + i] = s;
-        }
-    }
+    let w = delassus_of_columns(factor, ndof, &cols)?;
     let q = cols
         .iter()
         .enumerate()
@@ -386,6 +524,92 @@ pub fn assemble_with(
         })
         .collect();
     Ok(Assembled { w, q, v_free })
+}
+
+/// One side of a column of G: its entries `cols[k][start..end]` on block `block`, and
+/// `M_b^{-1} G_{k,b}` at `mg[off..off + size_b]`.
+struct ColumnSide {
+    block: usize,
+    start: usize,
+    end: usize,
+    off: usize,
+}
+
+/// `W = G^T M^{-1} G` by the one assembly ([`WAssembly`]), each column of G a contact
+/// component (`dim = 1`) whose sides are its entries on the blocks of M.
+fn delassus_of_columns(
+    factor: &MassFactor,
+    ndof: usize,
+    cols: &[Vec<(usize, f64)>],
+) -> Result<Vec<f64>> {
+    let ranges = factor.block_ranges(ndof);
+    let mut block_of = vec![0usize; ndof];
+    for (b, &(o, s)) in ranges.iter().enumerate() {
+        block_of[o..o + s].fill(b);
+    }
+    // each column's sides (rows are sorted, so a block's entries are consecutive)
+    let mut sides: Vec<ColumnSide> = Vec::new();
+    let mut first = Vec::with_capacity(cols.len() + 1);
+    let mut len = 0usize;
+    for col in cols {
+        first.push(sides.len());
+        let mut e = 0;
+        while e < col.len() {
+            let block = block_of[col[e].0];
+            let start = e;
+            while e < col.len() && block_of[col[e].0] == block {
+                e += 1;
+            }
+            sides.push(ColumnSide {
+                block,
+                start,
+                end: e,
+                off: len,
+            });
+            len = len.saturating_add(ranges[block].1);
+        }
+    }
+    first.push(sides.len());
+    crate::limits::check_bytes(
+        &format!(
+            "M^-1 G over the blocks of M touched by {} columns of G",
+            cols.len()
+        ),
+        len,
+        8,
+        "",
+    )?;
+    let mut mg = vec![0.0; len];
+    for (k, col) in cols.iter().enumerate() {
+        for sd in &sides[first[k]..first[k + 1]] {
+            let (o, size) = ranges[sd.block];
+            let x = &mut mg[sd.off..sd.off + size];
+            for &(r, v) in &col[sd.start..sd.end] {
+                x[r - o] = v;
+            }
+            factor.solve_block_in_place(sd.block, x);
+        }
+    }
+    let mut asm = WAssembly::new();
+    asm.begin(ranges.len());
+    for k in 0..cols.len() {
+        for (s, sd) in sides[first[k]..first[k + 1]].iter().enumerate() {
+            asm.side(k, s, sd.block);
+        }
+    }
+    asm.assemble(1, cols.len(), false, |(i, ki), (j, kj)| {
+        let (si, sj) = (&sides[first[i] + ki], &sides[first[j] + kj]);
+        let o = ranges[si.block].0;
+        let x = &mg[sj.off..];
+        let v: f64 = cols[i][si.start..si.end]
+            .iter()
+            .map(|&(r, g)| g * x[r - o])
+            .sum();
+        let mut blk = [[0.0; 3]; 3];
+        blk[0][0] = v;
+        blk
+    });
+    Ok(asm.take_dense())
 }
 
 /// the velocity after the impulses: `v = v_free + M^{-1} G r`.
@@ -461,6 +685,120 @@ mod tests {
         }
         for (i, v) in back.iter().enumerate() {
             assert!((v - (i as f64 + 1.0)).abs() < 1e-14, "{back:?}");
+        }
+    }
+
+    /// sides of the test below: (contact, body, G block: dim = 2 columns of nv = 2).
+    type TestSide = (usize, usize, [[f64; 2]; 2]);
+
+    /// `G^T M^{-1} G` by dense products, G (nb nv x 3 dim) built from the sides.
+    #[allow(clippy::needless_range_loop)]
+    fn dense_w(sides: &[TestSide], minv: &[[f64; 4]; 3]) -> Vec<f64> {
+        let (dim, nv, nb) = (2usize, 2usize, 3usize);
+        let (ndof, n) = (nb * nv, 3 * dim);
+        let mut g = vec![0.0; ndof * n];
+        for &(c, b, blk) in sides {
+            for al in 0..dim {
+                for r in 0..nv {
+                    g[(b * nv + r) * n + c * dim + al] = blk[al][r];
+                }
+            }
+        }
+        let mut w = vec![0.0; n * n];
+        for i in 0..n {
+            for j in 0..n {
+                for b in 0..nb {
+                    for r in 0..nv {
+                        for c in 0..nv {
+                            w[i * n + j] += g[(b * nv + r) * n + i]
+                                * minv[b][r * nv + c]
+                                * g[(b * nv + c) * n + j];
+                        }
+                    }
+                }
+            }
+        }
+        w
+    }
+
+    /// W of three contacts (dim 2) on three bodies of two velocities each (contact 0 on
+    /// bodies 0 and 1, contact 1 on body 1, contact 2 on bodies 1 and 2, so contacts 0 and 2
+    /// share body 1 only), by the one assembly, dense and sparse, against the dense product.
+    #[test]
+    #[allow(clippy::needless_range_loop)]
+    fn the_one_assembly_sums_over_shared_blocks_dense_and_sparse() {
+        let (dim, nv, nb, n) = (2usize, 2usize, 3usize, 6usize);
+        let minv = [
+            [0.5, 0.1, 0.1, 0.25],
+            [1.0, -0.2, -0.2, 0.5],
+            [0.2, 0.0, 0.0, 0.8],
+        ];
+        let sides: [TestSide; 5] = [
+            (0, 0, [[1.0, 0.5], [0.0, 2.0]]),
+            (0, 1, [[-1.0, 0.3], [0.4, -2.0]]),
+            (1, 1, [[0.7, 0.0], [1.0, 1.0]]),
+            (2, 1, [[0.2, 1.5], [-0.6, 0.1]]),
+            (2, 2, [[-0.9, 0.4], [0.3, 0.3]]),
+        ];
+        let expected = dense_w(&sides, &minv);
+        let mut side_of = vec![vec![]; 3];
+        for (k, s) in sides.iter().enumerate() {
+            side_of[s.0].push(k);
+        }
+        let mut asm = WAssembly::new();
+        for sparse in [false, true, false] {
+            asm.begin(nb);
+            for (c, list) in side_of.iter().enumerate() {
+                for (k, &s) in list.iter().enumerate() {
+                    asm.side(c, k, sides[s].1);
+                }
+            }
+            let mut calls = 0;
+            asm.assemble(dim, 3, sparse, |(i, ki), (j, kj)| {
+                calls += 1;
+                let (si, sj) = (&sides[side_of[i][ki]], &sides[side_of[j][kj]]);
+                assert_eq!(si.1, sj.1, "a product across bodies");
+                let m = &minv[si.1];
+                let mut blk = [[0.0; 3]; 3];
+                for al in 0..dim {
+                    for be in 0..dim {
+                        for r in 0..nv {
+                            for c in 0..nv {
+                                blk[al][be] += si.2[al][r] * m[r * nv + c] * sj.2[be][c];
+                            }
+                        }
+                    }
+                }
+                blk
+            });
+            // body 0: 1 side, body 1: 3 sides (6 pairs), body 2: 1 side
+            assert_eq!(calls, 1 + 6 + 1);
+            let mut w = asm.dense().to_vec();
+            if sparse {
+                let csr = asm.block_csr().unwrap();
+                w = vec![0.0; n * n];
+                let (mut e, mut col) = (vec![0.0; n], vec![0.0; n]);
+                for j in 0..n {
+                    e.fill(0.0);
+                    e[j] = 1.0;
+                    csr.mul(&e, &mut col);
+                    for i in 0..n {
+                        w[i * n + j] = col[i];
+                    }
+                }
+            }
+            for k in 0..n * n {
+                assert!((w[k] - expected[k]).abs() < 1e-14, "{sparse}: {k}: {w:?}");
+            }
+            // blocks of two contacts are mirrored exactly; a contact's own block is the
+            // caller's product (symmetric to rounding)
+            for i in 0..n {
+                for j in 0..n {
+                    if i / dim != j / dim {
+                        assert_eq!(w[i * n + j], w[j * n + i]);
+                    }
+                }
+            }
         }
     }
 

@@ -56,11 +56,28 @@ pub struct Finish {
 /// set grows past [`MAX_CONTACTS`], Lemke fails, or no round passes `tol` ([`super::ContactMeasures::passes`]) on the
 /// whole problem.
 pub fn finish_2d(problem: &ContactProblem<'_>, r: &[f64], tol: f64) -> Result<Option<Finish>> {
-    if problem.dim != 2 || !problem.is_isotropic() || r.len() != problem.size() {
+    if r.len() != problem.size() {
+        return Ok(None);
+    }
+    let in_set: Vec<bool> = (0..problem.nc).map(|i| r[2 * i] > 0.0).collect();
+    finish_on(problem, in_set, tol)
+}
+
+/// [`finish_2d`] with every contact in the working set from the start: the whole 2D problem
+/// as one LCP (`None` as for [`finish_2d`]).
+pub fn finish_2d_whole(problem: &ContactProblem<'_>, tol: f64) -> Result<Option<Finish>> {
+    finish_on(problem, vec![true; problem.nc], tol)
+}
+
+fn finish_on(
+    problem: &ContactProblem<'_>,
+    mut in_set: Vec<bool>,
+    tol: f64,
+) -> Result<Option<Finish>> {
+    if problem.dim != 2 || !problem.is_isotropic() {
         return Ok(None);
     }
     let nc = problem.nc;
-    let mut in_set: Vec<bool> = (0..nc).map(|i| r[2 * i] > 0.0).collect();
     let mut pivots = 0usize;
     for round in 1..=MAX_ROUNDS {
         // the working set's positions, and each contact's index in it

@@ -32,6 +32,12 @@
 //!   summed from those terms, its rounding is a few ulps of `t_i`, and the measure reaches
 //!   rounding level at a solution.
 //!
+//!   In De Saxce's map the slip `s = ||u_{t,i}||` is counted only above the rounding of the
+//!   sum it comes from, `f = (n + 3) eps ||t_{t,i}||`, as `s - f^2 / s` (0 below f): with a
+//!   large mu, `mu ||u_t||` would otherwise turn the rounding of a sticking contact's u_t into
+//!   an error of `mu eps` (1e-4 at mu = 1e12), and the verdict would follow that rounding from
+//!   one unit system to the next.
+//!
 //!   with `D(R)` the disk of radius R (the ellipse `(x_1 / mu_1)^2 + (x_2 / mu_2)^2 <= r_n^2`
 //!   for anisotropic friction). Both maps vanish exactly at the solutions. De Saxce's alone is
 //!   blind for a large mu: its normal argument `rho (u_n + mu ||u_t||)` lets `mu ||u_t||` hide
@@ -242,6 +248,7 @@ fn scaled_residuals(
     rho: f64,
     r: &[f64],
     u: &[f64],
+    slip_floor: f64,
 ) -> ([f64; 3], [f64; 3]) {
     let dim = problem.dim;
     let mu = problem.mu[i];
@@ -249,13 +256,14 @@ fn scaled_residuals(
     for k in 0..dim {
         su[k] = rho * u[k];
     }
+    let floor = rho * slip_floor;
     let mut a = [0.0; 3];
     // Signorini: r_n - max(0, r_n - rho u_n)
     a[0] = r[0] - (r[0] - su[0]).max(0.0);
     let rn = r[0].max(0.0);
     let e = match problem.anisotropy(i) {
         None => {
-            let e = de_saxce_residual(&r[..dim], &su[..dim], mu);
+            let e = de_saxce_residual(&r[..dim], &su[..dim], mu, floor);
             // Coulomb with the normal impulse frozen: projection on the disk of radius mu r_n
             let radius = mu * rn;
             let mut x = [0.0; 2];
@@ -270,7 +278,7 @@ fn scaled_residuals(
             e
         }
         Some(pair) => {
-            let (e, _) = anisotropic_residual(pair, r, &su[..dim]);
+            let (e, _) = anisotropic_residual(pair, r, &su[..dim], floor);
             let x = [r[1] - su[1], r[2] - su[2]];
             let p = project_ellipse(x, pair[0], pair[1], rn);
             a[1] = r[1] - p[0];
@@ -279,6 +287,28 @@ fn scaled_residuals(
         }
     };
     (e, a)
+}
+
+/// The rounding bound of a tangential velocity `u_t = (W r + q)_t` of a problem of `n`
+/// unknowns whose terms have the magnitudes `terms` (`(|W| |r| + |q|)_t`): each component is a
+/// sum of `n + 1` products, so its rounding, and the effect of rounding r and the data
+/// by one unit in the last place, is at most `(n + 3) eps` times its terms (Higham 2002,
+/// sec. 3.1). A slip below this is not distinguishable from 0 (see [`counted_slip`]).
+#[inline]
+pub(crate) fn rounding_floor(n: usize, terms: &[f64]) -> f64 {
+    (n as f64 + 3.0) * f64::EPSILON * norm2(terms)
+}
+
+/// The slip `s = ||u_t||` De Saxce's map counts when u_t is formed to within `floor`:
+/// 0 up to the floor, then `s - floor^2 / s`, continuous and increasing, and equal to s to
+/// rounding once s is well above the floor (so an exact answer still measures exactly 0).
+#[inline]
+fn counted_slip(s: f64, floor: f64) -> f64 {
+    if s <= floor {
+        0.0
+    } else {
+        s - floor * (floor / s)
+    }
 }
 
 /// `u = W r + q` into `u` and the measures of r, without allocating.
@@ -316,15 +346,16 @@ pub(crate) fn measure_into(
         // the literature's map (velocities added to impulses as they are)
         let (e1, viol) = match problem.anisotropy(i) {
             None => (
-                de_saxce_residual(ri, ui, mu),
+                de_saxce_residual(ri, ui, mu, 0.0),
                 tangent_norm(&ri[1..]) - mu * ri[0],
             ),
-            Some(pair) => anisotropic_residual(pair, ri, ui),
+            Some(pair) => anisotropic_residual(pair, ri, ui, 0.0),
         };
         res.add_all(&e1[..dim]);
         // the unit-consistent maps, relative to the contact's own impulse scale
         let rho = scales.rho(problem, i);
-        let (e, a) = scaled_residuals(problem, i, rho, ri, ui);
+        let floor = rounding_floor(problem.size(), &terms[1..dim]);
+        let (e, a) = scaled_residuals(problem, i, rho, ri, ui, floor);
         let size = norm2(ri).max(rho * norm2(&terms[..dim]));
         let err = norm2(&e[..dim]).max(norm2(&a[..dim]));
         // size = 0 means r_i = 0 and every term of u_i is 0: both maps are exactly 0 there
@@ -382,7 +413,12 @@ pub(crate) fn measure_into(
 /// `e_k = r_k`: the impulse must vanish along it). B is invertible on the cone's span, so
 /// `e = 0` exactly at a solution; for `mu_1 = mu_2` it is `B = I` and e is the isotropic
 /// residual. The cone violation is `max(||B^+ r_t|| - m r_n, |r_k| for mu_k = 0)`.
-pub(crate) fn anisotropic_residual(pair: [f64; 2], r: &[f64], u: &[f64]) -> ([f64; 3], f64) {
+pub(crate) fn anisotropic_residual(
+    pair: [f64; 2],
+    r: &[f64],
+    u: &[f64],
+    slip_floor: f64,
+) -> ([f64; 3], f64) {
     let m = pair[0].max(pair[1]);
     if m <= 0.0 {
         // frictionless: the half-line
@@ -403,7 +439,7 @@ pub(crate) fn anisotropic_residual(pair: [f64; 2], r: &[f64], u: &[f64]) -> ([f6
             flat = flat.max(r[1 + k].abs());
         }
     }
-    let uht = uh[1].hypot(uh[2]);
+    let uht = counted_slip(uh[1].hypot(uh[2]), slip_floor);
     let mut v = [rh[0] - (uh[0] + m * uht), rh[1] - uh[1], rh[2] - uh[2]];
     project_cone(&mut v, m);
     let e = [r[0] - v[0], r[1] - b[0] * v[1], r[2] - b[1] * v[2]];
@@ -411,11 +447,14 @@ pub(crate) fn anisotropic_residual(pair: [f64; 2], r: &[f64], u: &[f64]) -> ([f6
 }
 
 /// De Saxcé's natural-map residual of one isotropic contact,
-/// `e = r - P_K(r - (u + mu ||u_t|| n))` (De Saxcé and Feng 1991), zero-padded to 3.
-fn de_saxce_residual(r: &[f64], u: &[f64], mu: f64) -> [f64; 3] {
+/// `e = r - P_K(r - (u + mu ||u_t|| n))` (De Saxcé and Feng 1991), zero-padded to 3, with the
+/// slip `||u_t||` counted by [`counted_slip`] above `slip_floor` (0 for the literature's map;
+/// the rounding of u_t for the verdict's, see [`rounding_floor`]).
+fn de_saxce_residual(r: &[f64], u: &[f64], mu: f64, slip_floor: f64) -> [f64; 3] {
     let dim = r.len();
     let mut v = [0.0; 3];
-    v[0] = r[0] - (u[0] + mu * tangent_norm(&u[1..dim]));
+    let slip = counted_slip(tangent_norm(&u[1..dim]), slip_floor);
+    v[0] = r[0] - (u[0] + mu * slip);
     for k in 1..dim {
         v[k] = r[k] - u[k];
     }
@@ -485,6 +524,33 @@ mod tests {
     }
 
     #[test]
+    fn a_slip_at_the_rounding_of_its_terms_is_no_slip_whatever_mu() {
+        // one sticking contact, r = (1, 0.5) and u = 0, with q_t off by `k` units of the
+        // rounding of u_t's terms: De Saxce's normal term is then mu k eps, 1e-4 of the
+        // impulse for mu = 1e12 and k = 1, though u_t cannot be formed any closer to 0
+        let w = [1.0, 0.3, 0.3, 1.0];
+        let r = [1.0, 0.5];
+        let terms_t = 0.3 * 1.0 + 1.0 * 0.5 + 0.8;
+        for (k, passes) in [(1.0, true), (4.0, true), (1e4, false)] {
+            let q = [-1.15, -0.8 + k * f64::EPSILON * terms_t];
+            for mu in [1.0, 1e8, 1e12] {
+                let mus = [mu];
+                let p = ContactProblem::new(2, &w, &q, &mus).unwrap();
+                let (u, m) = measure(&p, &r).unwrap();
+                assert!(u[1] != 0.0 && u[0].abs() < 1e-15);
+                if passes {
+                    assert!(m.scaled_error < 1e-14, "k {k} mu {mu}: {m:?}");
+                } else if mu >= 1e8 {
+                    // a slip 1e4 times its rounding is a slip: mu weighs it
+                    assert!(m.scaled_error > 1e-6, "k {k} mu {mu}: {m:?}");
+                } else {
+                    assert!(m.scaled_error < 1e-11, "k {k} mu {mu}: {m:?}");
+                }
+            }
+        }
+    }
+
+    #[test]
     fn norms_neither_underflow_nor_overflow() {
         for s in [1e-300, 1e-200, 1.0, 1e200, 1e300] {
             let x = [3.0 * s, 4.0 * s];
@@ -493,7 +559,7 @@ mod tests {
         assert!(norm2(&[f64::NAN, 1.0]).is_nan());
         assert_eq!(norm2(&[f64::INFINITY, 1.0]), f64::INFINITY);
         assert_eq!(norm2(&[0.0, -0.0]), 0.0);
-        // r = 0 for the seed's step at 1e-200: measured as at scale 1, not as 0
+        // r = 0 for the chapter's inelastic step at 1e-200: measured as at scale 1, not as 0
         let (w, q) = ([0.5e-200, 0.0, 0.0, 0.5e-200], [-3e-200, 1e-200]);
         let p = ContactProblem::new(2, &w, &q, &[0.2]).unwrap();
         let (_, m) = measure(&p, &[0.0, 0.0]).unwrap();
@@ -505,7 +571,7 @@ mod tests {
     }
 
     #[test]
-    fn measures_of_the_seed_answer_and_of_zero() {
+    fn measures_of_the_chapter_answer_and_of_zero() {
         let w = [0.5, 0.0, 0.0, 0.5];
         let q = [-3.0, 1.0];
         let p = ContactProblem::new(2, &w, &q, &[0.2]).unwrap();

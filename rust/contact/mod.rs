@@ -1,4 +1,4 @@
-//! Frictional contact over a frozen Delassus matrix (DESIGN.md, part 2):
+//! Frictional contact over a frozen Delassus matrix (Jean 1999; Acary and Brogliato 2008):
 //!
 //! ```text
 //!     u = W r + q,   per contact i:  K_i ∋ r_i  ⊥  u_i + mu_i ||u_{t,i}|| n  ∈ K_i^*,
@@ -378,7 +378,8 @@ fn pad(d: usize, t: &[f64], b: &mut [[f64; 3]; 3]) {
 pub enum ContactStatus {
     /// the error is at most the tolerance.
     Solved,
-    /// the iteration limit was reached first; the error is reported.
+    /// the method's budget was spent first (its iteration limit, Lemke's pivot limit, or the
+    /// robust mode's restarts after stalls); the error is reported.
     IterationLimit,
     /// the arithmetic broke down (non-finite iterates, or a contact with no normal stiffness
     /// `W_nn <= 0` that the answer needed).
@@ -487,7 +488,7 @@ mod tests {
         ));
         let a = p.with_anisotropic_friction(&[0.2, 0.5]).unwrap();
         assert!(!a.is_isotropic() && a.anisotropy(0) == Some([0.2, 0.5]));
-        // sliding along t1 with mu_1 = 0.2: the seed's answer, zero error
+        // sliding along t1 with mu_1 = 0.2: the chapter's answer, zero error
         let (u, m) = measure(&a, &[6.0, -1.2, 0.0]).unwrap();
         assert!((u[1] - 0.4).abs() < 1e-15);
         assert!(m.error < 1e-15 && m.cone_violation == 0.0, "{m:?}");
@@ -500,7 +501,7 @@ mod tests {
             let r = [rng.normal(), rng.normal(), rng.normal()];
             let u = [rng.normal(), rng.normal(), rng.normal()];
             let mu = rng.range(0.0, 2.0);
-            let (e, viol) = measures::anisotropic_residual([mu, mu], &r, &u);
+            let (e, viol) = measures::anisotropic_residual([mu, mu], &r, &u, 0.0);
             let d2: f64 = e.iter().map(|x| x * x).sum();
             let mut v = [
                 r[0] - u[0] - mu * u[1].hypot(u[2]),

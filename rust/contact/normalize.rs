@@ -25,6 +25,7 @@ use super::{
     solve_nsgs, BlockCsr, ContactProblem, ContactSolution, ContactStatus, Delassus, NsgsSettings,
 };
 use crate::error::{CoulombError, Result};
+use crate::readable::Readable;
 
 /// Which contact method [`solve`] runs, with its settings.
 #[derive(Clone, Debug)]
@@ -147,9 +148,12 @@ pub fn solve(problem: &ContactProblem<'_>, method: &Method) -> Result<ContactSol
     if sol.status == ContactStatus::Solved && exact_rule && !sol.measures.passes(tol) {
         sol.status = ContactStatus::NumericalFailure;
         sol.message = format!(
-            "{}; but on the original data (scaled back by 2^{}) scaled_error is {:.2e} > tol \
-             {:.1e}: the answer is out of f64's range there",
-            sol.message, -ir, sol.measures.scaled_error, tol
+            "{}; but on the original data (scaled back by 2^{}) scaled_error is {} > tol \
+             {}: the answer is out of f64's range there",
+            sol.message,
+            -ir,
+            Readable(sol.measures.scaled_error),
+            Readable(tol)
         );
     }
     Ok(sol)

@@ -37,6 +37,7 @@ use schedule::CheckSchedule;
 
 use super::{measure_into, ContactProblem, ContactSolution, ContactStatus};
 use crate::error::{check_finite, CoulombError, Result};
+use crate::readable::Readable;
 
 /// Settings of [`solve_nsgs`].
 #[derive(Clone, Debug)]
@@ -311,8 +312,8 @@ pub fn solve_nsgs(problem: &ContactProblem<'_>, s: &NsgsSettings) -> Result<Cont
         (
             ContactStatus::Solved,
             format!(
-                "solved in {sweeps} sweeps (scaled_error {:.2e})",
-                measures.scaled_error
+                "solved in {sweeps} sweeps (scaled_error {})",
+                Readable(measures.scaled_error)
             ),
         )
     } else if !measures.scaled_error.is_finite() || r.iter().any(|v| !v.is_finite()) {
@@ -324,17 +325,21 @@ pub fn solve_nsgs(problem: &ContactProblem<'_>, s: &NsgsSettings) -> Result<Cont
         (
             ContactStatus::NumericalFailure,
             format!(
-                "contact {i} has no normal stiffness (W_nn = {:.2e} <= 0) and scaled_error stays \
-                 at {:.2e} > tol {:.1e} after {sweeps} sweeps",
-                blocks[i].a, measures.scaled_error, s.tol
+                "contact {i} has no normal stiffness (W_nn = {} <= 0) and scaled_error stays \
+                 at {} > tol {} after {sweeps} sweeps",
+                Readable(blocks[i].a),
+                Readable(measures.scaled_error),
+                Readable(s.tol)
             ),
         )
     } else {
         (
             ContactStatus::IterationLimit,
             format!(
-                "stopped at max_iter = {} with scaled_error {:.2e} > tol {:.1e}",
-                s.max_iter, measures.scaled_error, s.tol
+                "stopped at max_iter = {} with scaled_error {} > tol {}",
+                s.max_iter,
+                Readable(measures.scaled_error),
+                Readable(s.tol)
             ),
         )
     };

@@ -35,66 +35,44 @@
 //!
 //! When 25 Newton steps pass without a tenfold decrease of `||F||` (or no step length helps
 //! even with eta at 1e10 times W's scale) the iterate is moved by 100 NSGS sweeps and Newton
-//! restarts from there with the initial eta (at most 10 restarts): this rescued
-//! FrictionContactProblem00727 (stalled at error_q 5.6e-4 without it) and Capsules-i101-404.
+//! restarts from there with the initial eta (at most 10 restarts): sweeps move the iterate
+//! off a stall that Newton's local model cannot leave (BENCHMARKS.md lists the problems it
+//! rescued).
 //!
 //! In 2D, at the first such stall, the answer is first sought by the 2D LCP finish
 //! ([`super::lcp_finish`]): the 2D problem is exactly an LCP (the friction cone is an
 //! interval), solved by Lemke's method on the contacts with `r_n > 0` in the current iterate,
 //! the working set growing by the left-out contacts that close (`u_n < 0`) until the answer
 //! passes on the whole problem; if it does not, the NSGS restarts go on as before. Why it is
-//! needed, measured on fc2d_granularflowonwall_02020_00213 (nc 2020; W printed with 6
-//! significant digits, 18 eigenvalues below 1e-2 in magnitude against a largest 1.7e4, 10 of
-//! them negative down to -3.9e-3): Newton stalls at error_q 3.5e-7 for eta = 0.1, 1 and 10
-//! (and NSGS at 5.5e-7 after 20000 sweeps), and the stall is not an inner-solve accuracy
-//! issue: with the statuses of the stalled iterate (214 steps) fixed (739 pushing contacts,
-//! 460 of them sticking) the linear system of the piece (1199 unknowns) has three singular
-//! values 3.8e-4 to 1.9e-3 against 1.2e4, and its exact (dense LU) solution leaves the cones
-//! (r_n down to -1.9e-4, error_q 2.4e-4): no answer exists with those statuses. The answer Lemke finds (error_q
-//! 1.4e-15) has six contacts with other statuses (three sticking ones slide, a sticking one
-//! separates, a separated one slides, a sliding one sticks) and differs from the stalled
-//! iterate by 11% of `||r||` in r but by 7e-6 in u: a move along W's near-null directions,
-//! which the Newton pieces cannot make one status at a time (a Newton method with an exact
-//! ratio test to the first kink, tried from the stalled iterate, cycles between sticking and
-//! sliding at one contact). Figures: 53 Newton steps, then Lemke in 2 rounds (743 then 744
-//! contacts, 2972 and 2976 LCP unknowns, 3816 pivots), 4.4 to 9.5 s in all (solve_time,
-//! block-sparse W, a loaded 2-core machine), of which the 53 Newton steps take 0.18 s and
-//! Lemke the rest (before: stalled after 214 steps, 0.8 to 1.3 s); Lemke's dense
-//! tableau bounds the working set at [`super::lcp_finish::MAX_CONTACTS`] contacts. In 3D the
-//! polyhedral LCP is an approximation, so there is no such finish.
+//! needed: on a singular W (near-null directions from redundant contacts) Newton can stall at
+//! an iterate whose contact statuses admit no answer (the linear system of that piece is
+//! nearly singular and its exact solution leaves the cones), while the answer differs from
+//! the iterate at several contacts at once, by a large move in r along W's near-null
+//! directions and a tiny one in u: the Newton pieces cannot make that move one status at a
+//! time (a Newton method with an exact ratio test to the first kink cycles between sticking
+//! and sliding at one contact), and Lemke's pivoting can. fc2d_granularflowonwall_02020_00213
+//! is such a problem (BENCHMARKS.md, "The robust mode"). Lemke's dense tableau bounds the
+//! working set at [`super::lcp_finish::MAX_CONTACTS`] contacts. In 3D the polyhedral LCP is an
+//! approximation, so there is no such finish.
 //!
-//! Measured choice (release build, 2-core machine, tol 1e-8 on error_q, zero start; the
-//! numbers of `benches/peer_contact.py`):
-//!
-//! - this method with the default eta = 0.1 solves every 3D problem of the FCLib subset except
-//!   RockPile (BoxesStack1 49 Newton steps / 21 ms, local_problem_test 31 / 25 ms,
-//!   OneObject-i100000-499 8 / 1 ms, Capsules-i122-1617 26 / 0.30 s, KaplasTower 14 / 0.33 s,
-//!   Spheres (reduced) 20 / 0.14 s, PerioBox 23 / 45 ms), and 42 of the 44
-//!   local siconos-fc problems: all but RockPile_tob1 and the 2D
-//!   fc2d_granularflowonwall_02020_00213 (nc 2020: Newton alone stalls at error_q 3.5e-7;
-//!   solved to 1.4e-15 by the 2D LCP finish above). RockPile ends at error_q 8e-5 after 200
-//!   steps (Siconos NSGS: 3.5e-4).
-//! - eta = 1 solved the same set but slower (Capsules-i122 40 steps, Spheres 41); eta = 10
-//!   failed BoxesStack1; eta = 1e-12 from the start (plain semismooth Newton with a tiny
-//!   regularization) failed Capsules-i122-1617 (3.5e-7 after 200 steps) and took 57 steps on
-//!   KaplasTower.
-//! - A proximal outer loop with NSGS as the inner solver (`W + eta I`, eta = 0.1, 1 or 10 times
-//!   W's mean diagonal, inner NSGS to 1e-12 or 200 sweeps) did not reach 1e-8 on BoxesStack1
-//!   (best 4.5e-5), OneObject-i100000-499 (2.4e-5), local_problem_test (5.5e-4) or
-//!   Capsules-i97-269 (4e-6) within 1e5 sweeps: the outer loop contracts at the rate
-//!   `eta / (eta + lambda)` of W's small nonzero eigenvalues lambda, and the inner problems are
-//!   well conditioned only for eta comparable to W's diagonal. It was not kept.
+//! Why eta = 0.1 by default, and why the proximal loop is Newton's and not NSGS's: a large
+//! eta (10) makes every step a short projected step and fails where the problem is stiff; a
+//! tiny eta from the start (plain semismooth Newton) fails on singular W; 0.1 and 1 solve the
+//! same problems, 0.1 in fewer steps. A proximal outer loop with NSGS as the inner solver
+//! contracts only at the rate `eta / (eta + lambda)` of W's small nonzero eigenvalues lambda,
+//! while its inner problems are well conditioned only for eta comparable to W's diagonal: it
+//! was tried and not kept. The measurements behind these choices are in BENCHMARKS.md ("The
+//! robust mode").
 //!
 //! The stopping test is the success rule of every contact method,
 //! [`super::ContactMeasures::passes`]: the unit-consistent `scaled_error <= tol` (default
-//! 1e-8; see [`super::measures`]). The figures above were measured when the test was
-//! `error_q <= tol`; `error_q` and `error` are still reported.
+//! 1e-8; see [`super::measures`]); `error_q` and `error` are reported too.
 
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::{SparseColMat, Triplet};
 
-use super::lcp_finish::finish_2d;
+use super::lcp_finish::{finish_2d, finish_2d_whole};
 use super::nsgs::{solve_nsgs, NsgsSettings};
 use super::projection::{project_cone, tangent_norm};
 use super::{measure_into, ContactMeasures, ContactProblem, ContactSolution, ContactStatus};
@@ -520,6 +498,16 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
         }
     }
 
+    // 2D, not solved: the whole problem as one LCP (the working set of the first stall may
+    // have missed the answer's contacts, or the stall came only at the end of the budget)
+    if dim == 2 && !measures.passes(s.tol) && nc <= super::lcp_finish::MAX_CONTACTS {
+        if let Some(fin) = finish_2d_whole(problem, s.tol)? {
+            r = fin.impulse;
+            u = fin.velocity;
+            measures = fin.measures;
+            finish = Some((fin.contacts, fin.rounds, fin.pivots));
+        }
+    }
     let finished = match finish {
         Some((contacts, rounds, pivots)) => format!(
             " and the 2D LCP finish (Lemke, {pivots} pivots in {rounds} rounds on {contacts} of \
@@ -541,12 +529,15 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
             format!("the iterates became non-finite after {iterations} Newton steps"),
         )
     } else if stalled {
+        // the budget of restarts is spent: like the step budget, a limit of the method (the
+        // arithmetic did not break down), and reported as such, so that a problem stalling
+        // at step 197 in some units and stopping at step 200 in others gets one status
         (
-            ContactStatus::NumericalFailure,
+            ContactStatus::IterationLimit,
             format!(
-                "stalled after {iterations} Newton steps: no step decreases the natural-map \
-                 residual even with the proximal parameter at {eta:.1e} (scaled_error {:.2e} > \
-                 tol {:.1e})",
+                "stalled after {iterations} Newton steps and {restarts} restarts: no step \
+                 decreases the natural-map residual even with the proximal parameter at \
+                 {eta:.1e} (scaled_error {:.2e} > tol {:.1e})",
                 measures.scaled_error, s.tol
             ),
         )

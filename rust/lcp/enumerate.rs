@@ -8,6 +8,7 @@ use super::scaling::Equilibration;
 use super::small::gauss_complete;
 use super::{check_tol, passes, LcpRef, LcpSolution, LcpStatus, WarmStart};
 use crate::error::{CoulombError, Result};
+use crate::readable::Readable;
 
 /// the largest n enumeration accepts (2^15 = 32768 bases).
 pub const MAX_ENUMERATE: usize = 15;
@@ -110,8 +111,8 @@ pub fn solve_enumerate(lcp: &LcpRef<'_>, s: &EnumerateSettings) -> Result<LcpSol
                 w,
                 status: LcpStatus::NoSolution,
                 message: format!(
-                    "no complementary basis among {bases} gives a solution within tol {:.1e}",
-                    s.tol
+                    "no complementary basis among {bases} gives a solution within tol {}",
+                    Readable(s.tol)
                 ),
                 measures,
                 pivots: 0,

@@ -1,4 +1,4 @@
-//! Linear complementarity problems (the seed's "Linear complementarity problems"):
+//! Linear complementarity problems (Cottle, Pang and Stone 1992):
 //!
 //! ```text
 //!     find z  with  0 <= z  ⊥  w = M z + q >= 0,
@@ -103,7 +103,7 @@ impl WarmStart {
 /// The error measures of an answer z, always computed from the original M and q.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LcpMeasures {
-    /// `||min(z, w)||_2 / max(1, ||q||_2)` with `w = M z + q` (DESIGN.md, as Siconos reports it).
+    /// `||min(z, w)||_2 / max(1, ||q||_2)` with `w = M z + q` (as Siconos reports it).
     pub error: f64,
     /// the same test judged in each row's and column's own units:
     /// `max_i |min(z_i / s_z, w_i / s_i)|` where

@@ -11,6 +11,7 @@
 use super::scaling::Equilibration;
 use super::{check_tol, passes, LcpRef, LcpSolution, LcpStatus, WarmStart};
 use crate::error::{check_finite, CoulombError, Result};
+use crate::readable::Readable;
 
 /// Settings of [`solve_pgs`].
 #[derive(Clone, Debug)]
@@ -90,7 +91,10 @@ pub fn solve_pgs(lcp: &LcpRef<'_>, s: &PgsSettings) -> Result<LcpSolution> {
     let (status, message) = if passes(&measures, s.tol) {
         (
             LcpStatus::Solved,
-            format!("solved in {sweeps} sweeps (error {:.2e})", measures.error),
+            format!(
+                "solved in {sweeps} sweeps (error {})",
+                Readable(measures.error)
+            ),
         )
     } else if !measures.error.is_finite() {
         (
@@ -101,8 +105,10 @@ pub fn solve_pgs(lcp: &LcpRef<'_>, s: &PgsSettings) -> Result<LcpSolution> {
         (
             LcpStatus::IterationLimit,
             format!(
-                "stopped at max_iter = {} with error {:.2e} > tol {:.1e}",
-                s.max_iter, measures.error, s.tol
+                "stopped at max_iter = {} with error {} > tol {}",
+                s.max_iter,
+                Readable(measures.error),
+                Readable(s.tol)
             ),
         )
     };

@@ -10,7 +10,7 @@ use pyo3::intern;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use super::{guarded, slice1, slice2, to_py};
+use super::{guarded, settings, slice1, slice2, to_py};
 use crate::contact::assembly::{self, FreeMotion, MassFactor, Triplets};
 use crate::contact::prox::ProxSettings;
 use crate::contact::{
@@ -171,22 +171,8 @@ fn contact_solve<'py>(
         None => None,
     };
     let settings = match method {
-        "nsgs" => ContactSettings::Nsgs(NsgsSettings {
-            tol,
-            max_iter: max_iter.unwrap_or(1000),
-            relaxation,
-            initial: init,
-            order,
-        }),
-        "lemke" => {
-            let mut s = PolyhedralSettings::for_dim(dim);
-            if let Some(f) = facets {
-                s.facets = f;
-            }
-            s.lemke.tol = tol;
-            s.lemke.max_pivots = max_iter;
-            ContactSettings::Lemke(s)
-        }
+        "nsgs" => ContactSettings::Nsgs(settings::nsgs(tol, max_iter, relaxation, init, order)),
+        "lemke" => ContactSettings::Lemke(settings::lemke(dim, tol, max_iter, facets)),
         "prox" => {
             let d = ProxSettings::default();
             ContactSettings::Prox(ProxSettings {

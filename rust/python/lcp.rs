@@ -56,8 +56,8 @@ fn solution_dict<'py>(
 const LCP_DETACH_N: usize = 128;
 
 /// problems up to this size reuse one Lemke workspace per thread: for small n the
-/// workspace's allocations cost more than the pivots (at n = 3 about a quarter of a call),
-/// and at this bound it holds under 0.7 MB.
+/// workspace's allocations cost more than the pivots, and at this bound the kept workspace
+/// stays under 0.7 MB.
 const REUSED_WORKSPACE_MAX_N: usize = 256;
 
 thread_local! {
@@ -145,9 +145,8 @@ fn lcp_solve<'py>(
             ))
         }
     };
-    // Lemke's solves below n = 128 take under about 0.1 ms: releasing and re-taking the GIL
-    // would cost a noticeable share of them for no one's benefit. PGS and enumeration can
-    // run long at any size.
+    // Lemke's small solves are short: releasing and re-taking the GIL would cost a noticeable
+    // share of them for no one's benefit. PGS and enumeration can run long at any size.
     let work = match &chosen {
         Method::Lemke(_) if n < LCP_DETACH_N => 0,
         _ => n * n,

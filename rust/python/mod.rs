@@ -4,14 +4,18 @@
 //! numerics of their own.
 //!
 //! One file per area: [`lcp`] (`lcp_solve`, `lcp_measures`), [`contact`] (`contact_solve`,
-//! `contact_assemble`, `contact_post_velocity`), [`step`] (`step_simulate`), [`io`] (the
-//! Siconos readers), [`errors`] (the exception of each error kind). This file registers them
-//! and holds what they share: [`guarded`] (GIL release, Ctrl-C, panics) and array borrowing.
+//! `contact_assemble`, `contact_post_velocity`), [`step`] (`step_simulate`), [`model`]
+//! (`model_simulate`), [`io`] (the Siconos readers), [`errors`] (the exception of each error
+//! kind), [`settings`] (the contact solvers' settings, built once for `contact`, `step` and
+//! `model`). This file registers them and holds what they share: [`guarded`] (GIL release,
+//! Ctrl-C, panics) and array borrowing.
 
 mod contact;
 mod errors;
 mod io;
 mod lcp;
+mod model;
+mod settings;
 mod step;
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -145,6 +149,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     io::register(m)?;
     m.add_function(wrap_pyfunction!(simd_level, m)?)?;
     step::register(m)?;
+    model::register(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

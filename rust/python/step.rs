@@ -8,12 +8,12 @@ use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString};
 
-use super::{guarded, to_py};
-use crate::contact::{NsgsSettings, PolyhedralSettings};
+use super::{guarded, settings, to_py};
+use crate::contact::ContactOrder;
 use crate::error::CoulombError;
 use crate::step::{
     simulate_recorded, Body, BodyKind, Drift, HalfSpace, Pair, Restitution, Scene, Shape,
-    StepSettings, StepSolver,
+    StepSettings, StepSolver, Trajectory,
 };
 
 fn item<'py, T: FromPyObjectOwned<'py>>(d: &Bound<'py, PyDict>, key: &str) -> PyResult<T> {
@@ -134,17 +134,11 @@ fn matrix<'py, T: numpy::Element>(
         .into_any())
 }
 
-/// Simulates a scene (a dict of plain lists, see `coulomb.model.Scene`) for `steps` steps of
-/// size `h`; returns the trajectory as a dict of arrays.
-#[pyfunction]
-#[pyo3(signature = (scene, h, steps, solver="nsgs", tol=1e-12, max_iter=None, relaxation=1.0,
-                    facets=None, gap_tolerance=1e-9, warm_start=true, fallback=true,
-                    drift="none", drift_bias=0.2, restitution="newton", record_every=1,
-                    locate_impacts=false))]
+/// The step settings from the options of `step_simulate` and `model_simulate`.
 #[allow(clippy::too_many_arguments)]
-pub(super) fn step_simulate<'py>(
-    py: Python<'py>,
-    scene: &Bound<'py, PyDict>,
+pub(super) fn settings_from(
+    py: Python<'_>,
+    dim: usize,
     h: f64,
     steps: usize,
     solver: &str,
@@ -158,27 +152,17 @@ pub(super) fn step_simulate<'py>(
     drift: &str,
     drift_bias: f64,
     restitution: &str,
-    record_every: usize,
     locate_impacts: bool,
-) -> PyResult<Bound<'py, PyDict>> {
-    let scene = scene_from_dict(scene)?;
+) -> PyResult<StepSettings> {
     let solver = match solver {
-        "nsgs" => StepSolver::Nsgs(NsgsSettings {
+        "nsgs" => StepSolver::Nsgs(settings::nsgs(
             tol,
-            max_iter: max_iter.unwrap_or(1000),
+            max_iter,
             relaxation,
-            initial: None,
-            order: crate::contact::ContactOrder::Forward,
-        }),
-        "lemke" => {
-            let mut s = PolyhedralSettings::for_dim(scene.dim);
-            if let Some(f) = facets {
-                s.facets = f;
-            }
-            s.lemke.tol = tol;
-            s.lemke.max_pivots = max_iter;
-            StepSolver::Lemke(s)
-        }
+            None,
+            ContactOrder::Forward,
+        )),
+        "lemke" => StepSolver::Lemke(settings::lemke(dim, tol, max_iter, facets)),
         other => {
             return Err(to_py(
                 py,
@@ -214,7 +198,7 @@ pub(super) fn step_simulate<'py>(
             ))
         }
     };
-    let settings = StepSettings {
+    Ok(StepSettings {
         h,
         steps,
         solver,
@@ -224,12 +208,15 @@ pub(super) fn step_simulate<'py>(
         drift,
         restitution,
         locate_impacts,
-    };
-    let (tr, seconds) = guarded(py, usize::MAX, || {
-        let start = std::time::Instant::now();
-        let tr = simulate_recorded(&scene, &settings, record_every)?;
-        Ok((tr, start.elapsed().as_secs_f64()))
-    })?;
+    })
+}
+
+/// A trajectory as the dict of arrays `coulomb.trajectory.Trajectory` is made from.
+pub(super) fn trajectory_dict<'py>(
+    py: Python<'py>,
+    tr: Trajectory,
+    seconds: f64,
+) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     let n = tr.t.len();
     let dim = tr.dim;
@@ -342,6 +329,60 @@ pub(super) fn step_simulate<'py>(
     d.set_item("stopped", tr.stopped)?;
     d.set_item("solve_time", seconds)?;
     Ok(d)
+}
+
+/// Simulates a scene (a dict of plain lists, see `coulomb.model.Scene`) for `steps` steps of
+/// size `h`; returns the trajectory as a dict of arrays.
+#[pyfunction]
+#[pyo3(signature = (scene, h, steps, solver="nsgs", tol=1e-12, max_iter=None, relaxation=1.0,
+                    facets=None, gap_tolerance=1e-9, warm_start=true, fallback=true,
+                    drift="none", drift_bias=0.2, restitution="newton", record_every=1,
+                    locate_impacts=false))]
+#[allow(clippy::too_many_arguments)]
+pub(super) fn step_simulate<'py>(
+    py: Python<'py>,
+    scene: &Bound<'py, PyDict>,
+    h: f64,
+    steps: usize,
+    solver: &str,
+    tol: f64,
+    max_iter: Option<usize>,
+    relaxation: f64,
+    facets: Option<usize>,
+    gap_tolerance: f64,
+    warm_start: bool,
+    fallback: bool,
+    drift: &str,
+    drift_bias: f64,
+    restitution: &str,
+    record_every: usize,
+    locate_impacts: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let scene = scene_from_dict(scene)?;
+    let settings = settings_from(
+        py,
+        scene.dim,
+        h,
+        steps,
+        solver,
+        tol,
+        max_iter,
+        relaxation,
+        facets,
+        gap_tolerance,
+        warm_start,
+        fallback,
+        drift,
+        drift_bias,
+        restitution,
+        locate_impacts,
+    )?;
+    let (tr, seconds) = guarded(py, usize::MAX, || {
+        let start = std::time::Instant::now();
+        let tr = simulate_recorded(&scene, &settings, record_every)?;
+        Ok((tr, start.elapsed().as_secs_f64()))
+    })?;
+    trajectory_dict(py, tr, seconds)
 }
 
 /// registers the stepper's functions in `coulomb._core`.

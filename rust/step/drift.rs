@@ -1,8 +1,8 @@
 //! The post-step projection of [`Drift::Projection`](super::super::Drift::Projection).
 //!
-//! A velocity-level step does not enforce `g(q_{k+1}) >= 0` (seed, "Position drift and
-//! restitution"); the projection moves the positions (velocities untouched) by the M-smallest
-//! displacement that closes the linearised gaps,
+//! A velocity-level step does not enforce `g(q_{k+1}) >= 0` (Stewart 2000 discusses the drift
+//! of velocity-level schemes); the projection moves the positions (velocities untouched) by
+//! the M-smallest displacement that closes the linearised gaps,
 //!
 //! ```text
 //!     Δq = M^{-1} J_n^T λ,    0 <= λ  ⊥  J_n M^{-1} J_n^T λ + g >= 0,
@@ -11,7 +11,7 @@
 //! over every candidate contact near enough to be reached (not only the penetrating ones: a
 //! ball pushed out of the one below must not be pushed into the one above), repeated while the
 //! true gaps still penetrate (the gaps are not linear in q). It is checked for its effect on
-//! constraints and energy, as the seed asks, and kept only where it helps:
+//! constraints and energy, and kept only where it helps:
 //!
 //! - it never deepens the worst penetration over the candidates;
 //! - it never raises the energy above the larger of the step's starting energy and the

@@ -7,7 +7,7 @@
 use super::super::poisson::{restitution_with_friction, routh};
 use super::solve::{solve_step_problem, step_problem, SolveBuffers, SPARSE_FROM};
 use super::{dot6, dot_v, Active, Drift, Restitution, StepRecord, StepSettings, Stepper};
-use crate::contact::{BlockCsr, ContactProblem, Delassus};
+use crate::contact::{ContactProblem, Delassus};
 use crate::error::Result;
 
 impl Stepper {
@@ -23,13 +23,7 @@ impl Stepper {
         // W's storage: dense for few contacts, block CSR for many
         let w_sparse = if nc >= SPARSE_FROM {
             // every contact's diagonal block is present (a contact touches a body)
-            Some(BlockCsr::from_coo(
-                dim,
-                n,
-                &self.coo_rows,
-                &self.coo_cols,
-                &self.coo_vals,
-            )?)
+            Some(self.delassus.block_csr()?)
         } else {
             None
         };
@@ -46,7 +40,13 @@ impl Stepper {
         let mut p_impact = std::mem::take(&mut self.p_impact);
         p_impact.clear();
         if self.poisson_impact {
-            let problem = step_problem(dim, &self.w, w_sparse.as_ref(), &self.q1, &self.mu)?;
+            let problem = step_problem(
+                dim,
+                self.delassus.dense(),
+                w_sparse.as_ref(),
+                &self.q1,
+                &self.mu,
+            )?;
             let mut restitution = std::mem::take(&mut self.restitution);
             restitution.clear();
             restitution.extend(self.active.iter().map(|a| self.candidates[a.cand].e));
@@ -73,7 +73,13 @@ impl Stepper {
             }
             self.solve.velocity = wp;
         }
-        let problem = step_problem(dim, &self.w, w_sparse.as_ref(), &self.qc, &self.mu)?;
+        let problem = step_problem(
+            dim,
+            self.delassus.dense(),
+            w_sparse.as_ref(),
+            &self.qc,
+            &self.mu,
+        )?;
         let out = solve_step_problem(
             &self.settings,
             &problem,
@@ -109,65 +115,23 @@ impl Stepper {
         self.contact_terms(record);
     }
 
-    /// W over the active contacts (see [`Stepper::assemble`]).
+    /// W over the active contacts (see [`Stepper::assemble`]) by the one assembly
+    /// ([`crate::contact::assembly::WAssembly`]): each body is a block, each side of a
+    /// contact its G columns and `M_b^{-1}` times them.
     fn assemble_w(&mut self) {
-        let dim = self.dim;
         let nc = self.active.len();
-        let n = nc * dim;
-        let sparse = nc >= SPARSE_FROM;
-        self.w.clear();
-        if !sparse {
-            self.w.resize(n * n, 0.0);
-        }
-        self.coo_rows.clear();
-        self.coo_cols.clear();
-        self.coo_vals.clear();
-        for list in &mut self.incidence {
-            list.clear();
-        }
-        for (i, a) in self.active.iter().enumerate() {
+        let active = &self.active;
+        let w = &mut self.delassus;
+        w.begin(self.bodies.len());
+        for (i, a) in active.iter().enumerate() {
             for (k, side) in a.sides[..a.nsides].iter().enumerate() {
-                self.incidence[side.body].push((i, k));
+                w.side(i, k, side.body);
             }
         }
-        for list in &self.incidence {
-            for (p, &(i, ki)) in list.iter().enumerate() {
-                let si = &self.active[i].sides[ki];
-                for &(j, kj) in &list[p..] {
-                    let sj = &self.active[j].sides[kj];
-                    let mut blk = [[0.0; 3]; 3];
-                    for al in 0..dim {
-                        for be in 0..dim {
-                            blk[al][be] = dot6(&si.g[al], &sj.b[be]);
-                        }
-                    }
-                    let mirror = i != j;
-                    if sparse {
-                        for al in 0..dim {
-                            for be in 0..dim {
-                                self.coo_rows.push(i * dim + al);
-                                self.coo_cols.push(j * dim + be);
-                                self.coo_vals.push(blk[al][be]);
-                                if mirror {
-                                    self.coo_rows.push(j * dim + be);
-                                    self.coo_cols.push(i * dim + al);
-                                    self.coo_vals.push(blk[al][be]);
-                                }
-                            }
-                        }
-                    } else {
-                        for al in 0..dim {
-                            for be in 0..dim {
-                                self.w[(i * dim + al) * n + j * dim + be] += blk[al][be];
-                                if mirror {
-                                    self.w[(j * dim + be) * n + i * dim + al] += blk[al][be];
-                                }
-                            }
-                        }
-                    }
-                }
-            }
-        }
+        let dim = self.dim;
+        w.assemble(dim, nc, nc >= SPARSE_FROM, |i, j| {
+            side_product(dim, active, i, j)
+        });
     }
 
     /// `q_c = G^T v_free` plus each contact's restitution, bias or gap term, `q_1 = G^T v_k`
@@ -228,6 +192,24 @@ impl Stepper {
             self.qc[i * dim] += bound;
         }
     }
+}
+
+/// `G_{i,b}^T M_b^{-1} G_{j,b}` of side ki of contact i and side kj of contact j (same body).
+#[inline(always)]
+fn side_product(
+    dim: usize,
+    active: &[Active],
+    (i, ki): (usize, usize),
+    (j, kj): (usize, usize),
+) -> [[f64; 3]; 3] {
+    let (si, sj) = (&active[i].sides[ki], &active[j].sides[kj]);
+    let mut blk = [[0.0; 3]; 3];
+    for al in 0..dim {
+        for be in 0..dim {
+            blk[al][be] = dot6(&si.g[al], &sj.b[be]);
+        }
+    }
+    blk
 }
 
 /// What Poisson's impact phase reads.

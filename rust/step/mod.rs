@@ -1,4 +1,4 @@
-//! The impulse time stepper (DESIGN.md, part 3): the seed's "One impulse-based time step".
+//! The impulse time stepper of Stewart and Trinkle (1996), as surveyed in Stewart (2000).
 //!
 //! Per step, with M and the contact Jacobians frozen at `q_k`:
 //!
@@ -25,8 +25,8 @@
 //!   impact fell. With no force acting during the step this is exact; under gravity the
 //!   approach is the velocity at the start of the landing step, so with e = 1 each bounce
 //!   loses `m g y_k` (y_k the height at that start, at most `m g h |v_n^-|`: first order);
-//! - a contact that is far (neither of the above) carries no unknowns (seed: "A contact
-//!   search must first identify closed or imminently closing contacts").
+//! - a contact that is far (neither of the above) carries no unknowns (the impact condition
+//!   applied to distant bodies would give premature impulses; Stewart 2000).
 //!
 //! [`Restitution::Poisson`] replaces Newton's condition by an impact phase on `v_k`
 //! (compression, then the normal impulse `e P_comp`, Coulomb friction active in both phases:
@@ -58,8 +58,8 @@
 //! by one or found each step by the broad phase ([`Pair::Spheres`], a uniform grid over the
 //! spheres, O(N) per step: [`broad`]).
 //!
-//! Drift: a velocity-level condition does not enforce `g(q_{k+1}) >= 0` exactly (seed,
-//! "Position drift and restitution"). Gaps are monitored in every step's record, and
+//! Drift: a velocity-level condition does not enforce `g(q_{k+1}) >= 0` exactly
+//! (Stewart 2000). Gaps are monitored in every step's record, and
 //! [`Drift`] chooses a correction: none (the default), a velocity bias, or a post-step
 //! projection onto `g >= 0`.
 
@@ -68,6 +68,9 @@ mod impact;
 mod poisson;
 mod stepper;
 
+pub use stepper::generalized::{
+    simulate_generalized, GeneralizedStepper, GeneralizedSystem, GeneralizedTrajectory,
+};
 pub use stepper::{simulate, simulate_recorded, ContactRecord, StepRecord, Stepper, Trajectory};
 
 use crate::contact::{NsgsSettings, PolyhedralSettings};
@@ -399,9 +402,8 @@ pub enum StepSolver {
     Lemke(PolyhedralSettings),
 }
 
-/// The position-drift correction (seed: "Monitor the gap and use an appropriate correction";
-/// "Position projection should be documented and checked for its effect on constraints and
-/// energy").
+/// The position-drift correction: gaps are monitored every step, and a projection is checked
+/// for its effect on the constraints and the energy (see `drift`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Drift {
     /// none: closed contacts keep whatever penetration the linearised update leaves.
@@ -434,16 +436,16 @@ pub enum Drift {
 /// The impact law at closed contacts.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Restitution {
-    /// Newton's: `0 <= P_n ⊥ J_n v_{k+1} + e v_n^- >= 0` (the seed's velocity-level
-    /// condition).
+    /// Newton's: `0 <= P_n ⊥ J_n v_{k+1} + e v_n^- >= 0` (the velocity-level
+    /// impact condition of Stewart 2000).
     Newton,
     /// Poisson's: an impact phase on `v_k` alone, compression until the normal velocity
     /// stops (`P_comp`), then the normal restitution impulse `P_rest = e P_comp` (each pair's
     /// `e` as `e_P`), Coulomb friction active in both phases: Routh's integration in impulse
     /// space when one contact impacts alone, the phases solved as wholes for coupled contacts
     /// (see the module `poisson`); the step's smooth phase is then inelastic. For a single
-    /// frictionless impact it agrees with Newton's law (seed); for one frictional contact it
-    /// never gains energy (Glocker, Multibody Syst. Dyn. 2013).
+    /// frictionless impact it agrees with Newton's law; for one frictional contact it never
+    /// gains energy (Glocker, Multibody Syst. Dyn. 2013).
     Poisson,
 }
 

@@ -2,7 +2,7 @@
 //!
 //! Poisson's hypothesis splits the normal impulse of an impact into compression, which ends
 //! when the contact's normal velocity reaches zero (`P_n^c`), and restitution, which adds
-//! `e P_n^c` (seed, "Poisson's compression and restitution phases"). Friction acts in both:
+//! `e P_n^c` (Glocker 2013). Friction acts in both:
 //!
 //! - **one contact** (no other contact of the impact shares its bodies): Routh's method, the
 //!   impact integrated in impulse space with the normal impulse `P_n` as the independent

@@ -1,14 +1,15 @@
 //! The record stage: [`simulate`] and [`simulate_recorded`] run a [`Stepper`] and keep its
-//! states, the checks of every step ([`StepRecord`], the seed's "Time-step accuracy and
-//! validation" list) and the impulse of every active contact ([`ContactRecord`]) in a
-//! [`Trajectory`], folding the records of unrecorded steps into the next recorded one.
+//! states, the checks of every step ([`StepRecord`]: momentum balance, gaps, normal impulses,
+//! friction cone, complementarity, energy) and the impulse of every active contact
+//! ([`ContactRecord`]) in a [`Trajectory`], folding the records of unrecorded steps into the
+//! next recorded one.
 
 use super::Stepper;
 use crate::contact::ContactStatus;
 use crate::error::Result;
 use crate::step::{Scene, StepSettings};
 
-/// The checks of one step k -> k+1 (the seed's "Time-step accuracy and validation" list).
+/// The checks of one step k -> k+1: momentum balance, gaps, cone, complementarity, energy.
 #[derive(Clone, Debug)]
 pub struct StepRecord {
     /// active contacts (closed or imminently closing) that carried unknowns.

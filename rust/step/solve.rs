@@ -29,7 +29,7 @@ pub(super) const NSGS_BUDGET: usize = 100;
 /// towards [`POLISH_TOL`] times its tolerance, and its answer stands if within the tolerance.
 /// The residual velocity a step leaves (up to tol) builds up in the next steps' problems; an
 /// answer well inside the tolerance lets the following steps reuse it as it is for longer
-/// (callgrind, 3000 steps: ramp 107M -> 76M instructions, resting box 99M -> 77M).
+/// (the instruction counts this saves are in BENCHMARKS.md).
 pub(super) const POLISH_NEAR: f64 = 1e3;
 /// see [`POLISH_NEAR`].
 pub(super) const POLISH_SWEEPS: usize = 2;

@@ -13,6 +13,8 @@ mod bodies;
 mod drift;
 #[path = "event.rs"]
 mod event;
+#[path = "generalized.rs"]
+pub mod generalized;
 #[path = "law.rs"]
 mod law;
 #[path = "narrow.rs"]
@@ -34,6 +36,7 @@ use super::poisson::routh;
 use super::{
     BodyKind, Drift, Pair, PolyhedralSettings, Restitution, Scene, StepSettings, StepSolver,
 };
+use crate::contact::assembly::WAssembly;
 use crate::error::Result;
 
 /// below this a norm counts as zero when forming a relative residual.
@@ -104,17 +107,14 @@ pub struct Stepper {
     frozen: Vec<Frozen>,
     v_free: Vec<f64>,
     active: Vec<Active>,
-    w: Vec<f64>,
-    incidence: Vec<Vec<(usize, usize)>>,
+    /// the assembly of W (dense, or COO triplets for block CSR), kept from step to step.
+    delassus: WAssembly,
     /// the step index whose state `prepare` has done (M, v_free, speed bounds, pairs,
     /// geometry), so the record of a state and the step from it share that work.
     prepared: Option<usize>,
     /// every candidate's geometry at the prepared state.
     geo_cache: Vec<Geometry>,
     speed_bounds: Vec<[f64; 2]>,
-    coo_rows: Vec<usize>,
-    coo_cols: Vec<usize>,
-    coo_vals: Vec<f64>,
     qc: Vec<f64>,
     q1: Vec<f64>,
     mu: Vec<f64>,
@@ -181,14 +181,10 @@ impl Stepper {
             v,
             step_index: 0,
             active: Vec::with_capacity(nc),
-            w: Vec::new(),
-            incidence: vec![Vec::new(); scene.bodies.len()],
+            delassus: WAssembly::new(),
             prepared: None,
             geo_cache: Vec::new(),
             speed_bounds: vec![[0.0; 2]; scene.bodies.len()],
-            coo_rows: Vec::new(),
-            coo_cols: Vec::new(),
-            coo_vals: Vec::new(),
             qc: Vec::new(),
             q1: Vec::new(),
             mu: Vec::new(),
@@ -275,7 +271,7 @@ impl Stepper {
         }
     }
 
-    /// The seed's "One impulse-based time step", from `(t_k, q_k, v_k)` to
+    /// One impulse time step (Stewart and Trinkle 1996), from `(t_k, q_k, v_k)` to
     /// `(t_{k+1}, q_{k+1}, v_{k+1})`; appends the active contacts to `contacts` and returns the
     /// step's checks. Errors only for settings the contact solver refuses.
     ///
@@ -323,10 +319,10 @@ impl Stepper {
         Ok(record)
     }
 
-    /// The contact search (seed: "A contact search must first identify closed or imminently
-    /// closing contacts"): every candidate closed (`g <= gap_tolerance`), owed a rebound, or
-    /// open but closing within the step by its speed bound becomes an active contact with its
-    /// G and `M^{-1} G` columns; the others forget their state.
+    /// The contact search, which must find the closed and the imminently closing contacts
+    /// before the solve (Stewart 2000): every candidate closed (`g <= gap_tolerance`), owed a
+    /// rebound, or open but closing within the step by its speed bound becomes an active
+    /// contact with its G and `M^{-1} G` columns; the others forget their state.
     fn search_contacts(&mut self) {
         let h = self.settings.h;
         let tol_gap = self.settings.gap_tolerance;

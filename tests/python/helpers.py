@@ -225,7 +225,9 @@ def contact_scaled_error(W: Array, q: Array, mu: Array, dim: int, r: Array) -> f
     recomputed here in numpy for isotropic friction: with ``rho_i = 1 / W_nn,i`` (the mean
     positive ``W_nn`` for a contact whose own is not positive or below 1e-12 times it), the
     worst contact's larger of De Saxce's and Alart-Curnier's natural maps in impulse units,
-    relative to ``max(||r_i||, rho_i ||(|W| |r| + |q|)_i||)``."""
+    relative to ``max(||r_i||, rho_i ||(|W| |r| + |q|)_i||)``; in De Saxce's map the slip
+    ``s = ||u_t||`` counts above its rounding ``f = (n + 3) eps ||(|W| |r| + |q|)_t||``, as
+    ``s - f^2 / s`` (0 below f)."""
     r = np.asarray(r, dtype=float).reshape(-1)
     q = np.asarray(q, dtype=float)
     W = np.asarray(W, dtype=float)
@@ -245,7 +247,9 @@ def contact_scaled_error(W: Array, q: Array, mu: Array, dim: int, r: Array) -> f
         s = slice(i * dim, (i + 1) * dim)
         ri, su = r[s], rho[i] * u[s]
         v = ri - su
-        v[0] -= m * np.linalg.norm(su[1:])
+        floor = (r.size + 3) * np.finfo(float).eps * np.linalg.norm(terms[s][1:])
+        slip = float(np.linalg.norm(u[s][1:]))
+        v[0] -= m * rho[i] * (0.0 if slip <= floor else slip - floor * (floor / slip))
         ds = ri - project_coulomb_cone(v, float(m))
         x = ri[1:] - su[1:]
         radius = m * max(ri[0], 0.0)

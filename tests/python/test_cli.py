@@ -1,4 +1,4 @@
-"""The ``coulomb`` command line: ``validate`` reproduces the seed's figures, ``solve-lcp``
+"""The ``coulomb`` command line: ``validate`` reproduces the chapter's figures, ``solve-lcp``
 solves a file."""
 
 from __future__ import annotations
@@ -113,7 +113,7 @@ def test_solve_lcp_own_file(tmp_path):
 
 def test_solve_lcp_without_solution_exits_2(tmp_path):
     path = tmp_path / "lcp_none.dat"
-    path.write_text("1\n0\n1\n1\n1 1\n-1\n-1\n")  # the seed's w = -z - 1
+    path.write_text("1\n0\n1\n1\n1 1\n-1\n-1\n")  # the chapter's w = -z - 1
     p = run(["solve-lcp", str(path)], tmp_path)
     assert p.returncode == 2
     assert "Status.RAY_TERMINATION" in p.stdout

@@ -50,16 +50,25 @@ def test_every_success_satisfies_the_law(seed, dim, planted, ka, kb, method):
 def test_status_is_invariant_under_units(seed, dim, ka, kb, method):
     # Planted problems (a solution exists) with mu up to 10. Beyond, a problem is conditioned
     # like mu, and on problems without a solution an iterative method's path is chaotic: a
-    # verdict near the tolerance may then flip with the rounding of the scaled data (counted
-    # by the campaign, docs/properties.md), never into a false success.
-    # The robust mode in 3D is excluded: its stall detection and restarts make its path
-    # sensitive to rounding on singular W (3 status changes in 200 such problems,
-    # docs/properties.md); its successes are still checked above.
+    # verdict near the tolerance may then flip with the rounding of the scaled data (bounded
+    # by the campaign test below, counted in docs/properties.md), never into a false success.
+    # The robust mode in 3D is excluded here: on singular W its Newton path may converge late
+    # in its budget (campaign seed 2481: solved in 111 steps in some units, 2.5e-5 at 200 in
+    # others; 1 in 581 in the long campaign, which bounds it); its successes are checked above.
     if method == "prox" and dim == 3:
         return
     base = generate(seed, dim, True, mu_choices=MODERATE_MU)
     other = generate(seed, dim, True, ka, kb, mu_choices=MODERATE_MU)
     r, s = solve(base, method), solve(other, method)
+    if method != "lemke" and r.status != s.status:
+        # an iterative method converging at the edge of its budget (NSGS on singular W,
+        # campaign seed 1345: solved in 1926 sweeps in some units, 2.6e-8 after 2000 in
+        # others): the other run stopped at the limit, this one used most of it
+        done, stopped = (r, s) if r.success else (s, r)
+        budget = 2000 if method == "nsgs" else 200
+        assert done.success and stopped.status == "iteration_limit", (r.message, s.message)
+        assert done.iterations >= 0.75 * budget, (r.message, s.message)
+        return
     assert (r.success, r.status) == (s.success, s.status), (r.message, s.message)
     unique = np.linalg.cond(base.W) < 1e6 and base.mu.max() <= 0.5
     if r.success and unique:
@@ -86,9 +95,12 @@ def test_campaign_has_no_false_success_and_solves_planted_problems():
     counts = campaign(300 if LONG else 30)
     for method, c in counts.items():
         assert c.false_successes == 0, (method, c)
-        # planted, mu up to 10: one in 100 at most (long campaign: 1, 2 and 1 in 581, see
-        # docs/properties.md; the robust mode's 3D path is sensitive to rounding)
-        assert c.status_changes <= 1 + 0.01 * (c.cases - c.hard_cases), (method, c)
+        # planted, mu up to 10: one in 200 at most (long campaign: 1, 1 and 0 in 581, see
+        # docs/properties.md: an iterative method converging at the edge of its budget)
+        assert c.status_changes <= 1 + 0.005 * (c.cases - c.hard_cases), (method, c)
+        # mu up to 1e12 or no solution planted: 3 in 100 at most (long campaign: 6, 35 and
+        # 23 in 2419)
+        assert c.hard_status_changes <= 1 + 0.03 * c.hard_cases, (method, c)
     # planted problems (a solution exists) with mu up to 10: Lemke's pivoting (exact in 2D)
     # and the robust mode solve them (long campaign: 99.5% and 98%, docs/properties.md); with
     # mu up to 1e12 as well, 91% and 82%; NSGS may stall on singular W

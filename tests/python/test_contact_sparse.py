@@ -404,7 +404,7 @@ def test_one_contact_answer_is_the_ellipse_projection(qt, m1, m2, qn, mass):
 
 @pytest.mark.parametrize("order", ["forward", "backward", "symmetric", "custom"])
 def test_sweep_orders_reach_the_same_answer(order):
-    from coulomb.study import _stack_problem
+    from coulomb._presets import _stack_problem
 
     W, q = _stack_problem(10, 3)
     ref = contact.solve(W, q, 0.5, tol=1e-13, max_iter=100_000)

@@ -118,6 +118,7 @@ def test_input_error_classes_are_distinct():
         errors.InvalidParameterError,
         errors.ProblemTooLargeError,
         errors.ProblemFormatError,
+        errors.SettingsConflictError,
     ],
 )
 def test_error_hierarchy(cls):
@@ -138,6 +139,7 @@ def test_internal_error_is_a_coulomb_error():
         "NonFiniteError",
         "ProblemFormatError",
         "ProblemTooLargeError",
+        "SettingsConflictError",
         "ShapeError",
     }
 
@@ -257,3 +259,16 @@ def test_check_refuses_a_z_of_the_wrong_length_or_with_nan(n):
         lcp.check(M, q, nan_at(np.ones(n), n - 1))
     # the right length gives the measures of z = 1: w = 0, an exact solution
     assert lcp.check(M, q, np.ones(n)).error == 0.0
+
+
+@pytest.mark.parametrize(("M", "q", "word"), [
+    (np.eye(3), np.ones(2), "q"),          # q does not match M
+    (np.ones((2, 3)), np.ones(2), "M"),    # M not square
+    (np.eye(2), np.ones(3), "q"),
+])
+def test_lcp_shapes_that_do_not_fit_are_refused_by_the_core(M, q, word):
+    # the Python wrapper leaves this check to the core, which makes it before any work
+    with pytest.raises(errors.ShapeError, match=word):
+        lcp.solve(M, q)
+    with pytest.raises(errors.ShapeError, match=word):
+        lcp.solve(M, q, "pgs")

@@ -20,22 +20,22 @@ def sliding_ball(mu: float = 0.2) -> coulomb.Scene:
 def test_every_kth_state_of_the_full_run_is_kept(k):
     full = sliding_ball().simulate(2.0, 1e-3)
     part = sliding_ball().simulate(2.0, 1e-3, record_every=k)
-    n = len(full["t"]) - 1
+    n = len(full.t) - 1
     kept = [s for s in range(1, n + 1) if s % k == 0 or s == n]
-    assert part["record_every"] == k
-    assert len(part["t"]) == len(kept) + 1
-    np.testing.assert_array_equal(part["t"][1:], full["t"][kept])
-    np.testing.assert_array_equal(part["q"], full["q"][[0, *kept]])
-    np.testing.assert_array_equal(part["v"], full["v"][[0, *kept]])
+    assert part.record_every == k
+    assert len(part.t) == len(kept) + 1
+    np.testing.assert_array_equal(part.t[1:], full.t[kept])
+    np.testing.assert_array_equal(part.q, full.q[[0, *kept]])
+    np.testing.assert_array_equal(part.v, full.v[[0, *kept]])
     # the checks of a kept step: the worst over the steps it stands for
     starts = [0, *kept[:-1]]
     for row, (a, b) in enumerate(zip(starts, kept, strict=True)):
-        assert part["momentum_residual"][row] == full["momentum_residual"][a:b].max()
-        assert part["cone_violation"][row] == full["cone_violation"][a:b].max()
-        assert part["min_normal_impulse"][row] == full["min_normal_impulse"][a:b].min()
-        assert part["active"][row] == full["active"][a:b].max()
+        assert part.momentum_residual[row] == full.momentum_residual[a:b].max()
+        assert part.cone_violation[row] == full.cone_violation[a:b].max()
+        assert part.min_normal_impulse[row] == full.min_normal_impulse[a:b].min()
+        assert part.active[row] == full.active[a:b].max()
     # contact records of the kept steps only, indexed by row
-    assert np.all(part["contact_step"] < len(kept))
+    assert np.all(part.contact_step < len(kept))
     assert part.check().ok == full.check().ok
 
 
@@ -51,12 +51,12 @@ def test_a_failed_step_is_never_lost():
     # two coupled corners, one NSGS sweep and no fallback: some solves miss the tolerance
     kw = {"max_iter": 1, "fallback": False, "tol": 1e-14}
     full = landing_box().simulate(1.0, 1e-3, **kw)
-    failed = np.array([s not in ("solved", "no_contact") for s in full["solver_status"]])
+    failed = np.array([s not in ("solved", "no_contact") for s in full.solver_status])
     assert failed.any() and not failed.all()
     part = landing_box().simulate(1.0, 1e-3, record_every=50, **kw)
     windows = failed.reshape(-1, 50).any(axis=1)
-    kept_failed = np.array([s not in ("solved", "no_contact") for s in part["solver_status"]])
+    kept_failed = np.array([s not in ("solved", "no_contact") for s in part.solver_status])
     np.testing.assert_array_equal(kept_failed, windows)
-    assert not part["success"] and not full["success"]
-    np.testing.assert_array_equal(part["solver_error"],
-                                  full["solver_error"].reshape(-1, 50).max(axis=1))
+    assert not part.success and not full.success
+    np.testing.assert_array_equal(part.solver_error,
+                                  full.solver_error.reshape(-1, 50).max(axis=1))

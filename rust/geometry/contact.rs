@@ -1,0 +1,328 @@
+//! Contact manifolds between two shapes at given poses (parry's narrow phase, converted at this
+//! one boundary).
+//!
+//! For shapes a, b at poses `q_a`, `q_b`, every returned point has
+//!
+//! ```text
+//!     n unit (world frame, from a to b),   g = (q_b p_b - q_a p_a) · n <= prediction,
+//! ```
+//!
+//! the witness points `p_a`, `p_b` in the bodies' frames (in a compound's frame, not its
+//! part's). `g < 0` is an overlap of depth `-g` (Stewart 2000, §2: the gap function).
+//!
+//! parry updates a manifold incrementally when the relative motion since the last call is
+//! small (it re-projects the old points with absolute thresholds of 1e-3 length and 1 degree).
+//! That update is neither exact nor scale invariant, so here every call recomputes the points
+//! from the geometry: the cache keeps only parry's manifold buffers (and the last normal, which
+//! seeds GJK) and the workspace of composite shapes, so a steady call allocates nothing.
+//!
+//! parry's GJK and EPA use absolute tolerances (a squared distance below about 1e-14 counts as
+//! an overlap): between shapes of size 1e-4 touching within 1e-15, parry found no contact at
+//! all. Each pair's query is therefore made in the unit `2^k` nearest the smaller shape's size
+//! (shapes scaled once per pair and kept in the cache; a power of two scales exactly), which
+//! makes the answer scale equivariant up to the rounding of the data.
+//!
+//! In 3D parry appends GJK's closest pair, with unknown features, to the clipped polygon
+//! points; it lies among them, so it is dropped unless it is deeper than all of them (a
+//! redundant point would make the contact Delassus matrix singular).
+//!
+//! Allocation: a warm query between separated shapes allocates nothing; a touching one still
+//! allocates inside parry (its half-space manifold replaces the point buffer, its polygon
+//! clipping and its mesh and heightfield traversals use temporary vectors), a few
+//! allocations per query to a few tens for meshes and heightfields.
+
+use nalgebra::{Isometry2, Isometry3, Point2, Point3, Vector2, Vector3};
+use parry2d_f64::query::{
+    ContactManifold as Manifold2, ContactManifoldsWorkspace as Workspace2,
+    DefaultQueryDispatcher as Dispatcher2, PersistentQueryDispatcher as _,
+    TrackedContact as Tracked2,
+};
+use parry3d_f64::query::{
+    ContactManifold as Manifold3, ContactManifoldsWorkspace as Workspace3,
+    DefaultQueryDispatcher as Dispatcher3, PersistentQueryDispatcher as _,
+    TrackedContact as Tracked3,
+};
+
+use parry2d_f64::shape::Shape as Parry2;
+use parry3d_f64::shape::Shape as Parry3;
+
+use super::shape2::{check_pose2, Shape2};
+use super::shape3::{check_pose3, Shape3};
+use crate::error::{CoulombError, Result};
+
+/// Which features touch: the parts of a and b (index of a compound's part, of a mesh's or a
+/// heightfield's triangle; 0 for a simple shape) and parry's packed feature ids on them
+/// (vertex, edge or face, with its index). Equal ids across steps mean the same contact.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct ContactId {
+    pub part_a: u32,
+    pub part_b: u32,
+    pub feature_a: u32,
+    pub feature_b: u32,
+}
+
+/// One contact point in 3D.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactPoint3 {
+    /// unit normal from a to b, world frame.
+    pub normal: Vector3<f64>,
+    /// signed gap along `normal` (negative: overlap).
+    pub gap: f64,
+    /// witness point on a, in a's body frame.
+    pub point_a: Point3<f64>,
+    /// witness point on b, in b's body frame.
+    pub point_b: Point3<f64>,
+    pub id: ContactId,
+}
+
+/// One contact point in 2D.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactPoint2 {
+    /// unit normal from a to b, world frame.
+    pub normal: Vector2<f64>,
+    /// signed gap along `normal` (negative: overlap).
+    pub gap: f64,
+    /// witness point on a, in a's body frame.
+    pub point_a: Point2<f64>,
+    /// witness point on b, in b's body frame.
+    pub point_b: Point2<f64>,
+    pub id: ContactId,
+}
+
+/// The buffers of one pair of shapes in 3D, kept from call to call (one cache per pair: it
+/// holds the pair's scaled shapes, named by the shapes' ids).
+#[derive(Default)]
+pub struct ContactCache3 {
+    manifolds: Vec<Manifold3<(), ()>>,
+    workspace: Option<Workspace3>,
+    retry: Vec<ContactPoint3>,
+    scaled: Option<Scaled<dyn Parry3>>,
+}
+
+/// The buffers of one pair of shapes in 2D, kept from call to call.
+#[derive(Default)]
+pub struct ContactCache2 {
+    manifolds: Vec<Manifold2<(), ()>>,
+    workspace: Option<Workspace2>,
+    retry: Vec<ContactPoint2>,
+    scaled: Option<Scaled<dyn Parry2>>,
+}
+
+/// The pair's shapes scaled by `1 / scale` (a power of two), with the shapes' ids.
+struct Scaled<S: ?Sized> {
+    ids: (u64, u64),
+    scale: f64,
+    a: Box<S>,
+    b: Box<S>,
+}
+
+/// The power of two nearest `size` (in log scale), the unit of a pair's query.
+fn unit_of(size: f64) -> f64 {
+    let e = size.log2().round().clamp(-1000.0, 1000.0) as i32;
+    2f64.powi(e)
+}
+
+/// Depth (in the query's unit) by which GJK's extra point must beat the clipped ones to stay.
+const REDUNDANT: f64 = 1e-9;
+
+/// Relative size of the pull-apart of the second query (see [`contacts3`]).
+const PULL: f64 = 1e-8;
+/// Relative gap at or below which the second query is made.
+const TOUCH: f64 = 1e-10;
+/// Relative margin by which the first query must beat the second to be kept.
+const PREFER: f64 = 1e-12;
+
+fn deepest_gap<P>(points: &[P], gap: impl Fn(&P) -> f64) -> f64 {
+    points.iter().map(gap).fold(f64::INFINITY, f64::min)
+}
+
+fn check_prediction(prediction: f64) -> Result<()> {
+    if !prediction.is_finite() {
+        return Err(CoulombError::NonFinite(format!(
+            "prediction is {prediction}"
+        )));
+    }
+    if prediction < 0.0 {
+        return Err(CoulombError::InvalidParameter(format!(
+            "prediction must be >= 0, got {prediction}"
+        )));
+    }
+    Ok(())
+}
+
+fn both_static() -> CoulombError {
+    CoulombError::InvalidParameter(
+        "both shapes are static (mesh, heightfield or half-space): no contact between them"
+            .to_string(),
+    )
+}
+
+fn unsupported(what: String) -> CoulombError {
+    CoulombError::InvalidParameter(format!("no contact manifold for {what}"))
+}
+
+macro_rules! contacts_impl {
+    ($(#[$doc:meta])* $name:ident, $raw:ident, $shape:ty, $iso:ident, $vec:ident, $point:ident,
+     $cache:ident, $dispatcher:ident, $check_pose:ident, $manifold:ty, $workspace:ty,
+     $dynshape:ty, $tracked:ident) => {
+        /// parry's manifolds of `a` at `pose_a` and `b` at `pose_b` translated by `shift`,
+        /// converted; gaps taken back to the unshifted poses (`g - n · shift`, exact while the
+        /// same features touch), kept when `<= prediction`.
+        #[allow(clippy::too_many_arguments)]
+        fn $raw(
+            (a, b): (&$dynshape, &$dynshape),
+            unit: f64,
+            pose_a: &$iso<f64>,
+            pose_b: &$iso<f64>,
+            shift: $vec<f64>,
+            prediction: f64,
+            manifolds: &mut Vec<$manifold>,
+            workspace: &mut Option<$workspace>,
+            out: &mut Vec<$point>,
+        ) -> Result<()> {
+            out.clear();
+            for m in manifolds.iter_mut() {
+                m.points.clear();
+            }
+            // the query in units of `unit` (a power of two: exact)
+            let inv = 1.0 / unit;
+            let at = $iso::from_parts((pose_a.translation.vector * inv).into(), pose_a.rotation);
+            let bt = $iso::from_parts(
+                ((pose_b.translation.vector + shift) * inv).into(),
+                pose_b.rotation,
+            );
+            let pos12 = at.inv_mul(&bt);
+            let query = (prediction + shift.norm()) * inv;
+            $dispatcher
+                .contact_manifolds(&pos12, a, b, query, manifolds, workspace)
+                .map_err(|_| unsupported(format!("{:?} and {:?}", a.shape_type(), b.shape_type())))?;
+            for m in manifolds.iter() {
+                let part_a = m.subshape_pos1.unwrap_or_else($iso::identity);
+                let part_b = m.subshape_pos2.unwrap_or_else($iso::identity);
+                let normal = pose_a.rotation * (part_a.rotation * m.local_n1);
+                let back = normal.dot(&shift);
+                // parry adds GJK's closest pair (features unknown) to the clipped points in 3D:
+                // dropped when a clipped point is at least as deep (it lies among them)
+                let unknown = |p: &&_| {
+                    let p: &$tracked<()> = p;
+                    p.fid1.is_unknown() && p.fid2.is_unknown()
+                };
+                let known = m
+                    .points
+                    .iter()
+                    .filter(|p| !unknown(p))
+                    .map(|p| p.dist)
+                    .fold(f64::INFINITY, f64::min);
+                for p in &m.points {
+                    if unknown(&p) && known <= p.dist + REDUNDANT {
+                        continue;
+                    }
+                    let gap = p.dist * unit - back;
+                    if gap <= prediction {
+                        out.push($point {
+                            normal,
+                            gap,
+                            point_a: (part_a * p.local_p1) * unit,
+                            point_b: (part_b * p.local_p2) * unit,
+                            id: ContactId {
+                                part_a: m.subshape1,
+                                part_b: m.subshape2,
+                                feature_a: p.fid1.0,
+                                feature_b: p.fid2.0,
+                            },
+                        });
+                    }
+                }
+            }
+            Ok(())
+        }
+
+        $(#[$doc])*
+        pub fn $name(
+            a: &$shape,
+            pose_a: &$iso<f64>,
+            b: &$shape,
+            pose_b: &$iso<f64>,
+            prediction: f64,
+            cache: &mut $cache,
+            out: &mut Vec<$point>,
+        ) -> Result<()> {
+            out.clear();
+            check_prediction(prediction)?;
+            $check_pose("pose a", pose_a)?;
+            $check_pose("pose b", pose_b)?;
+            if a.is_static() && b.is_static() {
+                return Err(both_static());
+            }
+            let $cache { manifolds, workspace, retry, scaled } = cache;
+            let size = match (a.size(), b.size()) {
+                (Some(x), Some(y)) => x.min(y),
+                (Some(x), None) | (None, Some(x)) => x,
+                (None, None) => return Err(both_static()),
+            };
+            let unit = unit_of(size);
+            let ids = (a.id(), b.id());
+            if unit != 1.0 && !matches!(scaled, Some(s) if s.ids == ids && s.scale == unit) {
+                *scaled = match (a.scaled_parry(1.0 / unit), b.scaled_parry(1.0 / unit)) {
+                    (Some(sa), Some(sb)) => Some(Scaled { ids, scale: unit, a: sa, b: sb }),
+                    _ => None,
+                };
+                manifolds.clear();
+                *workspace = None;
+            }
+            let (shapes, unit): ((&$dynshape, &$dynshape), f64) = match scaled {
+                Some(s) if unit != 1.0 && s.ids == ids && s.scale == unit => ((&*s.a, &*s.b), unit),
+                _ => ((a.parry(), b.parry()), 1.0),
+            };
+            let zero = $vec::zeros();
+            $raw(shapes, unit, pose_a, pose_b, zero, prediction, manifolds, workspace, out)?;
+            let first = deepest_gap(out, |p| p.gap);
+            // a half-space's points are its support feature's vertices: no GJK to go wrong
+            if first > TOUCH * size || a.is_half_space() || b.is_half_space() {
+                return Ok(());
+            }
+            // touching or overlapping: query again with b pulled apart, along the line of
+            // centres between two moving shapes, else along the first answer's normal
+            let centres = pose_b.translation.vector - pose_a.translation.vector;
+            let along = if !a.is_static() && !b.is_static() && centres.norm() > TOUCH * size {
+                centres.normalize()
+            } else {
+                match out.iter().min_by(|p, q| p.gap.total_cmp(&q.gap)) {
+                    Some(p) => p.normal,
+                    None => return Ok(()),
+                }
+            };
+            let shift = along * (PULL * size);
+            $raw(shapes, unit, pose_a, pose_b, shift, prediction, manifolds, workspace, retry)?;
+            let second = deepest_gap(retry, |p| p.gap);
+            if first <= second + PREFER * size {
+                std::mem::swap(out, retry);
+            }
+            Ok(())
+        }
+    };
+}
+
+contacts_impl!(
+    /// Writes into `out` (cleared first) the contact points of shapes `a` at `pose_a` and `b`
+    /// at `pose_b` with gap `<= prediction` (`>= 0`). Errors: non-finite poses, a bad
+    /// prediction, or two static shapes.
+    ///
+    /// The signed distance of two convex sets is the largest separation over directions,
+    /// `g = max_n s(n)` with `s(n) = min_{y in B} n · y - max_{x in A} n · x` (the separating
+    /// hyperplane theorem), so every consistent answer `(n, s(n))` is a lower bound of the
+    /// true gap. parry's GJK-EPA can return such a wrong lower bound when the shapes touch to
+    /// within rounding (two boxes face to face at gap 0 come back at the depth of the other
+    /// axis). So when the first answer's deepest gap is `<= 1e-10 L` (`L` the smaller shape's
+    /// size), the query is made again with b pulled apart by `1e-8 L` (its gaps taken back by
+    /// `n · shift`), and the answer with the larger deepest gap is kept (the second one unless
+    /// the first beats it by more than `1e-12 L`).
+    contacts3, raw3, Shape3, Isometry3, Vector3, ContactPoint3, ContactCache3, Dispatcher3,
+    check_pose3, Manifold3<(), ()>, Workspace3, dyn Parry3, Tracked3
+);
+
+contacts_impl!(
+    /// [`contacts3`] in 2D.
+    contacts2, raw2, Shape2, Isometry2, Vector2, ContactPoint2, ContactCache2, Dispatcher2,
+    check_pose2, Manifold2<(), ()>, Workspace2, dyn Parry2, Tracked2
+);

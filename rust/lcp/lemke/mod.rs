@@ -1,0 +1,581 @@
+//! Lemke's complementary pivoting method (Cottle, Pang and Stone 1992; Stewart 2000 on what
+//! it guarantees for contact LCPs).
+//!
+//! With a covering vector d > 0 and an artificial variable z0 >= 0, Lemke follows the
+//! almost-complementary path of
+//!
+//! ```text
+//!     w = q + M z + d z0,    z, w, z0 >= 0,    z_i w_i = 0,
+//! ```
+//!
+//! starting from z = 0, z0 = max_i(-q_i / d_i). Each pivot brings in the complement of the
+//! variable that just left; the path ends when z0 leaves the basis (a solution) or when the
+//! entering column has no blocking row (a secondary ray). For copositive-plus M (for example
+//! positive semidefinite M) a secondary ray proves that the LCP has no solution.
+//!
+//! Implementation notes:
+//!
+//! - The data are equilibrated first (see `scaling`), so the pivot tolerance and the
+//!   tie test are relative to the data's units; the default covering vector is all ones on the
+//!   equilibrated problem.
+//! - For 16 <= n <= 1024 the basis inverse is kept in product form (`revised`): a pivot
+//!   forms only the entering column through the file of eta vectors, O(n k) for the k-th
+//!   pivot, about a quarter of the tableau's work on a path of n/2 pivots. Rounding can
+//!   break a degenerate tie differently there, so under [`LemkeEngine::Auto`] a path that
+//!   does not end in a solution within 2n + 16 pivots is re-run on the tableau.
+//! - The tableau is *condensed*: only the n+1 nonbasic columns and the right-hand side are
+//!   stored, n x (n+2) row-major, and a pivot is one rank-one update of it (about n^2 fused
+//!   multiply-adds, contiguous by rows). It is allocated once per workspace; pivots allocate
+//!   nothing.
+//! - Ties in the minimum-ratio test are broken lexicographically on the rows of
+//!   `[q̄, B^{-1}]`, which makes the method finite on degenerate problems; z0 leaves first
+//!   whenever its row is among the ties (so the path stops at the first solution it meets).
+//! - The final basis is polished: its system is re-solved on the original data by one step
+//!   of iterative refinement through the inverse the path holds (eta file or tableau), or,
+//!   when that answer fails, by factorizing the principal block `M_aa z_a = -q_a`; the
+//!   polished answer is kept if its error is smaller.
+
+mod answer;
+mod tableau;
+
+use super::revised::{PathEnd, RevisedLemke};
+use super::scaling::Equilibration;
+use super::{check_tol, passes, LcpRef, LcpSolution, LcpStatus, WarmStart};
+use crate::error::{check_finite, CoulombError, Result};
+use crate::readable::Readable;
+use answer::{better, candidate, principal, with_fallback_note, Candidate};
+pub use tableau::LemkeWorkspace;
+
+/// Settings of [`solve_lemke`].
+#[derive(Clone, Debug)]
+pub struct LemkeSettings {
+    /// tolerance on the answer's error measures (both `error` and `scaled_error`), on the
+    /// original data.
+    pub tol: f64,
+    /// the pivot limit; `None` means `max(1000, 50 n)`.
+    pub max_pivots: Option<usize>,
+    /// the covering vector d > 0 in the units of q; `None` means all ones on the equilibrated
+    /// problem, which makes the pivot path independent of the rows' units.
+    pub covering_vector: Option<Vec<f64>>,
+    /// a guessed basis: the indices i with z_i > 0 (for example the previous time step's
+    /// active set). If it solves the LCP no pivot is made; otherwise Lemke starts cold.
+    pub warm_start: Option<Vec<usize>>,
+    /// re-solve the final basis's principal system and keep it if better.
+    pub polish: bool,
+    /// after a ray termination, how many other covering vectors to try (only when
+    /// `covering_vector` is `None`). A secondary ray proves infeasibility only for
+    /// copositive-plus M; for other matrices a different path may still find a solution.
+    pub restarts: usize,
+    /// how the basis inverse is kept along the path (see [`LemkeEngine`]).
+    pub engine: LemkeEngine,
+}
+
+/// How Lemke's path keeps the basis inverse. Both follow the same lexicographic rule; they
+/// differ in cost and in rounding.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LemkeEngine {
+    /// the product form for 16 <= n <= 1024, where it is fastest, and the tableau otherwise;
+    /// a product-form path that does not end in a solution within `2n + 16` pivots is
+    /// re-run on the tableau, whose answer is then reported.
+    #[default]
+    Auto,
+    /// the condensed tableau: O(n^2) per pivot.
+    Tableau,
+    /// the product form (eta file): O(n p) for the p-th pivot, no fallback.
+    ProductForm,
+}
+
+impl Default for LemkeSettings {
+    fn default() -> Self {
+        Self {
+            tol: 1e-9,
+            max_pivots: None,
+            covering_vector: None,
+            warm_start: None,
+            polish: true,
+            restarts: 2,
+            engine: LemkeEngine::Auto,
+        }
+    }
+}
+
+/// How a pivoting run ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Ending {
+    Terminal,
+    Ray,
+    Limit,
+    NonFinite,
+}
+
+/// the most covering vectors Lemke tries after the first ([`LemkeSettings::restarts`]).
+pub const MAX_RESTARTS: usize = 1000;
+
+fn validate(lcp: &LcpRef<'_>, s: &LemkeSettings) -> Result<()> {
+    check_tol(s.tol)?;
+    if let Some(d) = &s.covering_vector {
+        if d.len() != lcp.n {
+            return Err(CoulombError::Shape(format!(
+                "covering_vector has length {}, expected {}",
+                d.len(),
+                lcp.n
+            )));
+        }
+        check_finite("covering_vector", d)?;
+        if let Some(k) = d.iter().position(|v| *v <= 0.0) {
+            return Err(CoulombError::InvalidParameter(format!(
+                "covering_vector must be positive, entry {k} is {}",
+                d[k]
+            )));
+        }
+    }
+    if let Some(b) = &s.warm_start {
+        let mut seen = vec![false; lcp.n];
+        for &k in b {
+            if k >= lcp.n {
+                return Err(CoulombError::InvalidParameter(format!(
+                    "warm_start index {k} is out of range for n = {}",
+                    lcp.n
+                )));
+            }
+            if seen[k] {
+                return Err(CoulombError::InvalidParameter(format!(
+                    "warm_start index {k} appears twice"
+                )));
+            }
+            seen[k] = true;
+        }
+    }
+    if s.max_pivots == Some(0) {
+        return Err(CoulombError::InvalidParameter(
+            "max_pivots must be at least 1".into(),
+        ));
+    }
+    if s.restarts > MAX_RESTARTS {
+        return Err(CoulombError::InvalidParameter(format!(
+            "restarts must be at most {MAX_RESTARTS}, got {}",
+            s.restarts
+        )));
+    }
+    let entries = crate::limits::dense_lemke_entries(lcp.n).unwrap_or(usize::MAX);
+    crate::limits::check_bytes(
+        &format!("Lemke's workspace for n = {}", lcp.n),
+        entries / 2,
+        8,
+        "",
+    )?;
+    Ok(())
+}
+
+/// Solves the LCP by Lemke's method with a fresh workspace. See [`solve_lemke_with`].
+pub fn solve_lemke(lcp: &LcpRef<'_>, settings: &LemkeSettings) -> Result<LcpSolution> {
+    let mut ws = LemkeWorkspace::new(lcp.n);
+    solve_lemke_with(&mut ws, lcp, settings)
+}
+
+/// The i-th covering vector on the equilibrated problem: the user's (scaled), all ones, then
+/// for restarts the user-units ones and deterministic spreads.
+fn covering(k: usize, eq: &Equilibration, user: Option<&[f64]>, out: &mut [f64]) {
+    match (user, k) {
+        (Some(d), _) => {
+            for ((o, r), di) in out.iter_mut().zip(&eq.row).zip(d) {
+                *o = r * di;
+            }
+        }
+        (None, 0) => out.iter_mut().for_each(|v| *v = 1.0),
+        (None, 1) => out.copy_from_slice(&eq.row),
+        (None, _) => {
+            // a fixed low-discrepancy spread in [0.5, 1.5): reproducible, never zero
+            let phi = 0.618_033_988_749_895 * k as f64;
+            for (i, v) in out.iter_mut().enumerate() {
+                *v = 0.5 + ((i as f64 + 1.0) * phi).fract();
+            }
+        }
+    }
+    let dmax = out.iter().fold(0.0f64, |m, v| m.max(*v));
+    if dmax > 0.0 {
+        out.iter_mut().for_each(|v| *v /= dmax);
+    }
+}
+
+/// How one path ended, and on which engine.
+struct Path {
+    ending: Ending,
+    pivots: usize,
+    /// whether the answer is the product form's (else the tableau's).
+    on_product_form: bool,
+    /// product-form pivots abandoned for the tableau (see [`LemkeEngine::Auto`]).
+    abandoned: usize,
+}
+
+/// Follows one complementary path with covering vector `cover` (equilibrated units) on the
+/// engine the settings choose, and leaves its answer in `z` and its basic z's in `basis`.
+#[allow(clippy::too_many_arguments)]
+fn follow_path(
+    ws: &mut LemkeWorkspace,
+    lcp: &LcpRef<'_>,
+    eq: &Equilibration,
+    cover: &[f64],
+    settings: &LemkeSettings,
+    max_pivots: usize,
+    z: &mut [f64],
+    basis: &mut Vec<usize>,
+) -> Path {
+    let n = lcp.n;
+    let product_form = match settings.engine {
+        LemkeEngine::Auto => ws.product_form.size() == n && n > 0,
+        LemkeEngine::Tableau => false,
+        LemkeEngine::ProductForm => true,
+    };
+    let mut path = Path {
+        ending: Ending::NonFinite,
+        pivots: 0,
+        on_product_form: false,
+        abandoned: 0,
+    };
+    if product_form {
+        if ws.product_form.size() != n {
+            ws.product_form = RevisedLemke::new(n);
+        }
+        // Rounding can break the lexicographic rule's ties differently from exact
+        // arithmetic; under Auto a path that wanders (or ends without a solution) is
+        // re-run on the tableau, whose verdict is then the one reported.
+        let budget = if settings.engine == LemkeEngine::Auto {
+            max_pivots.min(2 * n + 16)
+        } else {
+            max_pivots
+        };
+        let pf = &mut ws.product_form;
+        pf.load(lcp, eq, cover);
+        let (end, k) = pf.run(lcp, eq, budget);
+        path.ending = match end {
+            PathEnd::Terminal => Ending::Terminal,
+            PathEnd::Ray => Ending::Ray,
+            PathEnd::Limit => Ending::Limit,
+            PathEnd::NonFinite => Ending::NonFinite,
+        };
+        path.pivots = k;
+        path.on_product_form = true;
+        if path.ending != Ending::Terminal && settings.engine == LemkeEngine::Auto {
+            path.abandoned = k;
+            path.on_product_form = false;
+        }
+    }
+    if path.on_product_form {
+        ws.product_form.extract(eq, z, basis);
+    } else {
+        ws.load(lcp, eq, cover);
+        (path.ending, path.pivots) = ws.run(max_pivots);
+        ws.extract(eq, z, basis);
+    }
+    path
+}
+
+/// The answer reported for a path: the path's own z, or (with `polish`) a polished one kept
+/// when it passes or is better (see the module notes); `true` when the polished one is kept.
+fn best_answer(
+    ws: &mut LemkeWorkspace,
+    lcp: &LcpRef<'_>,
+    eq: &Equilibration,
+    settings: &LemkeSettings,
+    path: &Path,
+    z: &[f64],
+    basis: &[usize],
+) -> (Candidate, bool) {
+    let (n, tol) = (lcp.n, settings.tol);
+    let ending = path.ending;
+    // One refinement step on the original data through the basis inverse the path
+    // already holds (the eta file, or the tableau's block) usually brings the answer to
+    // rounding level; the principal system is factorized afresh only when that answer
+    // fails. When the polished answer passes, the path's own need not be evaluated.
+    let polished_answer = if ending == Ending::Terminal && settings.polish {
+        let refined = if path.on_product_form {
+            let pf = &mut ws.product_form;
+            pf.refine(lcp, eq);
+            let mut zr = vec![0.0; n];
+            let mut br = Vec::with_capacity(basis.len());
+            pf.extract(eq, &mut zr, &mut br);
+            Some(candidate(lcp, eq, zr))
+        } else {
+            let mut zr = z.to_vec();
+            ws.refine(lcp, eq, &mut zr).then(|| candidate(lcp, eq, zr))
+        };
+        match refined {
+            Some(c) if passes(&c.measures, tol) => Some(c),
+            _ => principal(lcp, eq, basis),
+        }
+    } else {
+        None
+    };
+    match polished_answer {
+        Some(p) if passes(&p.measures, tol) => (p, true),
+        Some(p) => {
+            let t = candidate(lcp, eq, z.to_vec());
+            if better(&p.measures, &t.measures) {
+                (p, true)
+            } else {
+                (t, false)
+            }
+        }
+        // the path ended elsewhere (a ray, the limit): with rounding, a path that reaches
+        // z0 = 0 to rounding may still pick another leaving row; its answer, and the
+        // principal solution of its basic z's, are judged like any other
+        None if ending != Ending::NonFinite && settings.polish => {
+            let t = candidate(lcp, eq, z.to_vec());
+            match principal(lcp, eq, basis) {
+                Some(p) if better(&p.measures, &t.measures) => (p, true),
+                _ => (t, false),
+            }
+        }
+        None => (candidate(lcp, eq, z.to_vec()), false),
+    }
+}
+
+/// The status and message of a path's answer (already in `out`); `true` when it is final,
+/// `false` after a ray, which a restart with another covering vector may still overcome.
+fn verdict(
+    out: &mut LcpSolution,
+    ending: Ending,
+    polished: bool,
+    tol: f64,
+    max_pivots: usize,
+    attempt: usize,
+) -> bool {
+    let m = out.measures;
+    match ending {
+        Ending::Ray | Ending::Limit if passes(&m, tol) => {
+            out.status = LcpStatus::Solved;
+            out.message = format!(
+                "solved in {} pivots (error {}{}; the path ended on {}, but the answer \
+                 there passes tol)",
+                out.pivots,
+                Readable(m.error),
+                if polished { ", polished" } else { "" },
+                if ending == Ending::Ray {
+                    "a ray"
+                } else {
+                    "the pivot limit"
+                }
+            );
+            return true;
+        }
+        Ending::Terminal if passes(&m, tol) => {
+            out.status = LcpStatus::Solved;
+            out.message = format!(
+                "solved in {} pivots (error {}{})",
+                out.pivots,
+                Readable(m.error),
+                if polished { ", polished" } else { "" }
+            );
+            return true;
+        }
+        Ending::Terminal => {
+            out.status = LcpStatus::NumericalFailure;
+            out.message = format!(
+                "z0 left the basis but the answer fails tol {}: error {}, \
+                 scaled error {} (ill-conditioned basis)",
+                Readable(tol),
+                Readable(m.error),
+                Readable(m.scaled_error)
+            );
+            return true;
+        }
+        Ending::Ray => {
+            out.status = LcpStatus::RayTermination;
+            out.message = format!(
+                "ray termination after {} pivots with {} covering vector(s): no solution \
+                 found on Lemke's path (for copositive-plus M, e.g. positive semidefinite, \
+                 this proves there is none)",
+                out.pivots,
+                attempt + 1
+            );
+        }
+        Ending::Limit => {
+            out.status = LcpStatus::PivotLimit;
+            out.message = format!(
+                "stopped at the pivot limit ({max_pivots}) with error {}",
+                Readable(m.error)
+            );
+            return true;
+        }
+        Ending::NonFinite => {
+            out.status = LcpStatus::NumericalFailure;
+            out.message = format!("the tableau became non-finite after {} pivots", out.pivots);
+            return true;
+        }
+    }
+    false
+}
+
+/// Solves the LCP by Lemke's method, reusing `ws` (resized if needed).
+///
+/// Never fails on a well-formed problem: a secondary ray, the pivot limit or a numerical
+/// breakdown is reported in the result's status. Errors are for bad input only.
+pub fn solve_lemke_with(
+    ws: &mut LemkeWorkspace,
+    lcp: &LcpRef<'_>,
+    settings: &LemkeSettings,
+) -> Result<LcpSolution> {
+    validate(lcp, settings)?;
+    let n = lcp.n;
+    if ws.size() != n {
+        *ws = LemkeWorkspace::new(n);
+    }
+    let eq = Equilibration::compute(n, lcp.m, lcp.q);
+    let tol = settings.tol;
+    let (w0, m0) = lcp.evaluate_zero(&eq);
+    let mut out = LcpSolution {
+        z: vec![0.0; n],
+        w: w0,
+        status: LcpStatus::Solved,
+        message: String::new(),
+        measures: m0,
+        pivots: 0,
+        iterations: 0,
+        basis: Vec::new(),
+        warm_start: WarmStart::None,
+        pivots_saved: 0,
+        polished: false,
+        restarts: 0,
+        solutions: Vec::new(),
+    };
+
+    if let Some(guess) = &settings.warm_start {
+        let mut a = guess.clone();
+        a.sort_unstable();
+        if let Some(c) = principal(lcp, &eq, &a) {
+            if passes(&c.measures, tol) {
+                out.warm_start = WarmStart::Accepted;
+                out.pivots_saved = a.len() + 1;
+                out.basis = a;
+                out.z = c.z;
+                out.w = c.w;
+                out.measures = c.measures;
+                out.message = "solved by the warm-start basis without pivoting".into();
+                return Ok(out);
+            }
+        }
+        out.warm_start = WarmStart::Rejected;
+    }
+
+    if passes(&out.measures, tol) {
+        out.message = "z = 0 solves the problem (q >= 0)".into();
+        return Ok(out);
+    }
+
+    let max_pivots = settings.max_pivots.unwrap_or_else(|| (50 * n).max(1000));
+    let user = settings.covering_vector.as_deref();
+    let tries = if user.is_some() {
+        1
+    } else {
+        1 + settings.restarts
+    };
+    let mut cover = vec![0.0; n];
+    let mut z = vec![0.0; n];
+    let mut basis = Vec::with_capacity(n);
+    let mut abandoned = 0;
+    for attempt in 0..tries {
+        if attempt > 0 && crate::interrupt::poll(n * n) {
+            break;
+        }
+        covering(attempt, &eq, user, &mut cover);
+        let path = follow_path(
+            ws, lcp, &eq, &cover, settings, max_pivots, &mut z, &mut basis,
+        );
+        let (ending, pivots) = (path.ending, path.pivots);
+        abandoned += path.abandoned;
+        out.pivots += pivots;
+        out.restarts = attempt;
+        let (best, polished) = best_answer(ws, lcp, &eq, settings, &path, &z, &basis);
+        out.z = best.z;
+        out.w = best.w;
+        out.measures = best.measures;
+        out.basis = basis.clone();
+        out.polished = polished;
+        if verdict(&mut out, ending, polished, tol, max_pivots, attempt) {
+            return Ok(with_fallback_note(out, abandoned));
+        }
+    }
+    Ok(with_fallback_note(out, abandoned))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lemke(n: usize, m: &[f64], q: &[f64]) -> LcpSolution {
+        let lcp = LcpRef::new(n, m, q).unwrap();
+        solve_lemke(&lcp, &LemkeSettings::default()).unwrap()
+    }
+
+    #[test]
+    fn chapter_scalar_lcp_w_equals_2z_minus_6() {
+        let s = lemke(1, &[2.0], &[-6.0]);
+        assert_eq!(s.status, LcpStatus::Solved);
+        assert!((s.z[0] - 3.0).abs() < 1e-14);
+        assert!(s.w[0].abs() < 1e-14);
+    }
+
+    #[test]
+    fn chapter_scalar_lcp_w_equals_minus_z_minus_1_has_no_solution() {
+        let s = lemke(1, &[-1.0], &[-1.0]);
+        assert_eq!(s.status, LcpStatus::RayTermination);
+        assert!(!s.success());
+    }
+
+    #[test]
+    fn nonnegative_q_needs_no_pivot() {
+        let s = lemke(2, &[1.0, 0.0, 0.0, 1.0], &[0.0, 3.0]);
+        assert!(s.success());
+        assert_eq!(s.pivots, 0);
+        assert_eq!(s.z, vec![0.0, 0.0]);
+    }
+
+    #[test]
+    fn warm_start_with_the_right_basis_makes_no_pivot() {
+        let m = [2.0, 1.0, 1.0, 2.0];
+        let q = [-3.0, -3.0];
+        let cold = lemke(2, &m, &q);
+        assert!(cold.success());
+        let lcp = LcpRef::new(2, &m, &q).unwrap();
+        let s = LemkeSettings {
+            warm_start: Some(cold.basis.clone()),
+            ..Default::default()
+        };
+        let warm = solve_lemke(&lcp, &s).unwrap();
+        assert_eq!(warm.warm_start, WarmStart::Accepted);
+        assert_eq!(warm.pivots, 0);
+        assert!(warm.pivots_saved >= 3);
+        for (a, b) in warm.z.iter().zip(&cold.z) {
+            assert!((a - b).abs() < 1e-12);
+        }
+        let bad = LemkeSettings {
+            warm_start: Some(vec![]),
+            ..Default::default()
+        };
+        let fallback = solve_lemke(&lcp, &bad).unwrap();
+        assert_eq!(fallback.warm_start, WarmStart::Rejected);
+        assert!(fallback.success());
+    }
+
+    #[test]
+    fn bad_settings_are_refused() {
+        let lcp = LcpRef::new(1, &[1.0], &[-1.0]).unwrap();
+        for s in [
+            LemkeSettings {
+                tol: 0.0,
+                ..Default::default()
+            },
+            LemkeSettings {
+                covering_vector: Some(vec![-1.0]),
+                ..Default::default()
+            },
+            LemkeSettings {
+                warm_start: Some(vec![3]),
+                ..Default::default()
+            },
+        ] {
+            assert!(solve_lemke(&lcp, &s).is_err());
+        }
+    }
+}

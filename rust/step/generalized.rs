@@ -1,0 +1,603 @@
+//! Mechanisms in generalized coordinates stepped by the impulse time stepper: a
+//! [`GeneralizedSystem`] gives, at each state, its mass matrix `M(q)`, its forces
+//! `f(q, v, t)`, and per contact the gap `g_i(q)` and the rows `[J_n; J_t]` of its contact
+//! Jacobian (Moreau's measure differential inclusion
+//! `M(q) dv = f(q, v, t) dt + J_n^T dP_n + J_t^T dP_t`, `dq = v dt`; Stewart 2000).
+//!
+//! The step is the scenes' ([`super::Stepper`]), on one block of M (the whole mechanism):
+//!
+//! ```text
+//!     v_free  = v_k + h M(q_k)^{-1} f(q_k, v_k, t_k)
+//!     v_{k+1} = v_free + M^{-1} G P,    W = G^T M^{-1} G,    q_{k+1} = q_k + h v_{k+1}
+//! ```
+//!
+//! with the same contact search (closed, owed a rebound, or closing within the step by its
+//! normal velocity), the same impact law (Newton's with the impact memory of module `impact`,
+//! or Poisson's with friction in both phases, module `poisson`), the same drift options, the
+//! same contact solve (NSGS with its fallbacks, or Lemke, warm-started by contact) and the same
+//! records ([`Trajectory`], whose `scaled_error` carries each step's verdict). W is assembled
+//! by the one assembly, [`crate::contact::assembly::WAssembly`].
+//!
+//! A system's callbacks may fail (a user function raising): the error stops the run and is
+//! returned as it is. Located impacts ([`StepSettings::locate_impacts`]) are scenes' only.
+
+use super::super::impact::ImpactMemory;
+use super::persistence::CandState;
+use super::solve::{SolveBuffers, SPARSE_FROM};
+use super::{Active, ContactRecord, StepRecord, Stepper, Trajectory, TINY};
+use crate::contact::assembly::{cholesky_in_place, solve_cholesky, WAssembly};
+use crate::error::{check_finite, CoulombError, Result};
+use crate::step::{Drift, StepSettings};
+
+#[path = "generalized_drift.rs"]
+mod generalized_drift;
+#[path = "generalized_law.rs"]
+mod generalized_law;
+
+/// A mechanism in generalized coordinates (`dq/dt = v`, so `nq = nv`) whose mass matrix,
+/// forces and contacts the stepper asks for at each state it reaches.
+pub trait GeneralizedSystem {
+    /// 2 (a contact has a normal and one tangent) or 3 (two tangents).
+    fn dim(&self) -> usize;
+    /// the number of generalized coordinates and velocities.
+    fn nv(&self) -> usize;
+    /// per contact, its friction coefficient `mu >= 0` and restitution `e` in `[0, 1]`.
+    fn laws(&self) -> Vec<(f64, f64)>;
+    /// `M(q)`, row-major `nv x nv`, symmetric positive definite, into `m`.
+    fn mass(&mut self, q: &[f64], m: &mut [f64]) -> Result<()>;
+    /// the generalized forces `f(q, v, t)` into `f` (`nv` entries).
+    fn force(&mut self, q: &[f64], v: &[f64], t: f64, f: &mut [f64]) -> Result<()>;
+    /// per contact i its gap `gaps[i]` (> 0 when separated) and the rows of its Jacobian,
+    /// normal first then the tangents, at `rows[(i dim + α) nv ..][..nv]`.
+    fn contacts(&mut self, q: &[f64], gaps: &mut [f64], rows: &mut [f64]) -> Result<()>;
+    /// the potential energy `V(q)` of the forces, for the records (0 when not known).
+    fn potential(&mut self, q: &[f64]) -> Result<f64>;
+}
+
+impl<T: GeneralizedSystem + ?Sized> GeneralizedSystem for &mut T {
+    fn dim(&self) -> usize {
+        (**self).dim()
+    }
+    fn nv(&self) -> usize {
+        (**self).nv()
+    }
+    fn laws(&self) -> Vec<(f64, f64)> {
+        (**self).laws()
+    }
+    fn mass(&mut self, q: &[f64], m: &mut [f64]) -> Result<()> {
+        (**self).mass(q, m)
+    }
+    fn force(&mut self, q: &[f64], v: &[f64], t: f64, f: &mut [f64]) -> Result<()> {
+        (**self).force(q, v, t, f)
+    }
+    fn contacts(&mut self, q: &[f64], gaps: &mut [f64], rows: &mut [f64]) -> Result<()> {
+        (**self).contacts(q, gaps, rows)
+    }
+    fn potential(&mut self, q: &[f64]) -> Result<f64> {
+        (**self).potential(q)
+    }
+}
+
+/// relative symmetry tolerance on `M(q)`.
+const SYM_TOL: f64 = 1e-10;
+/// relative Cholesky pivot floor on `M(q)`.
+const PIVOT_TOL: f64 = 1e-14;
+
+/// The impulse time stepper of a [`GeneralizedSystem`] (module docs).
+pub struct GeneralizedStepper<S: GeneralizedSystem> {
+    system: S,
+    settings: StepSettings,
+    dim: usize,
+    nv: usize,
+    /// per contact `(mu, e)`.
+    laws: Vec<(f64, f64)>,
+    /// the current time.
+    pub t: f64,
+    /// the coordinates `q_k`.
+    pub q: Vec<f64>,
+    /// the velocities `v_k`.
+    pub v: Vec<f64>,
+    step_index: usize,
+    prepared: Option<usize>,
+    /// `M(q_k)` and its Cholesky factor (row-major).
+    m: Vec<f64>,
+    chol: Vec<f64>,
+    /// `f(q_k, v_k, t_k)`.
+    f: Vec<f64>,
+    v_free: Vec<f64>,
+    gaps: Vec<f64>,
+    rows: Vec<f64>,
+    state: Vec<CandState>,
+    active: Vec<Active>,
+    /// `M^{-1} G` of the active contacts, `(i dim + α) nv ..`.
+    mg: Vec<f64>,
+    delassus: WAssembly,
+    /// the union-find forest of the active contacts coupled through M.
+    coupling: Vec<usize>,
+    qc: Vec<f64>,
+    q1: Vec<f64>,
+    mu: Vec<f64>,
+    restitution: Vec<f64>,
+    poisson_impact: bool,
+    initial: Vec<f64>,
+    basis_guess: Vec<usize>,
+    p_impact: Vec<f64>,
+    solve: SolveBuffers,
+    gp: Vec<f64>,
+    v_next: Vec<f64>,
+}
+
+impl<S: GeneralizedSystem> GeneralizedStepper<S> {
+    /// Checks the settings and the system's sizes and laws, and sizes every workspace.
+    pub fn new(system: S, q0: &[f64], v0: &[f64], settings: &StepSettings) -> Result<Self> {
+        settings.validate()?;
+        if settings.locate_impacts {
+            return Err(CoulombError::InvalidParameter(
+                "located impacts are available for scenes only, not for models in generalized \
+                 coordinates"
+                    .into(),
+            ));
+        }
+        let (dim, nv) = (system.dim(), system.nv());
+        if dim != 2 && dim != 3 {
+            return Err(CoulombError::InvalidParameter(format!(
+                "dim must be 2 or 3, got {dim}"
+            )));
+        }
+        if q0.len() != nv || v0.len() != nv {
+            return Err(CoulombError::Shape(format!(
+                "q0 and v0 must have nv = {nv} entries, got {} and {}",
+                q0.len(),
+                v0.len()
+            )));
+        }
+        check_finite("q0", q0)?;
+        check_finite("v0", v0)?;
+        let laws = system.laws();
+        for (i, &(mu, e)) in laws.iter().enumerate() {
+            if !(mu.is_finite() && mu >= 0.0 && (0.0..=1.0).contains(&e)) {
+                return Err(CoulombError::InvalidParameter(format!(
+                    "contact {i}: mu must be finite and >= 0 and e in [0, 1], got {mu} and {e}"
+                )));
+            }
+        }
+        let nc = laws.len();
+        Ok(Self {
+            system,
+            settings: settings.clone(),
+            dim,
+            nv,
+            t: 0.0,
+            q: q0.to_vec(),
+            v: v0.to_vec(),
+            step_index: 0,
+            prepared: None,
+            m: vec![0.0; nv * nv],
+            chol: vec![0.0; nv * nv],
+            f: vec![0.0; nv],
+            v_free: vec![0.0; nv],
+            gaps: vec![0.0; nc],
+            rows: vec![0.0; nc * dim * nv],
+            state: vec![CandState::default(); nc],
+            active: Vec::with_capacity(nc),
+            mg: Vec::new(),
+            delassus: WAssembly::new(),
+            coupling: Vec::new(),
+            qc: Vec::new(),
+            q1: Vec::new(),
+            mu: Vec::new(),
+            restitution: Vec::new(),
+            poisson_impact: false,
+            initial: Vec::new(),
+            basis_guess: Vec::new(),
+            p_impact: Vec::new(),
+            solve: SolveBuffers::default(),
+            gp: vec![0.0; nv],
+            v_next: vec![0.0; nv],
+            laws,
+        })
+    }
+
+    /// the system stepped.
+    pub fn system(&self) -> &S {
+        &self.system
+    }
+
+    /// `M(q)` into `self.m` and its Cholesky factor into `self.chol`; refuses a non-finite,
+    /// asymmetric or not positive definite M.
+    fn factor_mass(&mut self) -> Result<()> {
+        let nv = self.nv;
+        self.system.mass(&self.q, &mut self.m)?;
+        check_finite("M(q)", &self.m)?;
+        let scale = self.m.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        for r in 0..nv {
+            for c in r + 1..nv {
+                if (self.m[r * nv + c] - self.m[c * nv + r]).abs() > SYM_TOL * scale {
+                    return Err(CoulombError::InvalidParameter(format!(
+                        "M(q) must be symmetric: M[{r}, {c}] = {} but M[{c}, {r}] = {} at t = {}",
+                        self.m[r * nv + c],
+                        self.m[c * nv + r],
+                        self.t
+                    )));
+                }
+            }
+        }
+        self.chol.copy_from_slice(&self.m);
+        let dmax = (0..nv).fold(0.0f64, |a, k| a.max(self.m[k * nv + k]));
+        if cholesky_in_place(&mut self.chol, nv, PIVOT_TOL * dmax).is_err() {
+            return Err(CoulombError::InvalidParameter(format!(
+                "M(q) must be positive definite, and is not at t = {}",
+                self.t
+            )));
+        }
+        Ok(())
+    }
+
+    /// The per-state work shared by the record of state k and by step k, done once: M and
+    /// its factor, the forces, `v_free`, the gaps and Jacobian rows.
+    fn prepare(&mut self) -> Result<()> {
+        if self.prepared == Some(self.step_index) {
+            return Ok(());
+        }
+        self.factor_mass()?;
+        self.system.force(&self.q, &self.v, self.t, &mut self.f)?;
+        check_finite("f(q, v, t)", &self.f)?;
+        self.v_free.copy_from_slice(&self.f);
+        solve_cholesky(&self.chol, self.nv, &mut self.v_free);
+        let h = self.settings.h;
+        for (vf, v) in self.v_free.iter_mut().zip(&self.v) {
+            *vf = v + h * *vf;
+        }
+        self.frames()?;
+        self.prepared = Some(self.step_index);
+        Ok(())
+    }
+
+    /// the gaps and Jacobian rows at the current q.
+    fn frames(&mut self) -> Result<()> {
+        self.system
+            .contacts(&self.q, &mut self.gaps, &mut self.rows)?;
+        check_finite("the contact gaps", &self.gaps)?;
+        check_finite("the contact Jacobian rows", &self.rows)
+    }
+
+    /// row α of contact c's Jacobian.
+    fn row(&self, c: usize, al: usize) -> &[f64] {
+        let o = (c * self.dim + al) * self.nv;
+        &self.rows[o..o + self.nv]
+    }
+
+    /// One impulse time step from `(t_k, q_k, v_k)`; appends the active contacts to
+    /// `contacts` and returns the step's checks.
+    pub fn step(&mut self, contacts: &mut Vec<ContactRecord>) -> Result<StepRecord> {
+        self.prepare()?;
+        self.search_contacts();
+        let nc = self.active.len();
+        let mut record = Stepper::blank_record(nc);
+        let mut v_next = std::mem::take(&mut self.v_next);
+        v_next.copy_from_slice(&self.v_free);
+        self.gp.fill(0.0);
+        if nc > 0 {
+            self.assemble(&mut record);
+            self.solve_contacts(&mut record)?;
+            self.apply_impulses(&mut v_next);
+        }
+        record.momentum_residual = self.momentum_residual(&v_next);
+        if nc > 0 {
+            self.remember(&v_next, contacts);
+        }
+        let project = self.settings.drift == Drift::Projection && nc > 0;
+        let e_start = if project { self.energy()? } else { 0.0 };
+        self.v.copy_from_slice(&v_next);
+        self.v_next = v_next;
+        let h = self.settings.h;
+        for (q, v) in self.q.iter_mut().zip(&self.v) {
+            *q += h * v;
+        }
+        self.step_index += 1;
+        self.t = self.step_index as f64 * h;
+        if project {
+            record.projection = self.project(e_start)?;
+        }
+        Ok(record)
+    }
+
+    /// The contact search: a contact closed (`g <= gap_tolerance`), owed a rebound, or open
+    /// but closing within the step (`g <= gap_tolerance + 2 h max(-J_n v_k, -J_n v_free)`)
+    /// is active; the others forget their state.
+    fn search_contacts(&mut self) {
+        let h = self.settings.h;
+        let tol_gap = self.settings.gap_tolerance;
+        self.active.clear();
+        for c in 0..self.laws.len() {
+            let jn = self.row(c, 0);
+            let vn_k = dot(jn, &self.v);
+            let vn_free = dot(jn, &self.v_free);
+            let gap = self.gaps[c];
+            let pending = self.state[c].impact.pending;
+            let closing = (-vn_k).max(-vn_free).max(0.0);
+            if gap > tol_gap + 2.0 * h * closing && !pending {
+                self.state[c] = CandState::default();
+                continue;
+            }
+            let mut act = Active {
+                cand: c,
+                gap,
+                closed: gap <= tol_gap || pending,
+                vn_k,
+                nsides: 1,
+                ..Active::default()
+            };
+            // one side on the one block of M; its body is the contact's coupling class,
+            // set by the assembly
+            act.sides[0].body = 0;
+            self.active.push(act);
+        }
+    }
+
+    /// `M^{-1} G` of the active contacts, W by the one assembly (one block), and the contact
+    /// terms (as the scenes' step: Newton's `e v_n^-` with the impact memory, Poisson's impact
+    /// phase, the drift bias, the gap term).
+    fn assemble(&mut self, record: &mut StepRecord) {
+        let (dim, nv) = (self.dim, self.nv);
+        let na = self.active.len();
+        self.mg.clear();
+        self.mg.resize(na * dim * nv, 0.0);
+        for (i, a) in self.active.iter().enumerate() {
+            for al in 0..dim {
+                let o = (a.cand * dim + al) * nv;
+                let x = &mut self.mg[(i * dim + al) * nv..(i * dim + al + 1) * nv];
+                x.copy_from_slice(&self.rows[o..o + nv]);
+                solve_cholesky(&self.chol, nv, x);
+            }
+        }
+        // contacts coupled through M (a nonzero block W_ij) are linked, so that Poisson's
+        // impact phase treats a contact as isolated exactly when no closed contact is coupled
+        // to it, directly or through others (as bodies do in scenes)
+        let mut link = std::mem::take(&mut self.coupling);
+        link.clear();
+        link.extend(0..na);
+        let (rows, mg, active) = (&self.rows, &self.mg, &self.active);
+        let w = &mut self.delassus;
+        w.begin(1);
+        for i in 0..na {
+            w.side(i, 0, 0);
+        }
+        w.assemble(dim, na, na >= SPARSE_FROM, |(i, _), (j, _)| {
+            let ci = active[i].cand;
+            let mut blk = [[0.0; 3]; 3];
+            for al in 0..dim {
+                let g = &rows[(ci * dim + al) * nv..(ci * dim + al + 1) * nv];
+                for be in 0..dim {
+                    blk[al][be] = dot(g, &mg[(j * dim + be) * nv..(j * dim + be + 1) * nv]);
+                }
+            }
+            if i != j && blk.iter().flatten().any(|&x| x != 0.0) {
+                let (ri, rj) = (root(&mut link, i), root(&mut link, j));
+                link[ri.max(rj)] = ri.min(rj);
+            }
+            blk
+        });
+        for i in 0..na {
+            let r = root(&mut link, i);
+            self.active[i].sides[0].body = r;
+        }
+        self.coupling = link;
+        self.contact_terms(record);
+    }
+
+    /// `v_{k+1} = v_free + M^{-1} G P` (into `v_next`, which holds `v_free`), and `G P`.
+    fn apply_impulses(&mut self, v_next: &mut [f64]) {
+        let (dim, nv) = (self.dim, self.nv);
+        for (i, a) in self.active.iter().enumerate() {
+            for al in 0..dim {
+                let p = self.solve.impulse[i * dim + al];
+                let b = &self.mg[(i * dim + al) * nv..(i * dim + al + 1) * nv];
+                let o = (a.cand * dim + al) * nv;
+                let g = &self.rows[o..o + nv];
+                for k in 0..nv {
+                    v_next[k] += b[k] * p;
+                    self.gp[k] += g[k] * p;
+                }
+            }
+        }
+    }
+
+    /// `||M (v_{k+1} - v_free) - G P||` relative to `max(||G P||, ||M v_free||,
+    /// ||M v_{k+1}||)` (the absolute norm when all are zero).
+    fn momentum_residual(&self, v_next: &[f64]) -> f64 {
+        let nv = self.nv;
+        let (mut res2, mut gp2, mut mf2, mut mn2) = (0.0, 0.0, 0.0, 0.0);
+        for a in 0..nv {
+            let row = &self.m[a * nv..(a + 1) * nv];
+            let (mut mdv, mut mf, mut mn) = (0.0, 0.0, 0.0);
+            for c in 0..nv {
+                mdv += row[c] * (v_next[c] - self.v_free[c]);
+                mf += row[c] * self.v_free[c];
+                mn += row[c] * v_next[c];
+            }
+            let r = mdv - self.gp[a];
+            res2 += r * r;
+            gp2 += self.gp[a] * self.gp[a];
+            mf2 += mf * mf;
+            mn2 += mn * mn;
+        }
+        let scale2 = gp2.max(mf2).max(mn2);
+        if scale2.sqrt() > TINY {
+            (res2 / scale2).sqrt()
+        } else {
+            res2.sqrt()
+        }
+    }
+
+    /// Each active contact keeps its impulse, basis and impact record (as the scenes'
+    /// stepper), and its record of the step is appended to `contacts`.
+    fn remember(&mut self, v_next: &[f64], contacts: &mut Vec<ContactRecord>) {
+        let dim = self.dim;
+        for (i, a) in self.active.iter().enumerate() {
+            let p = &self.solve.impulse[i * dim..(i + 1) * dim];
+            let st = &mut self.state[a.cand];
+            st.warm[..dim].copy_from_slice(p);
+            st.basis = self.solve.basis.get(i).copied().unwrap_or(0);
+            st.impact = if !a.closed && p[0] > 0.0 {
+                ImpactMemory::landed(a.vn_k, p[0])
+            } else {
+                ImpactMemory::default()
+            };
+            let mut impulse = [0.0; 3];
+            impulse[..dim].copy_from_slice(p);
+            let mut velocity = [0.0; 3];
+            for (al, vel) in velocity.iter_mut().enumerate().take(dim) {
+                *vel = dot(self.row(a.cand, al), v_next);
+            }
+            contacts.push(ContactRecord {
+                step: self.step_index,
+                id: a.cand,
+                impulse,
+                velocity,
+                approach: a.approach,
+                gap: a.gap,
+                closed: a.closed,
+            });
+        }
+    }
+
+    /// the kinetic energy `v^T M v / 2` at the prepared state.
+    fn kinetic(&self) -> f64 {
+        let nv = self.nv;
+        let mut t = 0.0;
+        for a in 0..nv {
+            t += self.v[a] * dot(&self.m[a * nv..(a + 1) * nv], &self.v);
+        }
+        0.5 * t
+    }
+
+    /// the total energy `T + V` at the current state (M as last factored).
+    fn energy(&mut self) -> Result<f64> {
+        Ok(self.kinetic() + self.system.potential(&self.q)?)
+    }
+
+    /// records the current state into `out` (and `f . v` into `load_power`).
+    fn push_state(&mut self, out: &mut Trajectory, load_power: &mut Vec<f64>) -> Result<()> {
+        self.prepare()?;
+        out.t.push(self.t);
+        out.q.extend_from_slice(&self.q);
+        out.v.extend_from_slice(&self.v);
+        out.kinetic_energy.push(self.kinetic());
+        out.potential_energy.push(self.system.potential(&self.q)?);
+        let tol = self.settings.gap_tolerance;
+        out.min_gap
+            .push(self.gaps.iter().copied().fold(f64::INFINITY, f64::min));
+        out.negative_gaps
+            .push(self.gaps.iter().filter(|&&g| g < -tol).count());
+        load_power.push(dot(&self.f, &self.v));
+        Ok(())
+    }
+}
+
+/// the representative of `i`'s set in a union-find forest (paths halved on the way).
+fn root(link: &mut [usize], mut i: usize) -> usize {
+    while link[i] != i {
+        link[i] = link[link[i]];
+        i = link[i];
+    }
+    i
+}
+
+/// `x . y`.
+#[inline]
+fn dot(x: &[f64], y: &[f64]) -> f64 {
+    x.iter().zip(y).map(|(a, b)| a * b).sum()
+}
+
+/// The run of a [`GeneralizedSystem`]: the trajectory, and `f . v` at each recorded state
+/// (the power of the forces, for the energy balance `T + V + (h / 2) f . v`).
+#[derive(Clone, Debug)]
+pub struct GeneralizedTrajectory {
+    /// states, step checks and contact records, as a scene's.
+    pub trajectory: Trajectory,
+    /// `f(q, v, t) . v` per recorded state.
+    pub load_power: Vec<f64>,
+}
+
+/// Runs `settings.steps` steps of `system` from `(q0, v0)`, keeping the state after every
+/// `record_every`-th step (and after the last), as [`super::simulate_recorded`] does for a
+/// scene: unrecorded steps' checks are folded into the next recorded one, a non-finite state
+/// stops the run (`stopped` says why), the records are checked against the memory budget, and
+/// the caller's interrupt hook can stop it. A failing callback's error is returned (pass
+/// `&mut system` to keep the system, and what it noted, after the run).
+pub fn simulate_generalized<S: GeneralizedSystem>(
+    system: S,
+    q0: &[f64],
+    v0: &[f64],
+    settings: &StepSettings,
+    record_every: usize,
+) -> Result<GeneralizedTrajectory> {
+    let mut st = GeneralizedStepper::new(system, q0, v0, settings)?;
+    let (steps, nv) = (settings.steps, st.nv);
+    let every = record_every.max(1);
+    let rows = steps.div_ceil(every) + 1;
+    let row_bytes = 8 * (2 * nv + 6) + std::mem::size_of::<StepRecord>();
+    crate::limits::check_bytes(
+        &format!("recording {rows} states of {nv} coordinates"),
+        rows,
+        row_bytes,
+        "record fewer states with record_every",
+    )?;
+    let reserve = rows.min(4096);
+    let mut out = Trajectory {
+        dim: st.dim,
+        nq: nv,
+        nv,
+        t: Vec::with_capacity(reserve),
+        q: Vec::with_capacity(reserve * nv),
+        v: Vec::with_capacity(reserve * nv),
+        kinetic_energy: Vec::with_capacity(reserve),
+        potential_energy: Vec::with_capacity(reserve),
+        min_gap: Vec::with_capacity(reserve),
+        negative_gaps: Vec::with_capacity(reserve),
+        steps: Vec::with_capacity(reserve),
+        contacts: Vec::new(),
+        stopped: None,
+    };
+    let mut load_power = Vec::with_capacity(reserve);
+    st.push_state(&mut out, &mut load_power)?;
+    let mut pending: Option<StepRecord> = None;
+    for k in 0..steps {
+        if crate::interrupt::poll(nv * nv + 64) {
+            break;
+        }
+        let kept = out.contacts.len();
+        let mut rec = st.step(&mut out.contacts)?;
+        if let Some(p) = pending.take() {
+            rec.fold(&p);
+        }
+        let row = out.steps.len();
+        out.contacts[kept..].iter_mut().for_each(|c| c.step = row);
+        if !st.v.iter().chain(st.q.iter()).all(|x| x.is_finite()) {
+            out.stopped = Some(format!(
+                "step {k} produced a non-finite state (contact solver: {})",
+                rec.status.map_or("no contacts", |s| s.as_str())
+            ));
+            out.contacts.truncate(kept);
+            break;
+        }
+        if (k + 1) % every != 0 && k + 1 != steps {
+            out.contacts.truncate(kept);
+            pending = Some(rec);
+            continue;
+        }
+        crate::limits::check_bytes(
+            &format!("recording {} contact records", out.contacts.len()),
+            out.contacts.len(),
+            std::mem::size_of::<ContactRecord>(),
+            "record fewer states with record_every",
+        )?;
+        out.steps.push(rec);
+        st.push_state(&mut out, &mut load_power)?;
+    }
+    Ok(GeneralizedTrajectory {
+        trajectory: out,
+        load_power,
+    })
+}
