@@ -41,9 +41,11 @@ fn check(problem: &ContactProblem<'_>, what: &str) {
         seen.iter().all(|s| s.0 == seen[0].0),
         "{what}: allocations vary with the sweeps: {seen:?}"
     );
-    // the constant: impulses, diagonal blocks, velocities, the degenerate list, the message
+    // the constant: impulses, diagonal blocks, velocities, the degenerate list, the message,
+    // the measure's buffers, and for a dense W with mostly zero tiles its block CSR copy
+    // (four arrays sized exactly)
     assert!(
-        seen[0].0 <= 8,
+        seen[0].0 <= 12,
         "{what}: too many allocations per solve: {seen:?}"
     );
 }

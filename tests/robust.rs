@@ -110,10 +110,13 @@ fn local(path: &Path, name: &str) -> (usize, Vec<f64>, Vec<f64>, Vec<f64>) {
 
 #[test]
 fn problems_where_nsgs_stalls_are_solved_at_1e_8() {
-    for name in [
-        "BoxesStack1-i100000-32.hdf5.dat",
-        "OneObject-i100000-316.hdf5.dat",
-        "OneObject-i100000-499.hdf5.dat",
+    // (file, whether NSGS stalls on it within 1000 sweeps): OneObject-i100000-316 stalled only
+    // while NSGS symmetrised the diagonal blocks of its slightly unsymmetric W (8e-5); solved
+    // as stored, NSGS converges there in under 1000 sweeps
+    for (name, stalls) in [
+        ("BoxesStack1-i100000-32.hdf5.dat", true),
+        ("OneObject-i100000-316.hdf5.dat", false),
+        ("OneObject-i100000-499.hdf5.dat", true),
     ] {
         let (dim, w, q, mu) = local(&data::file("siconos-fc", name), name);
         let p = ContactProblem::new(dim, &w, &q, &mu).unwrap();
@@ -129,7 +132,11 @@ fn problems_where_nsgs_stalls_are_solved_at_1e_8() {
             },
         )
         .unwrap();
-        assert_eq!(n.status, ContactStatus::IterationLimit, "{name}");
+        if stalls {
+            assert_eq!(n.status, ContactStatus::IterationLimit, "{name}");
+        } else {
+            assert_eq!(n.status, ContactStatus::Solved, "{name}: {}", n.message);
+        }
         // warm start from the answer: solved at once (up to the projection's rounding)
         let again = solve_prox(
             &p,

@@ -58,6 +58,14 @@ fn check_dims(dim: usize, n: usize) -> Result<usize> {
     Ok(n / dim)
 }
 
+/// whether tile (bi, bj) of a dense row-major `n x n` W has a nonzero entry.
+fn dense_tile_nonzero(w: &[f64], dim: usize, n: usize, bi: usize, bj: usize) -> bool {
+    (0..dim).any(|a| {
+        let row = (bi * dim + a) * n + bj * dim;
+        w[row..row + dim].iter().any(|&v| v != 0.0)
+    })
+}
+
 fn check_data(data: &[f64]) -> Result<()> {
     crate::error::check_finite("W's data", data)
 }
@@ -225,6 +233,55 @@ impl BlockCsr {
         Self::from_entries(dim, nc, nnz, &entries)
     }
 
+    /// From a dense row-major `(dim nc)^2` W already checked for size and finiteness: the
+    /// tiles with a nonzero entry and the diagonal ones, in four allocations sized exactly
+    /// (no scratch). `tiles` is [`Self::dense_tile_count`] of the same W.
+    pub(crate) fn from_dense_counted(dim: usize, nc: usize, w: &[f64], tiles: usize) -> Self {
+        let n = dim * nc;
+        let bs = dim * dim;
+        let mut row_ptr = Vec::with_capacity(nc + 1);
+        let mut cols = Vec::with_capacity(tiles);
+        let mut values = Vec::with_capacity(tiles * bs);
+        let mut diag = Vec::with_capacity(nc);
+        row_ptr.push(0);
+        for bi in 0..nc {
+            for bj in 0..nc {
+                if bj == bi || dense_tile_nonzero(w, dim, n, bi, bj) {
+                    if bj == bi {
+                        diag.push(cols.len());
+                    }
+                    cols.push(bj);
+                    for a in 0..dim {
+                        let row = (bi * dim + a) * n + bj * dim;
+                        values.extend_from_slice(&w[row..row + dim]);
+                    }
+                }
+            }
+            row_ptr.push(cols.len());
+        }
+        Self {
+            dim,
+            nc,
+            row_ptr,
+            cols,
+            values,
+            diag,
+        }
+    }
+
+    /// the number of tiles [`Self::from_dense_counted`] stores for a dense W: those with a
+    /// nonzero entry and the diagonal ones. O(n^2), no allocation.
+    pub(crate) fn dense_tile_count(dim: usize, nc: usize, w: &[f64]) -> usize {
+        let n = dim * nc;
+        (0..nc)
+            .map(|bi| {
+                (0..nc)
+                    .filter(|&bj| bj == bi || dense_tile_nonzero(w, dim, n, bi, bj))
+                    .count()
+            })
+            .sum()
+    }
+
     /// the bucketing described in the module notes; indices are already checked.
     fn from_entries(dim: usize, nc: usize, nnz: usize, entries: &dyn Entries) -> Result<Self> {
         // 1. bucket the entries by block row (counting sort)
@@ -334,30 +391,44 @@ impl BlockCsr {
     /// give bitwise equal products.
     #[inline]
     pub fn row_mul(&self, i: usize, x: &[f64], skip_diag: bool) -> [f64; 3] {
-        let d = self.dim;
-        let mut out = [0.0; 3];
         let (lo, hi) = (self.row_ptr[i], self.row_ptr[i + 1]);
-        if d == 3 {
-            for t in lo..hi {
-                let j = self.cols[t];
-                if skip_diag && j == i {
-                    continue;
-                }
-                let b = &self.values[t * 9..t * 9 + 9];
+        if !skip_diag {
+            return self.tiles_mul(lo, hi, x);
+        }
+        // the tiles left and right of the diagonal one, continuing the same running sums
+        let d = self.diag[i];
+        let left = self.tiles_mul(lo, d, x);
+        self.tiles_mul_into(d + 1, hi, x, left)
+    }
+
+    /// `Σ_t W_t x_{cols[t]}` over the tiles `t in lo..hi` of one block row.
+    #[inline]
+    fn tiles_mul(&self, lo: usize, hi: usize, x: &[f64]) -> [f64; 3] {
+        self.tiles_mul_into(lo, hi, x, [0.0; 3])
+    }
+
+    /// `out + Σ_t W_t x_{cols[t]}`, each component summed in tile order (one running sum per
+    /// component, three products per tile, left to right).
+    #[inline]
+    fn tiles_mul_into(&self, lo: usize, hi: usize, x: &[f64], mut out: [f64; 3]) -> [f64; 3] {
+        let cols = &self.cols[lo..hi];
+        if self.dim == 3 {
+            let values = &self.values[lo * 9..hi * 9];
+            for (&j, b) in cols.iter().zip(values.chunks_exact(9)) {
                 let xj = &x[3 * j..3 * j + 3];
-                for (a, o) in out.iter_mut().enumerate() {
-                    *o += b[3 * a] * xj[0];
-                    *o += b[3 * a + 1] * xj[1];
-                    *o += b[3 * a + 2] * xj[2];
-                }
+                out[0] += b[0] * xj[0];
+                out[0] += b[1] * xj[1];
+                out[0] += b[2] * xj[2];
+                out[1] += b[3] * xj[0];
+                out[1] += b[4] * xj[1];
+                out[1] += b[5] * xj[2];
+                out[2] += b[6] * xj[0];
+                out[2] += b[7] * xj[1];
+                out[2] += b[8] * xj[2];
             }
         } else {
-            for t in lo..hi {
-                let j = self.cols[t];
-                if skip_diag && j == i {
-                    continue;
-                }
-                let b = &self.values[t * 4..t * 4 + 4];
+            let values = &self.values[lo * 4..hi * 4];
+            for (&j, b) in cols.iter().zip(values.chunks_exact(4)) {
                 let xj = &x[2 * j..2 * j + 2];
                 out[0] += b[0] * xj[0];
                 out[0] += b[1] * xj[1];
@@ -487,6 +558,8 @@ mod tests {
             assert_eq!(c.to_dense(), w);
             let d = BlockCsr::from_dense(dim, n, &w).unwrap();
             assert_eq!(a, d);
+            let tiles = BlockCsr::dense_tile_count(dim, nc, &w);
+            assert_eq!(BlockCsr::from_dense_counted(dim, nc, &w, tiles), d);
             assert_eq!(a, c);
             // every diagonal tile is stored, sorted columns
             for i in 0..nc {

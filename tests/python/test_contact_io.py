@@ -160,37 +160,37 @@ def test_problems_nsgs_must_solve_are_solved(problems, name):
     assert contact_scaled_error(p.W, p.q, p.mu, p.dim, r.impulse) <= TOL, name
 
 
-def test_rover_nsgs_stall_is_not_reported_as_solved(problems):
-    """Rover1039 used to be "solved" by NSGS because the old verdict divided by
-    max(||q||, ||r||, ||u||) (error 2.6e-7 <= 1e-6) while error_q was 2.3e-5 and a contact
-    both pushed and separated (r_n u_n 8.6e-5): NSGS stalls there. The unit-consistent
-    measure says so; the robust mode solves it (complementarity 2e-8)."""
+def test_rover_is_solved_by_nsgs_with_its_diagonal_blocks_as_stored(problems):
+    """Rover1039 (W symmetric to a relative 1e-5) stalled under NSGS (error_q 2.3e-5, a
+    contact both pushing and separating) while NSGS symmetrised each contact's diagonal block:
+    the sweeps' fixed point was not the problem's solution. Solved with the blocks as stored,
+    the answer passes the unit-consistent measure recomputed here; the robust mode agrees."""
     p = problems["Rover1039"]
     r = contact.solve(p.W, p.q, p.mu, p.dim, tol=TOL, max_iter=MAX_ITER)
-    scaled = contact_scaled_error(p.W, p.q, p.mu, p.dim, r.impulse)
-    assert not r.success and scaled > 10 * TOL and r.error_q > 10 * TOL
+    assert r.success and r.status == "solved", r.message
+    assert contact_scaled_error(p.W, p.q, p.mu, p.dim, r.impulse) <= TOL
     s = contact.solve(p.W, p.q, p.mu, p.dim, tol=TOL, method="prox")
     assert s.success and contact_scaled_error(p.W, p.q, p.mu, p.dim, s.impulse) <= TOL
-    assert s.max_complementarity < 1e-3 * r.max_complementarity
 
 
-def test_one_object_nsgs_stall_is_not_reported_as_solved(problems):
-    """OneObject-i1028-138 used to be "solved" by NSGS (error_q 5.9e-7 <= 1e-6): NSGS stalls
-    there (the same figures after 1e3 and 1e5 sweeps) with a contact off the law by 9.5e-6 of
-    its own scale (contact_gen.law_violation, independent of coulomb's measures). The
-    unit-consistent measure, taken contact by contact, says so; the robust mode solves it."""
+def test_one_object_is_solved_by_nsgs_with_its_diagonal_blocks_as_stored(problems):
+    """OneObject-i1028-138 stalled under NSGS (a contact off the law by 9.5e-6 of its own
+    scale after 1e3 and 1e5 sweeps) while NSGS symmetrised the diagonal blocks of its slightly
+    unsymmetric W. Solved with the blocks as stored (to 1e-8), every contact obeys the law to
+    1e-6 of its scale (contact_gen.law_violation, independent of coulomb's measures), as the robust
+    mode's answer does."""
     from contact_gen import law_violation
 
     p = problems["OneObject-i1028-138.hdf5"]
-    r = contact.solve(p.W, p.q, p.mu, p.dim, tol=TOL, max_iter=MAX_ITER)
-    assert not r.success and r.status == "iteration_limit"
-    assert law_violation(p.W, p.q, p.mu, p.dim, r.impulse) > 1e-6 >= r.error_q
+    # at 1e-2 TOL: the two per-contact measures differ in their scales by a small factor
+    r = contact.solve(p.W, p.q, p.mu, p.dim, tol=1e-2 * TOL, max_iter=MAX_ITER)
+    assert r.success and r.status == "solved", r.message
+    assert law_violation(p.W, p.q, p.mu, p.dim, r.impulse) <= 1e-6
     s = contact.solve(p.W, p.q, p.mu, p.dim, tol=TOL, method="prox")
     assert s.success and law_violation(p.W, p.q, p.mu, p.dim, s.impulse) <= 1e-6
 
 
 def test_iteration_limit_on_a_real_problem(problems):
-    # (OneObject-i1028-138, used here before, is not solved by NSGS: see above)
     p = problems["FrictionContactProblem00071"]
     r = contact.solve(p.W, p.q, p.mu, p.dim, tol=TOL, max_iter=1)
     assert not r.success

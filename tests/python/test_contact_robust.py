@@ -119,9 +119,14 @@ def test_problems_where_nsgs_stalls_are_solved(name):
     assert r.iterations <= 60
     err, err_q = contact_error(p.W, p.q, p.mu, p.dim, r.impulse)
     assert err_q <= TOL and err <= TOL
-    # contrast: NSGS does not reach 1e-8 on them within 2000 sweeps
+    # contrast: NSGS does not reach 1e-8 within 2000 sweeps on those it still stalls on;
+    # OneObject-i100000-316 stalled only while NSGS symmetrised the diagonal blocks of its
+    # slightly unsymmetric W, and is solved since
     n = contact.solve(p.W, p.q, p.mu, p.dim, method="nsgs", tol=TOL, max_iter=2000)
-    assert not n.success and n.error_q > 10 * TOL
+    if name == "OneObject-i100000-316.hdf5":
+        assert n.success and n.error_q <= TOL, n.message
+    else:
+        assert not n.success and n.error_q > 10 * TOL
 
 
 def redundant_planar_problem(seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
