@@ -173,7 +173,7 @@ def sphere_pile(count: int, h: float = 1e-3, t_end: float = 1.0, radius: float =
     {"".join(bodies)}
   </worldbody>
 </mujoco>"""
-    _t, _qpos, _qvel, n, sec = _rollout(xml, None, t_end, h, repeats=1)
+    _t, _qpos, _qvel, n, sec = _rollout(xml, None, t_end, h, repeats=3)
     return PeerRun(f"pile of {count} spheres", h, n, sec, {})
 
 

@@ -158,7 +158,7 @@ def coulomb_pile(count: int, h: float, solver: str, t_end: float = 1.0) -> dict:
         scene.contact_spheres(mu=0.5)
         return scene
 
-    tr, sec = _best(run, t_end, h, solver, repeats=1)
+    tr, sec = _best(run, t_end, h, solver, repeats=3)
     pos = tr.q.reshape(len(tr.t), count, 7)[:, :, :3]
     moved = float(np.max(np.linalg.norm(pos - pos[0], axis=2)))
     solved = int(np.sum(np.isin(tr.solver_status, ["solved", "no_contact"])))
@@ -243,8 +243,8 @@ def main() -> int:
         f"{datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC (revision {rev}; "
         f"coulomb {coulomb.__version__}, MuJoCo {mujoco.__version__}, Python "
         f"{platform.python_version()}, {platform.machine()}). Command: "
-        f"`python benches/peer_step.py`. h = 1 ms for every scene; best wall time of 3 runs "
-        f"(1 for the piles); MuJoCo's loop in C++ by `mujoco.rollout`, coulomb's in Rust by "
+        f"`python benches/peer_step.py`. h = 1 ms for every scene; best wall time of 3 runs; "
+        f"MuJoCo's loop in C++ by `mujoco.rollout`, coulomb's in Rust by "
         f"`Scene.simulate` (which also records every step's state, impulses and checks). "
         f"'vs MuJoCo': steps/s over MuJoCo's on the same scene in the same run. Load average "
         f"over the last minute when the run ended: {os.getloadavg()[0]:.1f} on "
