@@ -77,6 +77,7 @@ use super::nsgs::{solve_nsgs, NsgsSettings};
 use super::projection::{project_cone, tangent_norm};
 use super::{measure_into, ContactMeasures, ContactProblem, ContactSolution, ContactStatus};
 use crate::error::{CoulombError, Result};
+use crate::readable::Readable;
 
 /// Settings of [`solve_prox`].
 #[derive(Clone, Debug)]
@@ -519,8 +520,8 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
         (
             ContactStatus::Solved,
             format!(
-                "solved in {iterations} Newton steps{finished} (scaled_error {:.2e})",
-                measures.scaled_error
+                "solved in {iterations} Newton steps{finished} (scaled_error {})",
+                Readable(measures.scaled_error)
             ),
         )
     } else if !measures.scaled_error.is_finite() || r.iter().any(|v| !v.is_finite()) {
@@ -537,16 +538,20 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
             format!(
                 "stalled after {iterations} Newton steps and {restarts} restarts: no step \
                  decreases the natural-map residual even with the proximal parameter at \
-                 {eta:.1e} (scaled_error {:.2e} > tol {:.1e})",
-                measures.scaled_error, s.tol
+                 {} (scaled_error {} > tol {})",
+                Readable(eta),
+                Readable(measures.scaled_error),
+                Readable(s.tol)
             ),
         )
     } else {
         (
             ContactStatus::IterationLimit,
             format!(
-                "stopped at max_iter = {} with scaled_error {:.2e} > tol {:.1e}",
-                s.max_iter, measures.scaled_error, s.tol
+                "stopped at max_iter = {} with scaled_error {} > tol {}",
+                s.max_iter,
+                Readable(measures.scaled_error),
+                Readable(s.tol)
             ),
         )
     };

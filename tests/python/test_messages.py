@@ -49,10 +49,23 @@ def test_contact_messages_carry_the_measured_error_and_tol_readably() -> None:
     r = coulomb.contact.solve(W, q, 0.2, dim=3, max_iter=1, tol=1e-14)
     m = re.search(rf"scaled_error {NUMBER}", r.message)
     assert m and m.group(1) == readable(r.scaled_error), r.message
-    for method in ("nsgs", "lemke"):
+    for method in ("nsgs", "lemke", "prox"):
         for dim in (2, 3):
             text = coulomb.contact.solve(W, q, 0.2, dim=dim, method=method).message
             assert not UNREADABLE.search(text), text
+
+
+def test_prox_messages_print_the_scaled_error_and_tol_readably() -> None:
+    rng = np.random.default_rng(5)
+    a = rng.standard_normal((12, 12))
+    W = a @ a.T / 12 + 0.1 * np.eye(12)
+    q = rng.standard_normal(12)
+    r = coulomb.contact.solve(W, q, 0.5, dim=3, method="prox", max_iter=1, tol=1e-14)
+    assert not UNREADABLE.search(r.message), r.message
+    if not r.success:
+        m = re.search(rf"scaled_error {NUMBER} > tol {NUMBER}", r.message)
+        assert m, r.message
+        assert m.group(1) == readable(r.scaled_error) and m.group(2) == "1e-14"
 
 
 def test_trajectory_check_messages_print_residuals_readably() -> None:
