@@ -80,6 +80,20 @@ def generate(seed: int, dim: int, planted: bool, ka: int = 0, kb: int = 0,
                    None if r_star is None else r_star * a)
 
 
+def perturb_ulp(p: Problem, seed: int) -> Problem:
+    """The same problem with each entry of W (kept symmetric) and q moved by at most one unit
+    in the last place, in the same units: the rounding a change of units by 10^k brings to the
+    normalized data (every method runs on the problem rescaled by powers of two), without any
+    change of units."""
+    rng = np.random.default_rng(seed)
+    eps = np.finfo(float).eps
+    k = rng.integers(-1, 2, p.W.shape)
+    k = np.triu(k) + np.triu(k, 1).T
+    W = p.W * (1.0 + k * eps)
+    q = p.q * (1.0 + rng.integers(-1, 2, p.q.shape) * eps)
+    return Problem(W, q, p.mu, p.dim, p.planted, p.r_star)
+
+
 def law_violation(W: np.ndarray, q: np.ndarray, mu: np.ndarray, dim: int,
                   r: np.ndarray, polygon: bool = False) -> float:
     """The worst violation of Signorini's condition and Coulomb's law by impulses r, each
@@ -134,6 +148,8 @@ class Counts:
     status_changes: int = 0
     hard_cases: int = 0
     hard_status_changes: int = 0
+    ulp_status_changes: int = 0
+    ulp_hard_status_changes: int = 0
     worst_false: float = 0.0
 
 
@@ -149,9 +165,11 @@ def solve(p: Problem, method: str):
     return contact.solve(p.W, p.q, p.mu, dim=p.dim, method=method, tol=TOL, **kw)
 
 
-def campaign(n: int, start: int = 0) -> dict[str, Counts]:
+def campaign(n: int, start: int = 0, ulp: bool = False) -> dict[str, Counts]:
     """n generated problems (2 in 3 planted, both dims, units 10^-8..10^8, mu 0..1e12), each
-    solved by every method in its units and in other units (status compared)."""
+    solved by every method in its units and in other units (status compared); with ``ulp``,
+    also with its data moved by one ulp in its own units (:func:`perturb_ulp`, status
+    compared: the rounding control of the unit changes)."""
     out = {m: Counts() for m in METHODS}
     for seed in range(start, start + n):
         rng = np.random.default_rng(10_000 + seed)
@@ -160,10 +178,12 @@ def campaign(n: int, start: int = 0) -> dict[str, Counts]:
         ka, kb, ka2, kb2 = (int(k) for k in rng.integers(-8, 9, 4))
         p = generate(seed, dim, planted, ka, kb)
         p2 = generate(seed, dim, planted, ka2, kb2)
+        p3 = perturb_ulp(p, 20_000 + seed) if ulp else None
         for method in METHODS:
             c = out[method]
             res = solve(p, method)
             res2 = solve(p2, method)
+            res3 = solve(p3, method) if p3 is not None else res
             c.cases += 1
             c.planted += planted
             # mu above 10 somewhere (conditioned like mu) or no solution planted: a verdict
@@ -171,8 +191,10 @@ def campaign(n: int, start: int = 0) -> dict[str, Counts]:
             if p.mu.max() > 10 or not planted:
                 c.hard_cases += 1
                 c.hard_status_changes += res.status != res2.status
+                c.ulp_hard_status_changes += res.status != res3.status
             else:
                 c.status_changes += res.status != res2.status
+                c.ulp_status_changes += res.status != res3.status
             moderate = planted and p.mu.max() <= 10
             c.planted_moderate += moderate
             if res.success:
@@ -191,5 +213,5 @@ if __name__ == "__main__":  # the long campaign of docs/properties.md
     import sys
 
     n = int(sys.argv[1]) if len(sys.argv) > 1 else 3000
-    for method, c in campaign(n).items():
+    for method, c in campaign(n, ulp=True).items():
         print(f"{method}: {c}")
