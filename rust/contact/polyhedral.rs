@@ -325,6 +325,9 @@ fn check_facets(dim: usize, facets: usize) -> Result<()> {
     Ok(())
 }
 
+/// fixed covering vectors tried after the other engine's path (see [`other_paths`]).
+const COVERING_PATHS: usize = 6;
+
 /// Other Lemke paths on the same polyhedral LCP, tried in turn when the first does not solve
 /// it (only under the default engine and covering vector, which they replace): the other
 /// engine (the product form and the tableau round differently, and with mu of 1e4 and more
@@ -344,7 +347,7 @@ fn other_paths(s: &LemkeSettings, n: usize) -> Vec<LemkeSettings> {
         engine: other,
         ..s.clone()
     }];
-    for k in [1.0, 2.0] {
+    for k in (1..=COVERING_PATHS).map(|k| k as f64) {
         // the golden-ratio sequence: reproducible and never zero
         let phi = 0.618_033_988_749_895 * k;
         let d: Vec<f64> = (0..n)
