@@ -216,9 +216,7 @@ class Model:
         gap_tolerance = _validate.real("gap_tolerance", gap_tolerance, low=0.0)
         warm_start = _validate.boolean("warm_start", warm_start)
         fallback = _validate.boolean("fallback", fallback)
-        _validate.choice("drift", drift, ("none", "bias", "projection"), "drift correction")
-        drift_bias = _validate.real("drift_bias", drift_bias, low=0.0, high=1.0, low_open=True)
-        _validate.choice("restitution", restitution, ("newton", "poisson"), "impact law")
+        # drift, drift_bias and restitution are checked by the core (type, value, range)
         record_every = _validate.count("record_every", record_every)
         raw = _core.model_simulate(
             self.dim,
@@ -231,7 +229,7 @@ class Model:
             [float(x) for x in self.v0],
             h, steps, solver=solver, tol=tol, max_iter=max_iter, relaxation=relaxation,
             facets=facets, gap_tolerance=gap_tolerance, warm_start=warm_start,
-            fallback=fallback, drift=drift, drift_bias=float(drift_bias),
+            fallback=fallback, drift=drift, drift_bias=drift_bias,
             restitution=restitution, record_every=record_every,
         )
         return Trajectory._from_core(raw, scene=None, h=h, solver=solver,

@@ -513,9 +513,7 @@ class Scene:
         gap_tolerance = _validate.real("gap_tolerance", gap_tolerance, low=0.0)
         warm_start = _validate.boolean("warm_start", warm_start)
         fallback = _validate.boolean("fallback", fallback)
-        _validate.choice("drift", drift, ("none", "bias", "projection"), "drift correction")
-        drift_bias = _validate.real("drift_bias", drift_bias, low=0.0, high=1.0, low_open=True)
-        _validate.choice("restitution", restitution, ("newton", "poisson"), "impact law")
+        # drift, drift_bias and restitution are checked by the core (type, value, range)
         record_every = _validate.count("record_every", record_every)
         locate_impacts = _validate.boolean("locate_impacts", locate_impacts)
         if not self.bodies:
@@ -524,7 +522,7 @@ class Scene:
         raw = _core.step_simulate(
             spec, h, steps, solver=solver, tol=tol, max_iter=max_iter, relaxation=relaxation,
             facets=facets, gap_tolerance=gap_tolerance, warm_start=warm_start,
-            fallback=fallback, drift=drift, drift_bias=float(drift_bias),
+            fallback=fallback, drift=drift, drift_bias=drift_bias,
             restitution=restitution, record_every=record_every,
             locate_impacts=locate_impacts,
         )

@@ -16,6 +16,7 @@ static INVALID_PARAMETER_ERROR: PyOnceLock<Py<PyType>> = PyOnceLock::new();
 static TOO_LARGE_ERROR: PyOnceLock<Py<PyType>> = PyOnceLock::new();
 static FORMAT_ERROR: PyOnceLock<Py<PyType>> = PyOnceLock::new();
 static INTERNAL_ERROR: PyOnceLock<Py<PyType>> = PyOnceLock::new();
+static ARGUMENT_TYPE_ERROR: PyOnceLock<Py<PyType>> = PyOnceLock::new();
 
 fn raise(py: Python<'_>, cell: &PyOnceLock<Py<PyType>>, name: &str, msg: String) -> PyErr {
     match cell.import(py, "coulomb.errors", name) {
@@ -54,6 +55,12 @@ thread_local! {
     /// the exception `py.check_signals()` raised inside a solve, raised when the solve ends.
     pub(super) static PENDING_SIGNAL: std::cell::RefCell<Option<PyErr>> =
         const { std::cell::RefCell::new(None) };
+}
+
+/// `coulomb.errors.ArgumentTypeError` (an `InvalidParameterError` and a `TypeError`) for a
+/// keyword of the wrong type, checked by the core (see `super::settings::Keyword`).
+pub(super) fn argument_type(py: Python<'_>, msg: String) -> PyErr {
+    raise(py, &ARGUMENT_TYPE_ERROR, "ArgumentTypeError", msg)
 }
 
 /// `coulomb.errors.InternalError` for a Rust panic (a `RuntimeError` subclass; a plain

@@ -8,6 +8,7 @@ use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+use super::settings::Keyword;
 use super::step::{settings_from, trajectory_dict};
 use super::{guarded, to_py};
 use crate::error::{CoulombError, Result};
@@ -129,8 +130,15 @@ impl GeneralizedSystem for PySystem {
 #[pyfunction]
 #[pyo3(signature = (dim, laws, mass, force, contacts, potential, q0, v0, h, steps,
                     solver="nsgs", tol=1e-12, max_iter=None, relaxation=1.0, facets=None,
-                    gap_tolerance=1e-9, warm_start=true, fallback=true, drift="none",
-                    drift_bias=0.2, restitution="newton", record_every=1))]
+                    gap_tolerance=1e-9, warm_start=true, fallback=true,
+                    drift=Keyword::Default("none"), drift_bias=Keyword::Default(0.2),
+                    restitution=Keyword::Default("newton"), record_every=1))]
+#[pyo3(
+    text_signature = "(dim, laws, mass, force, contacts, potential, q0, v0, h, steps, \
+                         solver='nsgs', tol=1e-12, max_iter=None, relaxation=1.0, \
+                         facets=None, gap_tolerance=1e-09, warm_start=True, fallback=True, \
+                         drift='none', drift_bias=0.2, restitution='newton', record_every=1)"
+)]
 #[allow(clippy::too_many_arguments)]
 pub(super) fn model_simulate<'py>(
     py: Python<'py>,
@@ -152,9 +160,9 @@ pub(super) fn model_simulate<'py>(
     gap_tolerance: f64,
     warm_start: bool,
     fallback: bool,
-    drift: &str,
-    drift_bias: f64,
-    restitution: &str,
+    drift: Keyword<&'static str>,
+    drift_bias: Keyword<f64>,
+    restitution: Keyword<&'static str>,
     record_every: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
     let settings = settings_from(
@@ -170,9 +178,9 @@ pub(super) fn model_simulate<'py>(
         gap_tolerance,
         warm_start,
         fallback,
-        drift,
-        drift_bias,
-        restitution,
+        &drift,
+        &drift_bias,
+        &restitution,
         false,
     )?;
     let mut system = PySystem {

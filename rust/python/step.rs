@@ -8,12 +8,13 @@ use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString};
 
-use super::{guarded, settings, to_py};
+use super::settings::{self, Keyword};
+use super::{guarded, to_py};
 use crate::contact::ContactOrder;
 use crate::error::CoulombError;
 use crate::step::{
-    simulate_recorded, Body, BodyKind, Drift, HalfSpace, Pair, Restitution, Scene, Shape,
-    StepSettings, StepSolver, Trajectory,
+    simulate_recorded, Body, BodyKind, HalfSpace, Pair, Scene, Shape, StepSettings, StepSolver,
+    Trajectory,
 };
 
 fn item<'py, T: FromPyObjectOwned<'py>>(d: &Bound<'py, PyDict>, key: &str) -> PyResult<T> {
@@ -149,9 +150,9 @@ pub(super) fn settings_from(
     gap_tolerance: f64,
     warm_start: bool,
     fallback: bool,
-    drift: &str,
-    drift_bias: f64,
-    restitution: &str,
+    drift: &Keyword<&'static str>,
+    drift_bias: &Keyword<f64>,
+    restitution: &Keyword<&'static str>,
     locate_impacts: bool,
 ) -> PyResult<StepSettings> {
     let solver = match solver {
@@ -173,31 +174,8 @@ pub(super) fn settings_from(
             ))
         }
     };
-    let drift = match drift {
-        "none" => Drift::None,
-        "bias" => Drift::VelocityBias(drift_bias),
-        "projection" => Drift::Projection,
-        other => {
-            return Err(to_py(
-                py,
-                CoulombError::InvalidParameter(format!(
-                    "unknown drift correction {other:?}: expected 'none', 'bias' or 'projection'"
-                )),
-            ))
-        }
-    };
-    let restitution = match restitution {
-        "newton" => Restitution::Newton,
-        "poisson" => Restitution::Poisson,
-        other => {
-            return Err(to_py(
-                py,
-                CoulombError::InvalidParameter(format!(
-                    "unknown restitution law {other:?}: expected 'newton' or 'poisson'"
-                )),
-            ))
-        }
-    };
+    let drift = settings::drift(py, drift, drift_bias)?;
+    let restitution = settings::restitution(py, restitution)?;
     Ok(StepSettings {
         h,
         steps,
@@ -336,8 +314,15 @@ pub(super) fn trajectory_dict<'py>(
 #[pyfunction]
 #[pyo3(signature = (scene, h, steps, solver="nsgs", tol=1e-12, max_iter=None, relaxation=1.0,
                     facets=None, gap_tolerance=1e-9, warm_start=true, fallback=true,
-                    drift="none", drift_bias=0.2, restitution="newton", record_every=1,
+                    drift=Keyword::Default("none"), drift_bias=Keyword::Default(0.2),
+                    restitution=Keyword::Default("newton"), record_every=1,
                     locate_impacts=false))]
+#[pyo3(
+    text_signature = "(scene, h, steps, solver='nsgs', tol=1e-12, max_iter=None, \
+                         relaxation=1.0, facets=None, gap_tolerance=1e-09, warm_start=True, \
+                         fallback=True, drift='none', drift_bias=0.2, restitution='newton', \
+                         record_every=1, locate_impacts=False)"
+)]
 #[allow(clippy::too_many_arguments)]
 pub(super) fn step_simulate<'py>(
     py: Python<'py>,
@@ -352,9 +337,9 @@ pub(super) fn step_simulate<'py>(
     gap_tolerance: f64,
     warm_start: bool,
     fallback: bool,
-    drift: &str,
-    drift_bias: f64,
-    restitution: &str,
+    drift: Keyword<&'static str>,
+    drift_bias: Keyword<f64>,
+    restitution: Keyword<&'static str>,
     record_every: usize,
     locate_impacts: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
@@ -372,9 +357,9 @@ pub(super) fn step_simulate<'py>(
         gap_tolerance,
         warm_start,
         fallback,
-        drift,
-        drift_bias,
-        restitution,
+        &drift,
+        &drift_bias,
+        &restitution,
         locate_impacts,
     )?;
     let (tr, seconds) = guarded(py, usize::MAX, || {
