@@ -240,6 +240,9 @@ fn status_is_invariant_under_units() {
         }
     }
     println!("{} status changes in {cases} method-cases", changed.len());
+    for (seed, dim, ka, kb, k, a, b) in &changed {
+        println!("  seed {seed} dim {dim} units ({ka}, {kb}) method {k}: {a} | {b}");
+    }
     assert!(
         changed.len() as f64 <= 1.0 + 0.01 * cases as f64,
         "{cases} cases: {changed:?}"

@@ -65,7 +65,10 @@
 
 use super::{measure_into, ContactProblem, ContactSolution, ContactStatus};
 use crate::error::{CoulombError, Result};
-use crate::lcp::{solve_lemke, LcpRef, LcpSolution, LcpStatus, LemkeEngine, LemkeSettings};
+use crate::lcp::{
+    measure as measure_lcp, solve_lemke, LcpRef, LcpSolution, LcpStatus, LemkeEngine,
+    LemkeSettings, WarmStart,
+};
 use crate::readable::Readable;
 
 /// Settings of [`solve_polyhedral`].
@@ -366,6 +369,59 @@ fn other_paths(s: &LemkeSettings, n: usize) -> Vec<LemkeSettings> {
     out
 }
 
+/// The LCP's answer when every contact's free normal velocity is `q_n >= 0`: then `r = 0`
+/// solves the contact problem exactly (Signorini's condition holds with `u = q`, and De
+/// Saxce's `u + mu ||u_t|| n` lies in the dual cone exactly when `u_n >= 0`), and the
+/// polyhedral LCP too, with `z = (0, 0, λ)`, each contact's `z_λ = max(0, max_k -b_k) / c_i`
+/// over its β rows `b_k = d_k . q_t` (the least sliding speed for which every
+/// `w_β = b + c_i z_λ 1` is `>= 0`; `w_λ = 0`). Only the signs of `q_n` decide, so the answer
+/// does not depend on the units; Lemke's path is not needed for it, and on such an LCP (its
+/// λ rows start degenerate, `b = 0`) it could end on a ray in some roundings of the data
+/// (a one-contact problem with mu = 0.5 solved in 5 pivots with W and q as given and ended
+/// on a ray with both times 1.5). `None` when some `q_n < 0` or the answer misses `tol` on
+/// the LCP.
+fn separating_answer(
+    problem: &ContactProblem<'_>,
+    lcp: &PolyhedralLcp,
+    lref: &LcpRef<'_>,
+    tol: f64,
+) -> Result<Option<LcpSolution>> {
+    // q is finite (checked when the problem was made)
+    if (0..problem.nc).any(|i| problem.q[i * problem.dim] < 0.0) {
+        return Ok(None);
+    }
+    let mut z = vec![0.0; lcp.n];
+    let mut basis = Vec::new();
+    for i in 0..problem.nc {
+        if let Some(l) = lcp.lambda[i] {
+            let need = lcp.beta_range(i).map(|k| -lcp.q[k]).fold(0.0f64, f64::max);
+            if need > 0.0 {
+                z[l] = need / lcp.unit[i];
+                basis.push(l);
+            }
+        }
+    }
+    let (w, measures) = measure_lcp(lref, &z)?;
+    if !crate::lcp::passes(&measures, tol) {
+        return Ok(None);
+    }
+    Ok(Some(LcpSolution {
+        z,
+        w,
+        status: LcpStatus::Solved,
+        message: "solved without pivots: every contact has q_n >= 0, so r = 0".into(),
+        measures,
+        pivots: 0,
+        iterations: 0,
+        basis,
+        warm_start: WarmStart::None,
+        pivots_saved: 0,
+        polished: false,
+        restarts: 0,
+        solutions: Vec::new(),
+    }))
+}
+
 /// Solves the friction-contact problem on the polyhedral cone by Lemke's method (see the
 /// module notes), returning the impulses together with the LCP answer itself.
 pub fn solve_polyhedral_lcp(
@@ -380,7 +436,12 @@ pub fn solve_polyhedral_lcp(
         ls.status == LcpStatus::Solved
             && (problem.dim != 2 || measure_into(problem, r, u).passes(tol))
     };
-    let mut ls = solve_lemke(&lref, &settings.lemke)?;
+    // the settings are checked before the shortcut as Lemke would check them
+    crate::lcp::lemke::validate(&lref, &settings.lemke)?;
+    let mut ls = match separating_answer(problem, &lcp, &lref, tol)? {
+        Some(ls) => ls,
+        None => solve_lemke(&lref, &settings.lemke)?,
+    };
     let mut r = lcp.impulses(&ls.z);
     let mut pivots = ls.pivots;
     if !accepted(&ls, &r, &mut u) {
@@ -496,6 +557,46 @@ mod tests {
         assert_eq!(lcp.n, 2 + 4 + 1);
         assert!(lcp.beta_range(0).is_empty() && lcp.lambda_index(0).is_none());
         assert_eq!(lcp.beta_range(1), 2..6);
+    }
+
+    #[test]
+    fn a_separating_contact_is_solved_by_r_zero_at_every_scale() {
+        // one 3D contact with q_n > 0 and a rank-one W (a property-campaign problem: Lemke's
+        // path solved it in 5 pivots as given and ended on a ray with W and q times 1.5)
+        let w = [
+            0.001948617127454721,
+            -0.004570668695008731,
+            -0.007923598007756147,
+            -0.004570668695008731,
+            0.010720942572654385,
+            0.018585560424171164,
+            -0.007923598007756147,
+            0.018585560424171164,
+            0.032219467079469176,
+        ];
+        let q = [
+            7.730056310357876e-5,
+            -0.5800086400240654,
+            -0.03566910061094476,
+        ];
+        for c in [1.0, 1.5, 0.75, 3.0, 1e8, 1e-8] {
+            let wc: Vec<f64> = w.iter().map(|x| x * c).collect();
+            let qc: Vec<f64> = q.iter().map(|x| x * c).collect();
+            let p = ContactProblem::new(3, &wc, &qc, &[0.5]).unwrap();
+            let (sol, lcp, ls) = solve_polyhedral_lcp(&p, &PolyhedralSettings::for_dim(3)).unwrap();
+            assert_eq!(sol.status, ContactStatus::Solved, "{c}: {}", sol.message);
+            assert_eq!(sol.impulse, vec![0.0; 3]);
+            assert_eq!(ls.pivots, 0);
+            // the LCP's w = A z + b is >= 0 and complementary to z, exactly
+            let l = lcp.lambda_index(0).unwrap();
+            assert!(ls.z[l] > 0.0 && ls.w[l] == 0.0);
+            assert!(ls.w.iter().all(|&x| x >= 0.0), "{:?}", ls.w);
+            assert!(ls.z.iter().zip(&ls.w).all(|(a, b)| a * b == 0.0));
+        }
+        // a contact that approaches is not taken for separated
+        let p = ContactProblem::new(3, &w, &[-1e-3, 0.1, 0.0], &[0.5]).unwrap();
+        let (sol, _, ls) = solve_polyhedral_lcp(&p, &PolyhedralSettings::for_dim(3)).unwrap();
+        assert!(ls.pivots > 0 || sol.impulse[0] > 0.0, "{}", sol.message);
     }
 
     #[test]

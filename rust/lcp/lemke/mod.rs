@@ -111,7 +111,9 @@ enum Ending {
 /// the most covering vectors Lemke tries after the first ([`LemkeSettings::restarts`]).
 pub const MAX_RESTARTS: usize = 1000;
 
-fn validate(lcp: &LcpRef<'_>, s: &LemkeSettings) -> Result<()> {
+/// checks the settings against the LCP before any work: tol, the covering vector, the warm
+/// start's indices, the pivot and restart counts.
+pub(crate) fn validate(lcp: &LcpRef<'_>, s: &LemkeSettings) -> Result<()> {
     check_tol(s.tol)?;
     if let Some(d) = &s.covering_vector {
         if d.len() != lcp.n {
