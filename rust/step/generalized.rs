@@ -599,12 +599,7 @@ pub fn simulate_generalized<S: GeneralizedSystem>(
             pending = Some(rec);
             continue;
         }
-        crate::limits::check_bytes(
-            &format!("recording {} contact records", out.contacts.len()),
-            out.contacts.len(),
-            std::mem::size_of::<ContactRecord>(),
-            "record fewer states with record_every",
-        )?;
+        super::record::check_contact_records(out.contacts.len())?;
         out.steps.push(rec);
         st.push_state(&mut out, &mut load_power)?;
     }

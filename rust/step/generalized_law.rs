@@ -5,7 +5,6 @@
 //! same solve (NSGS with its fallbacks, or Lemke) over the dense or block-sparse W.
 
 use super::super::law::{curvature_term, normal_term, solve_phases, warm_start_of, Phases};
-use super::super::solve::SPARSE_FROM;
 use super::super::Active;
 use super::{dot, GeneralizedStepper, GeneralizedSystem};
 use crate::error::{check_finite, Result};
@@ -74,12 +73,6 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
     /// by contact, Poisson's impact phase when it has work, then the step's solve.
     pub(super) fn solve_contacts(&mut self, record: &mut StepRecord) -> Result<()> {
         let dim = self.dim;
-        let nc = self.active.len();
-        let w_sparse = if nc >= SPARSE_FROM {
-            Some(self.delassus.block_csr()?)
-        } else {
-            None
-        };
         let mut initial = std::mem::take(&mut self.initial);
         let corrected = warm_start_of(&self.settings, dim, &self.active, &self.state, &mut initial);
         let mut basis = std::mem::take(&mut self.basis_guess);
@@ -90,12 +83,13 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
                 .extend(self.active.iter().map(|a| self.laws[a.cand].1));
         }
         let mut p_impact = std::mem::take(&mut self.p_impact);
+        let (dense, sparse) = self.delassus.storage()?;
         let out = solve_phases(
             &Phases {
                 settings: &self.settings,
                 dim,
-                dense: self.delassus.dense(),
-                sparse: w_sparse.as_ref(),
+                dense,
+                sparse,
                 active: &self.active,
                 e: &self.restitution,
                 q1: &self.q1,

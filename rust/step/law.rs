@@ -18,15 +18,7 @@ impl Stepper {
     /// phase's are added to).
     pub(super) fn solve_contacts(&mut self, record: &mut StepRecord) -> Result<()> {
         let dim = self.dim;
-        let nc = self.active.len();
         self.assemble(record);
-        // W's storage: dense for few contacts, block CSR for many
-        let w_sparse = if nc >= SPARSE_FROM {
-            // every contact's diagonal block is present (a contact touches a body)
-            Some(self.delassus.block_csr()?)
-        } else {
-            None
-        };
         let mut initial = std::mem::take(&mut self.initial);
         let corrected = warm_start_of(&self.settings, dim, &self.active, &self.state, &mut initial);
         let mut basis = std::mem::take(&mut self.basis_guess);
@@ -37,12 +29,14 @@ impl Stepper {
             restitution.extend(self.active.iter().map(|a| self.candidates[a.cand].e));
         }
         let mut p_impact = std::mem::take(&mut self.p_impact);
+        // W's storage: dense for few contacts, block CSR for many
+        let (dense, sparse) = self.delassus.storage()?;
         let out = solve_phases(
             &Phases {
                 settings: &self.settings,
                 dim,
-                dense: self.delassus.dense(),
-                sparse: w_sparse.as_ref(),
+                dense,
+                sparse,
                 active: &self.active,
                 e: &restitution,
                 q1: &self.q1,

@@ -178,16 +178,29 @@ pub fn simulate_recorded(
             pending = Some(rec);
             continue;
         }
-        crate::limits::check_bytes(
-            &format!("recording {} contact records", out.contacts.len()),
-            out.contacts.len(),
-            std::mem::size_of::<ContactRecord>(),
-            "record fewer states with record_every",
-        )?;
+        check_contact_records(out.contacts.len())?;
         out.steps.push(rec);
         st.push_state(&mut out);
     }
     Ok(out)
+}
+
+/// the contact records' size against the memory budget ([`crate::limits::check_bytes`]), its
+/// message formed only when refused (the check runs after every recorded step).
+pub(super) fn check_contact_records(count: usize) -> Result<()> {
+    let item = std::mem::size_of::<ContactRecord>();
+    let within = count
+        .checked_mul(item)
+        .is_some_and(|b| b <= crate::limits::memory_budget());
+    if !within {
+        crate::limits::check_bytes(
+            &format!("recording {count} contact records"),
+            count,
+            item,
+            "record fewer states with record_every",
+        )?;
+    }
+    Ok(())
 }
 
 impl StepRecord {
