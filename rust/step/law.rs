@@ -103,10 +103,11 @@ impl Stepper {
         self.mu.clear();
         self.poisson_impact = false;
         for i in 0..nc {
-            let ai = self.active[i];
-            let cand = self.candidates[ai.cand];
-            let st = self.state[ai.cand];
-            self.mu.push(cand.mu);
+            // by reference: an active contact carries its G and M^{-1} G columns
+            let ai = &self.active[i];
+            let c = ai.cand;
+            let (mu, e) = (self.candidates[c].mu, self.candidates[c].e);
+            self.mu.push(mu);
             // q_c = G^T v_free (and q_1 = G^T v_k for Poisson's impact phase), then the
             // normal's restitution or gap term
             for si in &ai.sides[..ai.nsides] {
@@ -119,15 +120,15 @@ impl Stepper {
             let bound = normal_term(
                 &self.settings,
                 &mut self.active[i],
-                &st,
-                cand.e,
+                &self.state[c],
+                e,
                 &mut self.q1[i * dim],
                 &mut self.poisson_impact,
                 record,
             );
             // the gap's second-order remainder over the step on v_free (module `narrow`)
-            let c = self.gap_curvature(ai.cand, &self.geo_cache[ai.cand], &self.v_free);
-            self.qc[i * dim] += bound + curvature_term(c, h);
+            let curvature = self.gap_curvature(c, &self.geo_cache[c], &self.v_free);
+            self.qc[i * dim] += bound + curvature_term(curvature, h);
         }
     }
 }
