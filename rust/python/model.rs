@@ -130,7 +130,8 @@ impl GeneralizedSystem for PySystem {
 #[pyo3(signature = (dim, laws, mass, force, contacts, potential, q0, v0, h, steps,
                     solver="nsgs", tol=1e-12, max_iter=None, relaxation=1.0, facets=None,
                     gap_tolerance=1e-9, warm_start=true, fallback=true, drift="none",
-                    drift_bias=0.2, restitution="newton", record_every=1))]
+                    drift_bias=0.2, restitution="newton", record_every=1,
+                    locate_impacts=false))]
 #[allow(clippy::too_many_arguments)]
 pub(super) fn model_simulate<'py>(
     py: Python<'py>,
@@ -156,6 +157,7 @@ pub(super) fn model_simulate<'py>(
     drift_bias: f64,
     restitution: &str,
     record_every: usize,
+    locate_impacts: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let settings = settings_from(
         py,
@@ -173,7 +175,7 @@ pub(super) fn model_simulate<'py>(
         drift,
         drift_bias,
         restitution,
-        false,
+        locate_impacts,
     )?;
     let mut system = PySystem {
         dim,

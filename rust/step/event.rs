@@ -35,15 +35,15 @@
 //! the rebound to the next one, which then fell back to the plain law (O(h) energy).
 
 use super::bodies::displace_body;
-use super::{frame, ContactRecord, Geometry, Restitution, StepRecord, Stepper};
+use super::{frame, ContactRecord, Geometry, Restitution, StepRecord, StepSettings, Stepper};
 use crate::contact::{solve_nsgs, ContactProblem, NsgsSettings};
 use crate::error::Result;
 
 /// samples of the path per step before bisection.
-const SAMPLES: usize = 16;
+pub(super) const SAMPLES: usize = 16;
 
 /// bisection steps on the impact instant (to rounding of h).
-const BISECTIONS: usize = 64;
+pub(super) const BISECTIONS: usize = 64;
 
 /// What a located step did (module docs).
 pub(super) enum Located {
@@ -56,19 +56,86 @@ pub(super) enum Located {
 }
 
 /// the impact of a located step: contact, instant, impulse and velocities.
-struct Hit {
+pub(super) struct Hit {
     /// index into the step's active contacts.
-    active: usize,
+    pub(super) active: usize,
     /// the impulse, contact frame.
-    impulse: [f64; 3],
+    pub(super) impulse: [f64; 3],
     /// the approach normal velocity.
-    approach: f64,
+    pub(super) approach: f64,
     /// the contact velocity after the impact.
-    velocity: [f64; 3],
-    error: f64,
-    scaled_error: f64,
-    iterations: usize,
-    residual: f64,
+    pub(super) velocity: [f64; 3],
+    pub(super) error: f64,
+    pub(super) scaled_error: f64,
+    pub(super) iterations: usize,
+    /// the momentum balance `M dv = G P` at the impact, relative to `|G P|`.
+    pub(super) residual: f64,
+}
+
+/// The impulse of one contact's impact (W its `dim x dim` Delassus block row-major, u its
+/// contact velocity before), shared by the scenes' and the models' located steps: Newton's
+/// law `0 <= P_n ⊥ u_n^+ + e min(u_n^-, 0) >= 0` with Coulomb friction by NSGS on the single
+/// contact, or Poisson's by Routh's method (module `poisson`); with the solve's error, scaled
+/// error and iterations.
+pub(super) fn impact_law(
+    settings: &StepSettings,
+    dim: usize,
+    w: &[f64; 9],
+    u: [f64; 3],
+    mu: f64,
+    e: f64,
+) -> Result<([f64; 3], (f64, f64), usize)> {
+    match settings.restitution {
+        Restitution::Poisson => {
+            let mut w3 = [[0.0; 3]; 3];
+            for a in 0..dim {
+                for c in 0..dim {
+                    w3[a][c] = w[a * dim + c];
+                }
+            }
+            Ok((super::routh(dim, &w3, u, mu, e, 0.0), (0.0, 0.0), 0))
+        }
+        Restitution::Newton => {
+            let mut q = u;
+            q[0] += e * u[0].min(0.0);
+            let mu = [mu];
+            let problem = ContactProblem::new(dim, &w[..dim * dim], &q[..dim], &mu)?;
+            let nsgs = NsgsSettings {
+                tol: 1e-14,
+                max_iter: 100,
+                ..NsgsSettings::default()
+            };
+            let sol = solve_nsgs(&problem, &nsgs)?;
+            let mut p = [0.0; 3];
+            p[..dim].copy_from_slice(&sol.impulse);
+            Ok((
+                p,
+                (sol.measures.error, sol.measures.scaled_error),
+                sol.iterations,
+            ))
+        }
+    }
+}
+
+/// The step record of a located impact (one contact, friction `mu`, restitution `e`), shared
+/// by both drivers: the law's verdict, the momentum balance, the cone violation and Newton's
+/// complementarity `|P_n (u_n^+ + e u_n^-)|` (0 for Poisson's law, exact by construction).
+pub(super) fn located_record(settings: &StepSettings, hit: &Hit, mu: f64, e: f64) -> StepRecord {
+    let pt = (hit.impulse[1] * hit.impulse[1] + hit.impulse[2] * hit.impulse[2]).sqrt();
+    let bound = match settings.restitution {
+        Restitution::Newton => hit.velocity[0] + e * hit.approach,
+        Restitution::Poisson => 0.0,
+    };
+    let mut record = Stepper::blank_record(1);
+    record.status = Some(crate::contact::ContactStatus::Solved);
+    record.error = hit.error;
+    record.scaled_error = hit.scaled_error;
+    record.iterations = hit.iterations;
+    record.momentum_residual = hit.residual;
+    record.min_normal_impulse = hit.impulse[0];
+    record.cone_violation = (pt - mu * hit.impulse[0]).max(0.0);
+    record.complementarity = (hit.impulse[0] * bound).abs();
+    record
 }
 
 impl Stepper {
@@ -237,7 +304,7 @@ impl Stepper {
         }
         let approach = u[0].min(0.0);
         let (impulse, (error, scaled_error), iterations) =
-            self.impact_law(&w, u, cand.mu, cand.e)?;
+            impact_law(&self.settings, dim, &w, u, cand.mu, cand.e)?;
         // v+ = q'(s*) + M^{-1} G P, and the momentum balance M dv = G P at q(s*)
         let mut residual: f64 = 0.0;
         let mut scale: f64 = 0.0;
@@ -306,49 +373,6 @@ impl Stepper {
         (cols, bcols)
     }
 
-    /// the impulse of one contact's impact (W its `dim x dim` Delassus block row-major, u its
-    /// contact velocity before): Newton's law by NSGS on the single contact, or Poisson's by
-    /// Routh's method; with the solve's error and iterations.
-    fn impact_law(
-        &self,
-        w: &[f64; 9],
-        u: [f64; 3],
-        mu: f64,
-        e: f64,
-    ) -> Result<([f64; 3], (f64, f64), usize)> {
-        let dim = self.dim;
-        match self.settings.restitution {
-            Restitution::Poisson => {
-                let mut w3 = [[0.0; 3]; 3];
-                for a in 0..dim {
-                    for c in 0..dim {
-                        w3[a][c] = w[a * dim + c];
-                    }
-                }
-                Ok((super::routh(dim, &w3, u, mu, e, 0.0), (0.0, 0.0), 0))
-            }
-            Restitution::Newton => {
-                let mut q = u;
-                q[0] += e * u[0].min(0.0);
-                let mu = [mu];
-                let problem = ContactProblem::new(dim, &w[..dim * dim], &q[..dim], &mu)?;
-                let settings = NsgsSettings {
-                    tol: 1e-14,
-                    max_iter: 100,
-                    ..NsgsSettings::default()
-                };
-                let sol = solve_nsgs(&problem, &settings)?;
-                let mut p = [0.0; 3];
-                p[..dim].copy_from_slice(&sol.impulse);
-                Ok((
-                    p,
-                    (sol.measures.error, sol.measures.scaled_error),
-                    sol.iterations,
-                ))
-            }
-        }
-    }
-
     /// the records of a located step, the contacts' states, and the clock.
     fn finish_located(&mut self, hit: Hit, contacts: &mut Vec<ContactRecord>) -> StepRecord {
         let dim = self.dim;
@@ -370,20 +394,7 @@ impl Stepper {
             gap: a.gap,
             closed: true,
         });
-        let pt = (hit.impulse[1] * hit.impulse[1] + hit.impulse[2] * hit.impulse[2]).sqrt();
-        let bound = match self.settings.restitution {
-            Restitution::Newton => hit.velocity[0] + cand.e * hit.approach,
-            Restitution::Poisson => 0.0,
-        };
-        let mut record = Self::blank_record(1);
-        record.status = Some(crate::contact::ContactStatus::Solved);
-        record.error = hit.error;
-        record.scaled_error = hit.scaled_error;
-        record.iterations = hit.iterations;
-        record.momentum_residual = hit.residual;
-        record.min_normal_impulse = hit.impulse[0];
-        record.cone_violation = (pt - cand.mu * hit.impulse[0]).max(0.0);
-        record.complementarity = (hit.impulse[0] * bound).abs();
+        let record = located_record(&self.settings, &hit, cand.mu, cand.e);
         self.step_index += 1;
         self.t = self.step_index as f64 * self.settings.h;
         record

@@ -20,10 +20,12 @@
 //! records ([`Trajectory`], whose `scaled_error` carries each step's verdict). W is assembled
 //! by the one assembly, [`crate::contact::assembly::WAssembly`].
 //!
-//! A system's callbacks may fail (a user function raising): the error stops the run and is
-//! returned as it is. Located impacts ([`StepSettings::locate_impacts`]) are scenes' only.
+//! With [`StepSettings::locate_impacts`] an isolated impact is located within its step as
+//! for scenes (module `generalized_event`). A system's callbacks may fail (a user function
+//! raising): the error stops the run and is returned as it is.
 
 use super::super::impact::ImpactMemory;
+use super::event::Located;
 use super::persistence::CandState;
 use super::solve::{SolveBuffers, SPARSE_FROM};
 use super::{Active, ContactRecord, StepRecord, Stepper, Trajectory, TINY};
@@ -33,6 +35,8 @@ use crate::step::{Drift, StepSettings};
 
 #[path = "generalized_drift.rs"]
 mod generalized_drift;
+#[path = "generalized_event.rs"]
+mod generalized_event;
 #[path = "generalized_law.rs"]
 mod generalized_law;
 
@@ -133,19 +137,17 @@ pub struct GeneralizedStepper<S: GeneralizedSystem> {
     solve: SolveBuffers,
     gp: Vec<f64>,
     v_next: Vec<f64>,
+    /// `(q_k, v_k)` while a located step follows its path (module `generalized_event`), and
+    /// whether `m` and `chol` were factored on the path since.
+    saved_q: Vec<f64>,
+    saved_v: Vec<f64>,
+    mass_moved: bool,
 }
 
 impl<S: GeneralizedSystem> GeneralizedStepper<S> {
     /// Checks the settings and the system's sizes and laws, and sizes every workspace.
     pub fn new(system: S, q0: &[f64], v0: &[f64], settings: &StepSettings) -> Result<Self> {
         settings.validate()?;
-        if settings.locate_impacts {
-            return Err(CoulombError::InvalidParameter(
-                "located impacts are available for scenes only, not for models in generalized \
-                 coordinates"
-                    .into(),
-            ));
-        }
         let (dim, nv) = (system.dim(), system.nv());
         if dim != 2 && dim != 3 {
             return Err(CoulombError::InvalidParameter(format!(
@@ -205,6 +207,9 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
             solve: SolveBuffers::default(),
             gp: vec![0.0; nv],
             v_next: vec![0.0; nv],
+            saved_q: vec![0.0; nv],
+            saved_v: vec![0.0; nv],
+            mass_moved: false,
             laws,
         })
     }
@@ -283,12 +288,22 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
     pub fn step(&mut self, contacts: &mut Vec<ContactRecord>) -> Result<StepRecord> {
         self.prepare()?;
         self.search_contacts();
+        let mut free = false;
+        if self.settings.locate_impacts {
+            match self.located_step(contacts)? {
+                Located::Done(record) => return Ok(record),
+                Located::Free => free = true,
+                Located::Plain => {}
+            }
+        }
         let nc = self.active.len();
         let mut record = Stepper::blank_record(nc);
         let mut v_next = std::mem::take(&mut self.v_next);
         v_next.copy_from_slice(&self.v_free);
         self.gp.fill(0.0);
-        if nc > 0 {
+        if nc > 0 && free {
+            self.free_of_contacts(&mut record);
+        } else if nc > 0 {
             self.assemble(&mut record)?;
             self.solve_contacts(&mut record)?;
             self.apply_impulses(&mut v_next);
