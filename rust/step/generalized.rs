@@ -27,8 +27,9 @@
 use super::super::impact::ImpactMemory;
 use super::event::Located;
 use super::persistence::CandState;
+use super::record::{run_recorded, Recorded};
 use super::solve::{SolveBuffers, SPARSE_FROM};
-use super::{Active, ContactRecord, StepRecord, Stepper, Trajectory, TINY};
+use super::{Active, ContactRecord, StepRecord, Stepper, Trajectory};
 use crate::contact::assembly::{cholesky_in_place, solve_cholesky, WAssembly};
 use crate::error::{check_finite, CoulombError, Result};
 use crate::step::{Drift, StepSettings};
@@ -142,6 +143,23 @@ pub struct GeneralizedStepper<S: GeneralizedSystem> {
     saved_q: Vec<f64>,
     saved_v: Vec<f64>,
     mass_moved: bool,
+    /// `f . v` at each recorded state of the run.
+    load_power: Vec<f64>,
+}
+
+impl<S: GeneralizedSystem> Recorded for GeneralizedStepper<S> {
+    fn step(&mut self, contacts: &mut Vec<ContactRecord>) -> Result<StepRecord> {
+        GeneralizedStepper::step(self, contacts)
+    }
+    fn record_state(&mut self, out: &mut Trajectory) -> Result<()> {
+        self.push_state(out)
+    }
+    fn state_finite(&self) -> bool {
+        self.v.iter().chain(self.q.iter()).all(|x| x.is_finite())
+    }
+    fn step_cost(&self) -> usize {
+        self.nv * self.nv + 64
+    }
 }
 
 impl<S: GeneralizedSystem> GeneralizedStepper<S> {
@@ -210,6 +228,7 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
             saved_q: vec![0.0; nv],
             saved_v: vec![0.0; nv],
             mass_moved: false,
+            load_power: Vec::new(),
             laws,
         })
     }
@@ -429,31 +448,10 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
         }
     }
 
-    /// `||M (v_{k+1} - v_free) - G P||` relative to `max(||G P||, ||M v_free||,
-    /// ||M v_{k+1}||)` (the absolute norm when all are zero).
+    /// the momentum balance of the step ([`super::record::momentum_residual`]), M one block.
     fn momentum_residual(&self, v_next: &[f64]) -> f64 {
-        let nv = self.nv;
-        let (mut res2, mut gp2, mut mf2, mut mn2) = (0.0, 0.0, 0.0, 0.0);
-        for a in 0..nv {
-            let row = &self.m[a * nv..(a + 1) * nv];
-            let (mut mdv, mut mf, mut mn) = (0.0, 0.0, 0.0);
-            for c in 0..nv {
-                mdv += row[c] * (v_next[c] - self.v_free[c]);
-                mf += row[c] * self.v_free[c];
-                mn += row[c] * v_next[c];
-            }
-            let r = mdv - self.gp[a];
-            res2 += r * r;
-            gp2 += self.gp[a] * self.gp[a];
-            mf2 += mf * mf;
-            mn2 += mn * mn;
-        }
-        let scale2 = gp2.max(mf2).max(mn2);
-        if scale2.sqrt() > TINY {
-            (res2 / scale2).sqrt()
-        } else {
-            res2.sqrt()
-        }
+        let blocks = std::iter::once((&self.m[..], self.nv, 0, self.nv));
+        super::record::momentum_residual(blocks, v_next, &self.v_free, &self.gp)
     }
 
     /// Each active contact keeps its impulse, basis and impact record (as the scenes'
@@ -505,7 +503,7 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
     }
 
     /// records the current state into `out` (and `f . v` into `load_power`).
-    fn push_state(&mut self, out: &mut Trajectory, load_power: &mut Vec<f64>) -> Result<()> {
+    fn push_state(&mut self, out: &mut Trajectory) -> Result<()> {
         self.prepare()?;
         out.t.push(self.t);
         out.q.extend_from_slice(&self.q);
@@ -517,7 +515,8 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
             .push(self.gaps.iter().copied().fold(f64::INFINITY, f64::min));
         out.negative_gaps
             .push(self.gaps.iter().filter(|&&g| g < -tol).count());
-        load_power.push(dot(&self.f, &self.v));
+        let power = dot(&self.f, &self.v);
+        self.load_power.push(power);
         Ok(())
     }
 }
@@ -572,52 +571,10 @@ pub fn simulate_generalized<S: GeneralizedSystem>(
         "record fewer states with record_every",
     )?;
     let reserve = rows.min(4096);
-    let mut out = Trajectory {
-        dim: st.dim,
-        nq: nv,
-        nv,
-        t: Vec::with_capacity(reserve),
-        q: Vec::with_capacity(reserve * nv),
-        v: Vec::with_capacity(reserve * nv),
-        kinetic_energy: Vec::with_capacity(reserve),
-        potential_energy: Vec::with_capacity(reserve),
-        min_gap: Vec::with_capacity(reserve),
-        negative_gaps: Vec::with_capacity(reserve),
-        steps: Vec::with_capacity(reserve),
-        contacts: Vec::new(),
-        stopped: None,
-    };
-    let mut load_power = Vec::with_capacity(reserve);
-    st.push_state(&mut out, &mut load_power)?;
-    let mut pending: Option<StepRecord> = None;
-    for k in 0..steps {
-        if crate::interrupt::poll(nv * nv + 64) {
-            break;
-        }
-        let kept = out.contacts.len();
-        let mut rec = st.step(&mut out.contacts)?;
-        if let Some(p) = pending.take() {
-            rec.fold(&p);
-        }
-        let row = out.steps.len();
-        out.contacts[kept..].iter_mut().for_each(|c| c.step = row);
-        if !st.v.iter().chain(st.q.iter()).all(|x| x.is_finite()) {
-            out.stopped = Some(format!(
-                "step {k} produced a non-finite state (contact solver: {})",
-                rec.status.map_or("no contacts", |s| s.as_str())
-            ));
-            out.contacts.truncate(kept);
-            break;
-        }
-        if (k + 1) % every != 0 && k + 1 != steps {
-            out.contacts.truncate(kept);
-            pending = Some(rec);
-            continue;
-        }
-        super::record::check_contact_records(out.contacts.len())?;
-        out.steps.push(rec);
-        st.push_state(&mut out, &mut load_power)?;
-    }
+    let mut out = Trajectory::reserved(st.dim, nv, nv, reserve);
+    st.load_power = Vec::with_capacity(reserve);
+    run_recorded(&mut st, steps, every, &mut out)?;
+    let load_power = std::mem::take(&mut st.load_power);
     Ok(GeneralizedTrajectory {
         trajectory: out,
         load_power,

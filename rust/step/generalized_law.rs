@@ -4,12 +4,12 @@
 //! the gap's curvature term), the warm start and Lemke's guessed basis by contact, then the
 //! same solve (NSGS with its fallbacks, or Lemke) over the dense or block-sparse W.
 
-use super::super::law::{curvature_term, normal_term, solve_phases, warm_start_of, Phases};
-use super::super::Active;
+use super::super::law::{
+    basis_guess, curvature_term, normal_term, solve_phases, warm_start_of, Phases,
+};
 use super::{dot, GeneralizedStepper, GeneralizedSystem};
 use crate::error::{check_finite, Result};
 use crate::step::StepRecord;
-use crate::step::{PolyhedralSettings, StepSolver};
 
 impl<S: GeneralizedSystem> GeneralizedStepper<S> {
     /// `q_c = G^T v_free` plus each contact's restitution, bias or gap term
@@ -76,7 +76,15 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
         let mut initial = std::mem::take(&mut self.initial);
         let corrected = warm_start_of(&self.settings, dim, &self.active, &self.state, &mut initial);
         let mut basis = std::mem::take(&mut self.basis_guess);
-        self.basis_of_active(&mut basis);
+        let laws = &self.laws;
+        basis_guess(
+            &self.settings,
+            dim,
+            &self.active,
+            &self.state,
+            |c| laws[c].0,
+            &mut basis,
+        );
         self.restitution.clear();
         if self.poisson_impact {
             self.restitution
@@ -108,39 +116,5 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
         self.basis_guess = basis;
         self.p_impact = p_impact;
         out
-    }
-
-    /// Lemke's guessed basis from the active contacts' last bases (as the scenes' stepper).
-    fn basis_of_active(&self, out: &mut Vec<usize>) {
-        out.clear();
-        let facets = match &self.settings.solver {
-            StepSolver::Lemke(s) => s.facets,
-            StepSolver::Nsgs(_) => PolyhedralSettings::for_dim(self.dim).facets,
-        };
-        if facets + 2 > 64 || !self.settings.warm_start {
-            return;
-        }
-        let nc = self.active.len();
-        let frictional = |a: &Active| self.laws[a.cand].0 > 0.0;
-        let nf = self.active.iter().filter(|a| frictional(a)).count();
-        let (mut beta, mut lambda) = (nc, nc + nf * facets);
-        for (i, a) in self.active.iter().enumerate() {
-            let bits = self.state[a.cand].basis;
-            if bits & 1 != 0 {
-                out.push(i);
-            }
-            if frictional(a) {
-                for k in 0..facets {
-                    if bits & (1 << (2 + k)) != 0 {
-                        out.push(beta + k);
-                    }
-                }
-                if bits & 2 != 0 {
-                    out.push(lambda);
-                }
-                beta += facets;
-                lambda += 1;
-            }
-        }
     }
 }

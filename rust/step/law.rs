@@ -7,7 +7,10 @@
 use super::super::poisson::{restitution_with_friction, routh};
 use super::persistence::CandState;
 use super::solve::{solve_step_problem, step_problem, SolveBuffers, SPARSE_FROM};
-use super::{dot6, dot_v, Active, Drift, Restitution, StepRecord, StepSettings, Stepper};
+use super::{
+    dot6, dot_v, Active, Drift, PolyhedralSettings, Restitution, StepRecord, StepSettings,
+    StepSolver, Stepper,
+};
 use crate::contact::{BlockCsr, ContactProblem, Delassus};
 use crate::error::Result;
 
@@ -22,7 +25,15 @@ impl Stepper {
         let mut initial = std::mem::take(&mut self.initial);
         let corrected = warm_start_of(&self.settings, dim, &self.active, &self.state, &mut initial);
         let mut basis = std::mem::take(&mut self.basis_guess);
-        self.basis_of_active(&mut basis);
+        let candidates = &self.candidates;
+        basis_guess(
+            &self.settings,
+            dim,
+            &self.active,
+            &self.state,
+            |c| candidates[c].mu,
+            &mut basis,
+        );
         let mut restitution = std::mem::take(&mut self.restitution);
         restitution.clear();
         if self.poisson_impact {
@@ -208,6 +219,50 @@ pub(super) fn warm_start_of(
         initial.extend_from_slice(&state[a.cand].warm[..dim]);
     }
     !initial.is_empty() && active.iter().any(|a| state[a.cand].corrected)
+}
+
+/// The polyhedral LCP's guessed basis from the active contacts' last bases
+/// ([`CandState::basis`]), shared by both drivers, in the layout of
+/// [`crate::contact::polyhedral::PolyhedralLcp`]: normals `0..nc`, then each frictional
+/// contact's `facets` β, then their λ; `mu_of(c)` is candidate c's friction coefficient.
+/// Empty when warm starts are off or a contact's variables do not fit the 64 bits.
+pub(super) fn basis_guess(
+    settings: &StepSettings,
+    dim: usize,
+    active: &[Active],
+    state: &[CandState],
+    mu_of: impl Fn(usize) -> f64,
+    out: &mut Vec<usize>,
+) {
+    out.clear();
+    let facets = match &settings.solver {
+        StepSolver::Lemke(s) => s.facets,
+        StepSolver::Nsgs(_) => PolyhedralSettings::for_dim(dim).facets,
+    };
+    if facets + 2 > 64 || !settings.warm_start {
+        return;
+    }
+    let nc = active.len();
+    let nf = active.iter().filter(|a| mu_of(a.cand) > 0.0).count();
+    let (mut beta, mut lambda) = (nc, nc + nf * facets);
+    for (i, a) in active.iter().enumerate() {
+        let bits = state[a.cand].basis;
+        if bits & 1 != 0 {
+            out.push(i);
+        }
+        if mu_of(a.cand) > 0.0 {
+            for k in 0..facets {
+                if bits & (1 << (2 + k)) != 0 {
+                    out.push(beta + k);
+                }
+            }
+            if bits & 2 != 0 {
+                out.push(lambda);
+            }
+            beta += facets;
+            lambda += 1;
+        }
+    }
 }
 
 /// What a step's contact solve reads once W and the contact terms are built.

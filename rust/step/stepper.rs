@@ -418,35 +418,11 @@ impl Stepper {
         }
     }
 
-    /// the momentum balance `||M (v_{k+1} - v_free) - G P||` relative to the momenta
-    /// involved, `max(||G P||, ||M v_free||, ||M v_{k+1}||)` (rounding is relative to the
-    /// largest; the absolute norm when all are zero).
+    /// the momentum balance of the step ([`record::momentum_residual`]), body by body.
     fn momentum_residual(&self, v_next: &[f64]) -> f64 {
-        let mut res2 = 0.0;
-        let (mut gp2, mut mf2, mut mn2) = (0.0, 0.0, 0.0);
-        for (bi, b) in self.bodies.iter().enumerate() {
-            let m = &self.frozen[bi].m;
-            for a in 0..b.nv {
-                let (mut mdv, mut mf, mut mn) = (0.0, 0.0, 0.0);
-                for c in 0..b.nv {
-                    let (vn, vf) = (v_next[b.off_v + c], self.v_free[b.off_v + c]);
-                    mdv += m[a * 6 + c] * (vn - vf);
-                    mf += m[a * 6 + c] * vf;
-                    mn += m[a * 6 + c] * vn;
-                }
-                let r = mdv - self.gp[b.off_v + a];
-                res2 += r * r;
-                gp2 += self.gp[b.off_v + a] * self.gp[b.off_v + a];
-                mf2 += mf * mf;
-                mn2 += mn * mn;
-            }
-        }
-        let scale2 = gp2.max(mf2).max(mn2);
-        if scale2.sqrt() > TINY {
-            (res2 / scale2).sqrt()
-        } else {
-            res2.sqrt()
-        }
+        let blocks =
+            (self.bodies.iter().zip(&self.frozen)).map(|(b, f)| (&f.m[..], 6, b.off_v, b.nv));
+        record::momentum_residual(blocks, v_next, &self.v_free, &self.gp)
     }
 
     fn push_state(&mut self, out: &mut Trajectory) {
