@@ -35,7 +35,10 @@
 //! the rebound to the next one, which then fell back to the plain law (O(h) energy).
 
 use super::bodies::displace_body;
-use super::{frame, ContactRecord, Geometry, Restitution, StepRecord, StepSettings, Stepper};
+use super::solve::SolveBuffers;
+use super::{
+    frame, Active, ContactRecord, Geometry, Restitution, StepRecord, StepSettings, Stepper,
+};
 use crate::contact::{solve_nsgs, ContactProblem, NsgsSettings};
 use crate::error::Result;
 
@@ -115,6 +118,25 @@ pub(super) fn impact_law(
             ))
         }
     }
+}
+
+/// The contact answer of a free located step, shared by both drivers: zero impulses, which
+/// the contact law on the true gaps (all positive through the step) admits; each contact's
+/// approach is its velocity at the step's start.
+pub(super) fn free_answer(
+    dim: usize,
+    active: &mut [Active],
+    solve: &mut SolveBuffers,
+    record: &mut StepRecord,
+) {
+    solve.impulse.clear();
+    solve.impulse.resize(active.len() * dim, 0.0);
+    solve.basis.clear();
+    solve.corrected = false;
+    for a in active {
+        a.approach = a.vn_k;
+    }
+    record.status = Some(crate::contact::ContactStatus::Solved);
 }
 
 /// The step record of a located impact (one contact, friction `mu`, restitution `e`), shared
@@ -229,18 +251,9 @@ impl Stepper {
         Ok(Located::Done(self.finish_located(hit, contacts)))
     }
 
-    /// the contact answer of a free located step (see [`Located::Free`]): zero impulses,
-    /// which the contact law on the true gaps (all positive through the step) admits.
+    /// the contact answer of a free located step (see [`Located::Free`], [`free_answer`]).
     pub(super) fn free_of_contacts(&mut self, record: &mut StepRecord) {
-        let n = self.active.len() * self.dim;
-        self.solve.impulse.clear();
-        self.solve.impulse.resize(n, 0.0);
-        self.solve.basis.clear();
-        self.solve.corrected = false;
-        for a in &mut self.active {
-            a.approach = a.vn_k;
-        }
-        record.status = Some(crate::contact::ContactStatus::Solved);
+        free_answer(self.dim, &mut self.active, &mut self.solve, record);
     }
 
     /// back to `(q_k, v_k)`, bodies frozen there.

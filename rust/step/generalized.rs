@@ -25,67 +25,26 @@
 //! raising): the error stops the run and is returned as it is.
 
 use super::super::impact::ImpactMemory;
+use super::driver::{self, Driver};
 use super::event::Located;
 use super::persistence::CandState;
 use super::record::{run_recorded, Recorded};
 use super::solve::{SolveBuffers, SPARSE_FROM};
-use super::{Active, ContactRecord, StepRecord, Stepper, Trajectory};
+use super::{Active, ContactRecord, StepRecord, Trajectory};
 use crate::contact::assembly::{cholesky_in_place, solve_cholesky, WAssembly};
 use crate::error::{check_finite, CoulombError, Result};
-use crate::step::{Drift, StepSettings};
+use crate::step::StepSettings;
 
 #[path = "generalized_drift.rs"]
 mod generalized_drift;
 #[path = "generalized_event.rs"]
 mod generalized_event;
+#[path = "generalized_system.rs"]
+mod generalized_system;
+
+pub use self::generalized_system::GeneralizedSystem;
 #[path = "generalized_law.rs"]
 mod generalized_law;
-
-/// A mechanism in generalized coordinates (`dq/dt = v`, so `nq = nv`) whose mass matrix,
-/// forces and contacts the stepper asks for at each state it reaches.
-pub trait GeneralizedSystem {
-    /// 2 (a contact has a normal and one tangent) or 3 (two tangents).
-    fn dim(&self) -> usize;
-    /// the number of generalized coordinates and velocities.
-    fn nv(&self) -> usize;
-    /// per contact, its friction coefficient `mu >= 0` and restitution `e` in `[0, 1]`.
-    fn laws(&self) -> Vec<(f64, f64)>;
-    /// `M(q)`, row-major `nv x nv`, symmetric positive definite, into `m`.
-    fn mass(&mut self, q: &[f64], m: &mut [f64]) -> Result<()>;
-    /// the generalized forces `f(q, v, t)` into `f` (`nv` entries).
-    fn force(&mut self, q: &[f64], v: &[f64], t: f64, f: &mut [f64]) -> Result<()>;
-    /// per contact i its gap `gaps[i]` (> 0 when separated) and the rows of its Jacobian,
-    /// normal first then the tangents, at `rows[(i dim + α) nv ..][..nv]`. Called at each
-    /// state, and once more in a step with active contacts at the predicted state
-    /// `q_k + h v_free` (whose gaps give the gap's second-order term over the step).
-    fn contacts(&mut self, q: &[f64], gaps: &mut [f64], rows: &mut [f64]) -> Result<()>;
-    /// the potential energy `V(q)` of the forces, for the records (0 when not known).
-    fn potential(&mut self, q: &[f64]) -> Result<f64>;
-}
-
-impl<T: GeneralizedSystem + ?Sized> GeneralizedSystem for &mut T {
-    fn dim(&self) -> usize {
-        (**self).dim()
-    }
-    fn nv(&self) -> usize {
-        (**self).nv()
-    }
-    fn laws(&self) -> Vec<(f64, f64)> {
-        (**self).laws()
-    }
-    fn mass(&mut self, q: &[f64], m: &mut [f64]) -> Result<()> {
-        (**self).mass(q, m)
-    }
-    fn force(&mut self, q: &[f64], v: &[f64], t: f64, f: &mut [f64]) -> Result<()> {
-        (**self).force(q, v, t, f)
-    }
-    fn contacts(&mut self, q: &[f64], gaps: &mut [f64], rows: &mut [f64]) -> Result<()> {
-        (**self).contacts(q, gaps, rows)
-    }
-    fn potential(&mut self, q: &[f64]) -> Result<f64> {
-        (**self).potential(q)
-    }
-}
 
 /// relative symmetry tolerance on `M(q)`.
 const SYM_TOL: f64 = 1e-10;
@@ -145,6 +104,62 @@ pub struct GeneralizedStepper<S: GeneralizedSystem> {
     mass_moved: bool,
     /// `f . v` at each recorded state of the run.
     load_power: Vec<f64>,
+}
+
+impl<S: GeneralizedSystem> Driver for GeneralizedStepper<S> {
+    fn settings(&self) -> &StepSettings {
+        &self.settings
+    }
+    fn prepare_state(&mut self) -> Result<()> {
+        self.prepare()
+    }
+    fn search(&mut self) {
+        self.search_contacts();
+    }
+    fn active_len(&self) -> usize {
+        self.active.len()
+    }
+    fn locate(&mut self, contacts: &mut Vec<ContactRecord>) -> Result<Located> {
+        self.located_step(contacts)
+    }
+    fn free_answer(&mut self, record: &mut StepRecord) {
+        self.free_of_contacts(record);
+    }
+    fn solve(&mut self, record: &mut StepRecord) -> Result<()> {
+        self.assemble(record)?;
+        self.solve_contacts(record)
+    }
+    fn start_velocities(&mut self) -> Vec<f64> {
+        let mut v_next = std::mem::take(&mut self.v_next);
+        v_next.copy_from_slice(&self.v_free);
+        self.gp.fill(0.0);
+        v_next
+    }
+    fn apply(&mut self, v_next: &mut [f64]) {
+        self.apply_impulses(v_next);
+    }
+    fn momentum(&self, v_next: &[f64]) -> f64 {
+        self.momentum_residual(v_next)
+    }
+    fn remember(&mut self, v_next: &[f64], contacts: &mut Vec<ContactRecord>) {
+        GeneralizedStepper::remember(self, v_next, contacts);
+    }
+    fn energy(&mut self) -> Result<f64> {
+        GeneralizedStepper::energy(self)
+    }
+    fn advance(&mut self, v_next: Vec<f64>) {
+        self.v.copy_from_slice(&v_next);
+        self.v_next = v_next;
+        let h = self.settings.h;
+        for (q, v) in self.q.iter_mut().zip(&self.v) {
+            *q += h * v;
+        }
+        self.step_index += 1;
+        self.t = self.step_index as f64 * h;
+    }
+    fn project(&mut self, e_start: f64) -> Result<f64> {
+        GeneralizedStepper::project(self, e_start)
+    }
 }
 
 impl<S: GeneralizedSystem> Recorded for GeneralizedStepper<S> {
@@ -305,46 +320,7 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
     /// One impulse time step from `(t_k, q_k, v_k)`; appends the active contacts to
     /// `contacts` and returns the step's checks.
     pub fn step(&mut self, contacts: &mut Vec<ContactRecord>) -> Result<StepRecord> {
-        self.prepare()?;
-        self.search_contacts();
-        let mut free = false;
-        if self.settings.locate_impacts {
-            match self.located_step(contacts)? {
-                Located::Done(record) => return Ok(record),
-                Located::Free => free = true,
-                Located::Plain => {}
-            }
-        }
-        let nc = self.active.len();
-        let mut record = Stepper::blank_record(nc);
-        let mut v_next = std::mem::take(&mut self.v_next);
-        v_next.copy_from_slice(&self.v_free);
-        self.gp.fill(0.0);
-        if nc > 0 && free {
-            self.free_of_contacts(&mut record);
-        } else if nc > 0 {
-            self.assemble(&mut record)?;
-            self.solve_contacts(&mut record)?;
-            self.apply_impulses(&mut v_next);
-        }
-        record.momentum_residual = self.momentum_residual(&v_next);
-        if nc > 0 {
-            self.remember(&v_next, contacts);
-        }
-        let project = self.settings.drift == Drift::Projection && nc > 0;
-        let e_start = if project { self.energy()? } else { 0.0 };
-        self.v.copy_from_slice(&v_next);
-        self.v_next = v_next;
-        let h = self.settings.h;
-        for (q, v) in self.q.iter_mut().zip(&self.v) {
-            *q += h * v;
-        }
-        self.step_index += 1;
-        self.t = self.step_index as f64 * h;
-        if project {
-            record.projection = self.project(e_start)?;
-        }
-        Ok(record)
+        driver::step(self, contacts)
     }
 
     /// The contact search: a contact closed (`g <= gap_tolerance`), owed a rebound, or open

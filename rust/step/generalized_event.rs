@@ -12,7 +12,9 @@
 //! goes on with the post-impact velocity to `t_{k+1}`, and the state velocity is taken back by
 //! `-a h / 2`. Isolated, free and plain steps are decided as for scenes (module `event`).
 
-use super::super::event::{impact_law, located_record, Hit, Located, BISECTIONS, SAMPLES};
+use super::super::event::{
+    free_answer, impact_law, located_record, Hit, Located, BISECTIONS, SAMPLES,
+};
 use super::{dot, GeneralizedStepper, GeneralizedSystem};
 use crate::contact::assembly::solve_cholesky;
 use crate::error::{check_finite, Result};
@@ -232,17 +234,8 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
         record
     }
 
-    /// the contact answer of a free located step: zero impulses, which the contact law on
-    /// the gaps (all positive through the step) admits.
+    /// the contact answer of a free located step ([`free_answer`]).
     pub(super) fn free_of_contacts(&mut self, record: &mut StepRecord) {
-        let n = self.active.len() * self.dim;
-        self.solve.impulse.clear();
-        self.solve.impulse.resize(n, 0.0);
-        self.solve.basis.clear();
-        self.solve.corrected = false;
-        for a in &mut self.active {
-            a.approach = a.vn_k;
-        }
-        record.status = Some(crate::contact::ContactStatus::Solved);
+        free_answer(self.dim, &mut self.active, &mut self.solve, record);
     }
 }

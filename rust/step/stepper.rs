@@ -11,6 +11,8 @@
 mod bodies;
 #[path = "drift.rs"]
 mod drift;
+#[path = "driver.rs"]
+mod driver;
 #[path = "event.rs"]
 mod event;
 #[path = "generalized.rs"]
@@ -27,7 +29,6 @@ mod record;
 mod solve;
 
 use self::bodies::{bodies_of, norm3, BodyInfo, Frozen};
-use self::event::Located;
 use self::narrow::{declared_candidates, frame, Candidate, Geometry};
 use self::persistence::{sphere_points, CandState};
 pub use self::record::{simulate, simulate_recorded, ContactRecord, StepRecord, Trajectory};
@@ -284,50 +285,7 @@ impl Stepper {
     /// contact solve (impact law, W, solver), `v_{k+1} = v_free + M^{-1} G P`, the momentum
     /// check, the contacts' memory and records, the positions, the drift projection.
     pub fn step(&mut self, contacts: &mut Vec<ContactRecord>) -> Result<StepRecord> {
-        self.prepare();
-        self.search_contacts();
-        let mut free = false;
-        if self.settings.locate_impacts {
-            match self.located_step(contacts)? {
-                Located::Done(record) => return Ok(record),
-                Located::Free => free = true,
-                Located::Plain => {}
-            }
-        }
-        let nc = self.active.len();
-        let mut record = Self::blank_record(nc);
-        let mut v_next = std::mem::take(&mut self.v_next);
-        v_next.copy_from_slice(&self.v_free);
-        self.gp.fill(0.0);
-        if nc > 0 {
-            if free {
-                self.free_of_contacts(&mut record);
-            } else {
-                self.solve_contacts(&mut record)?;
-            }
-            self.apply_impulses(&mut v_next);
-        }
-        record.momentum_residual = self.momentum_residual(&v_next);
-        if nc > 0 {
-            self.remember(&v_next, contacts);
-        }
-        // the energy at the start of the step bounds the projection's
-        let project = self.settings.drift == Drift::Projection && nc > 0;
-        let e_start = if project {
-            let (t, v) = self.energies();
-            t + v
-        } else {
-            0.0
-        };
-        self.v.copy_from_slice(&v_next);
-        self.v_next = v_next;
-        self.integrate_positions();
-        if project {
-            record.projection = self.project(e_start)?;
-        }
-        self.step_index += 1;
-        self.t = self.step_index as f64 * self.settings.h;
-        Ok(record)
+        driver::step(self, contacts)
     }
 
     /// The contact search, which must find the closed and the imminently closing contacts
