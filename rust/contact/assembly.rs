@@ -410,7 +410,7 @@ impl WAssembly {
     /// the W of the last (sparse) assembly in block CSR (its storage kept for the next
     /// assembly); refuses non-finite entries.
     pub fn block_csr(&mut self) -> Result<&BlockCsr> {
-        let nc = if self.dim == 0 { 0 } else { self.n / self.dim };
+        let nc = self.n.checked_div(self.dim).unwrap_or(0);
         let csr = self.csr.get_or_insert_with(BlockCsr::empty);
         csr.rebuild_from_tiles(self.dim.max(1), nc, &self.tiles, &mut self.scratch)?;
         Ok(csr)

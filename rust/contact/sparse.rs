@@ -703,11 +703,11 @@ mod tests {
                 .collect();
             let (mut rows, mut cols, mut data) = (vec![], vec![], vec![]);
             for &(i, j, t) in &tiles {
-                for a in 0..dim {
-                    for b in 0..dim {
+                for (a, row) in t.iter().enumerate().take(dim) {
+                    for (b, &x) in row.iter().enumerate().take(dim) {
                         rows.push(i * dim + a);
                         cols.push(j * dim + b);
-                        data.push(t[a][b]);
+                        data.push(x);
                     }
                 }
             }
