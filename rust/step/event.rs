@@ -43,10 +43,10 @@ use crate::contact::{solve_nsgs, ContactProblem, NsgsSettings};
 use crate::error::Result;
 
 /// samples of the path per step before bisection.
-pub(super) const SAMPLES: usize = 16;
+const SAMPLES: usize = 16;
 
 /// bisection steps on the impact instant (to rounding of h).
-pub(super) const BISECTIONS: usize = 64;
+const BISECTIONS: usize = 64;
 
 /// What a located step did (module docs).
 pub(super) enum Located {
@@ -118,6 +118,40 @@ pub(super) fn impact_law(
             ))
         }
     }
+}
+
+/// The first instant in `(0, h]` at which the smallest gap over the step's active contacts,
+/// `min_gap(s)` on the free path, reaches zero, to rounding: sampled at [`SAMPLES`] instants,
+/// then bisected; `None` when no gap vanishes within the step. Shared by both drivers.
+pub(super) fn first_touch(
+    h: f64,
+    mut min_gap: impl FnMut(f64) -> Result<f64>,
+) -> Result<Option<f64>> {
+    let mut lo = 0.0;
+    let mut hi = None;
+    for j in 1..=SAMPLES {
+        let s = h * j as f64 / SAMPLES as f64;
+        if min_gap(s)? <= 0.0 {
+            hi = Some(s);
+            break;
+        }
+        lo = s;
+    }
+    let Some(mut hi) = hi else {
+        return Ok(None);
+    };
+    for _ in 0..BISECTIONS {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            break;
+        }
+        if min_gap(mid)? <= 0.0 {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    Ok(Some(hi))
 }
 
 /// The contact answer of a free located step, shared by both drivers: zero impulses, which
@@ -264,34 +298,14 @@ impl Stepper {
     }
 
     /// the first instant in `(0, h]` at which an active contact's true gap vanishes on the
-    /// free path, to rounding; `None` when no gap vanishes within the step.
+    /// free path ([`first_touch`]).
     fn impact_instant(&mut self) -> Option<f64> {
         let h = self.settings.h;
-        let mut lo = 0.0;
-        let mut hi = None;
-        for j in 1..=SAMPLES {
-            let s = h * j as f64 / SAMPLES as f64;
+        let found: Result<Option<f64>> = first_touch(h, |s| {
             self.follow(s);
-            if self.closest().0 <= 0.0 {
-                hi = Some(s);
-                break;
-            }
-            lo = s;
-        }
-        let mut hi = hi?;
-        for _ in 0..BISECTIONS {
-            let mid = 0.5 * (lo + hi);
-            if mid <= lo || mid >= hi {
-                break;
-            }
-            self.follow(mid);
-            if self.closest().0 <= 0.0 {
-                hi = mid;
-            } else {
-                lo = mid;
-            }
-        }
-        Some(hi)
+            Ok(self.closest().0)
+        });
+        found.ok().flatten()
     }
 
     /// applies the impact law to active contact `which` at the current state (the path at

@@ -12,9 +12,7 @@
 //! goes on with the post-impact velocity to `t_{k+1}`, and the state velocity is taken back by
 //! `-a h / 2`. Isolated, free and plain steps are decided as for scenes (module `event`).
 
-use super::super::event::{
-    free_answer, impact_law, located_record, Hit, Located, BISECTIONS, SAMPLES,
-};
+use super::super::event::{first_touch, free_answer, impact_law, located_record, Hit, Located};
 use super::{dot, GeneralizedStepper, GeneralizedSystem};
 use crate::contact::assembly::solve_cholesky;
 use crate::error::{check_finite, Result};
@@ -109,36 +107,13 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
     }
 
     /// the first instant in `(0, h]` at which an active contact's gap vanishes on the free
-    /// path, to rounding; `None` when no gap vanishes within the step.
+    /// path ([`first_touch`]).
     fn impact_instant(&mut self) -> Result<Option<f64>> {
         let h = self.settings.h;
-        let mut lo = 0.0;
-        let mut hi = None;
-        for j in 1..=SAMPLES {
-            let s = h * j as f64 / SAMPLES as f64;
+        first_touch(h, |s| {
             self.follow(s);
-            if self.closest()?.0 <= 0.0 {
-                hi = Some(s);
-                break;
-            }
-            lo = s;
-        }
-        let Some(mut hi) = hi else {
-            return Ok(None);
-        };
-        for _ in 0..BISECTIONS {
-            let mid = 0.5 * (lo + hi);
-            if mid <= lo || mid >= hi {
-                break;
-            }
-            self.follow(mid);
-            if self.closest()?.0 <= 0.0 {
-                hi = mid;
-            } else {
-                lo = mid;
-            }
-        }
-        Ok(Some(hi))
+            Ok(self.closest()?.0)
+        })
     }
 
     /// applies the impact law to active contact `which` at the current state (the path at the
