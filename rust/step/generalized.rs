@@ -27,6 +27,7 @@
 use super::super::impact::ImpactMemory;
 use super::driver::{self, Driver};
 use super::event::Located;
+use super::law::SolveWork;
 use super::persistence::CandState;
 use super::record::{run_recorded, Recorded};
 use super::solve::{SolveBuffers, SPARSE_FROM};
@@ -89,11 +90,9 @@ pub struct GeneralizedStepper<S: GeneralizedSystem> {
     qc: Vec<f64>,
     q1: Vec<f64>,
     mu: Vec<f64>,
-    restitution: Vec<f64>,
     poisson_impact: bool,
-    initial: Vec<f64>,
-    basis_guess: Vec<usize>,
-    p_impact: Vec<f64>,
+    /// the contact solve's buffers kept from step to step.
+    work: SolveWork,
     solve: SolveBuffers,
     gp: Vec<f64>,
     v_next: Vec<f64>,
@@ -232,11 +231,8 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
             qc: Vec::new(),
             q1: Vec::new(),
             mu: Vec::new(),
-            restitution: Vec::new(),
             poisson_impact: false,
-            initial: Vec::new(),
-            basis_guess: Vec::new(),
-            p_impact: Vec::new(),
+            work: SolveWork::default(),
             solve: SolveBuffers::default(),
             gp: vec![0.0; nv],
             v_next: vec![0.0; nv],

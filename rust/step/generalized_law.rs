@@ -4,9 +4,7 @@
 //! the gap's curvature term), the warm start and Lemke's guessed basis by contact, then the
 //! same solve (NSGS with its fallbacks, or Lemke) over the dense or block-sparse W.
 
-use super::super::law::{
-    basis_guess, curvature_term, normal_term, solve_phases, warm_start_of, Phases,
-};
+use super::super::law::{contact_solve, curvature_term, normal_term, ContactSolve};
 use super::{dot, GeneralizedStepper, GeneralizedSystem};
 use crate::error::{check_finite, Result};
 use crate::step::StepRecord;
@@ -68,53 +66,25 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
         check_finite("the contact gaps", &self.gaps_pred)
     }
 
-    /// The contact solve into `self.solve.impulse` by the scenes' phases ([`solve_phases`]):
-    /// the warm start (polished once more after a correcting solve) and Lemke's guessed basis
-    /// by contact, Poisson's impact phase when it has work, then the step's solve.
+    /// The contact solve into `self.solve.impulse`, as the scenes' ([`contact_solve`]).
     pub(super) fn solve_contacts(&mut self, record: &mut StepRecord) -> Result<()> {
-        let dim = self.dim;
-        let mut initial = std::mem::take(&mut self.initial);
-        let corrected = warm_start_of(&self.settings, dim, &self.active, &self.state, &mut initial);
-        let mut basis = std::mem::take(&mut self.basis_guess);
         let laws = &self.laws;
-        basis_guess(
-            &self.settings,
-            dim,
-            &self.active,
-            &self.state,
-            |c| laws[c].0,
-            &mut basis,
-        );
-        self.restitution.clear();
-        if self.poisson_impact {
-            self.restitution
-                .extend(self.active.iter().map(|a| self.laws[a.cand].1));
-        }
-        let mut p_impact = std::mem::take(&mut self.p_impact);
-        let (dense, sparse) = self.delassus.storage()?;
-        let out = solve_phases(
-            &Phases {
+        contact_solve(
+            &ContactSolve {
                 settings: &self.settings,
-                dim,
-                dense,
-                sparse,
+                dim: self.dim,
                 active: &self.active,
-                e: &self.restitution,
+                state: &self.state,
+                law_of: &|c| laws[c],
                 q1: &self.q1,
                 mu: &self.mu,
-                warm: (!initial.is_empty()).then_some(initial.as_slice()),
-                corrected,
-                guess: &basis,
                 poisson_impact: self.poisson_impact,
             },
+            &mut self.delassus,
             &mut self.qc,
-            record,
+            &mut self.work,
             &mut self.solve,
-            &mut p_impact,
-        );
-        self.initial = initial;
-        self.basis_guess = basis;
-        self.p_impact = p_impact;
-        out
+            record,
+        )
     }
 }

@@ -11,62 +11,33 @@ use super::{
     dot6, dot_v, Active, Drift, PolyhedralSettings, Restitution, StepRecord, StepSettings,
     StepSolver, Stepper,
 };
+use crate::contact::assembly::WAssembly;
 use crate::contact::{BlockCsr, ContactProblem, Delassus};
 use crate::error::Result;
 
 impl Stepper {
     /// The contact solve of a step with active contacts into `self.solve.impulse`: W and the
-    /// contact terms, the warm start and Lemke's guessed basis by contact identity, Poisson's
-    /// impact phase when it has work, then the step's solve (whose impulses the impact
-    /// phase's are added to).
+    /// contact terms, then the shared solve ([`contact_solve`]).
     pub(super) fn solve_contacts(&mut self, record: &mut StepRecord) -> Result<()> {
-        let dim = self.dim;
         self.assemble(record);
-        let mut initial = std::mem::take(&mut self.initial);
-        let corrected = warm_start_of(&self.settings, dim, &self.active, &self.state, &mut initial);
-        let mut basis = std::mem::take(&mut self.basis_guess);
         let candidates = &self.candidates;
-        basis_guess(
-            &self.settings,
-            dim,
-            &self.active,
-            &self.state,
-            |c| candidates[c].mu,
-            &mut basis,
-        );
-        let mut restitution = std::mem::take(&mut self.restitution);
-        restitution.clear();
-        if self.poisson_impact {
-            restitution.extend(self.active.iter().map(|a| self.candidates[a.cand].e));
-        }
-        let mut p_impact = std::mem::take(&mut self.p_impact);
-        // W's storage: dense for few contacts, block CSR for many
-        let (dense, sparse) = self.delassus.storage()?;
-        let out = solve_phases(
-            &Phases {
+        contact_solve(
+            &ContactSolve {
                 settings: &self.settings,
-                dim,
-                dense,
-                sparse,
+                dim: self.dim,
                 active: &self.active,
-                e: &restitution,
+                state: &self.state,
+                law_of: &|c| (candidates[c].mu, candidates[c].e),
                 q1: &self.q1,
                 mu: &self.mu,
-                warm: (!initial.is_empty()).then_some(initial.as_slice()),
-                corrected,
-                guess: &basis,
                 poisson_impact: self.poisson_impact,
             },
+            &mut self.delassus,
             &mut self.qc,
-            record,
+            &mut self.work,
             &mut self.solve,
-            &mut p_impact,
-        );
-        self.initial = initial;
-        self.basis_guess = basis;
-        self.restitution = restitution;
-        self.p_impact = p_impact;
-        out
+            record,
+        )
     }
 
     /// The step's contact problem from the active contacts: W (dense below [`SPARSE_FROM`]
@@ -263,6 +234,83 @@ pub(super) fn basis_guess(
             lambda += 1;
         }
     }
+}
+
+/// The buffers of a step's contact solve kept from step to step (the warm start, Lemke's
+/// guessed basis, the restitution coefficients and Poisson's impact impulses).
+#[derive(Default)]
+pub(super) struct SolveWork {
+    initial: Vec<f64>,
+    basis: Vec<usize>,
+    restitution: Vec<f64>,
+    p_impact: Vec<f64>,
+}
+
+/// What [`contact_solve`] reads: the active contacts, their states and laws, and the contact
+/// terms built by the driver.
+pub(super) struct ContactSolve<'a> {
+    pub(super) settings: &'a StepSettings,
+    pub(super) dim: usize,
+    pub(super) active: &'a [Active],
+    pub(super) state: &'a [CandState],
+    /// `(mu, e)` of a candidate.
+    pub(super) law_of: &'a dyn Fn(usize) -> (f64, f64),
+    pub(super) q1: &'a [f64],
+    pub(super) mu: &'a [f64],
+    pub(super) poisson_impact: bool,
+}
+
+/// The contact solve of a step, shared by both drivers, once W (`delassus`) and the contact
+/// terms (`qc`, `q1`, mu) are built: the warm start by contact identity (polished once more
+/// after a correcting solve, [`warm_start_of`]), Lemke's guessed basis ([`basis_guess`]),
+/// Poisson's impact phase when it has work, then the step's solve ([`solve_phases`]) into
+/// `solve.impulse`.
+pub(super) fn contact_solve(
+    input: &ContactSolve<'_>,
+    delassus: &mut WAssembly,
+    qc: &mut [f64],
+    work: &mut SolveWork,
+    solve: &mut SolveBuffers,
+    record: &mut StepRecord,
+) -> Result<()> {
+    let (settings, dim, active) = (input.settings, input.dim, input.active);
+    let corrected = warm_start_of(settings, dim, active, input.state, &mut work.initial);
+    let law_of = input.law_of;
+    basis_guess(
+        settings,
+        dim,
+        active,
+        input.state,
+        |c| law_of(c).0,
+        &mut work.basis,
+    );
+    work.restitution.clear();
+    if input.poisson_impact {
+        work.restitution
+            .extend(active.iter().map(|a| law_of(a.cand).1));
+    }
+    // W's storage: dense for few contacts, block CSR for many
+    let (dense, sparse) = delassus.storage()?;
+    solve_phases(
+        &Phases {
+            settings,
+            dim,
+            dense,
+            sparse,
+            active,
+            e: &work.restitution,
+            q1: input.q1,
+            mu: input.mu,
+            warm: (!work.initial.is_empty()).then_some(work.initial.as_slice()),
+            corrected,
+            guess: &work.basis,
+            poisson_impact: input.poisson_impact,
+        },
+        qc,
+        record,
+        solve,
+        &mut work.p_impact,
+    )
 }
 
 /// What a step's contact solve reads once W and the contact terms are built.

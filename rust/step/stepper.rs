@@ -29,6 +29,7 @@ mod record;
 mod solve;
 
 use self::bodies::{bodies_of, norm3, BodyInfo, Frozen};
+use self::law::SolveWork;
 use self::narrow::{declared_candidates, frame, Candidate, Geometry};
 use self::persistence::{sphere_points, CandState};
 pub use self::record::{simulate, simulate_recorded, ContactRecord, StepRecord, Trajectory};
@@ -143,12 +144,8 @@ pub struct Stepper {
     auto_keys: Vec<u64>,
     old_keys: Vec<u64>,
     old_state: Vec<CandState>,
-    /// the solve's warm start, Lemke's guessed basis and Poisson's impact impulse.
-    initial: Vec<f64>,
-    basis_guess: Vec<usize>,
-    p_impact: Vec<f64>,
-    /// the active contacts' restitution coefficients (Poisson's impact phase).
-    restitution: Vec<f64>,
+    /// the contact solve's buffers kept from step to step.
+    work: SolveWork,
     solve: SolveBuffers,
     gp: Vec<f64>,
     v_next: Vec<f64>,
@@ -206,10 +203,7 @@ impl Stepper {
             auto_keys: Vec::new(),
             old_keys: Vec::new(),
             old_state: Vec::new(),
-            initial: Vec::new(),
-            basis_guess: Vec::new(),
-            p_impact: Vec::new(),
-            restitution: Vec::new(),
+            work: SolveWork::default(),
             solve: SolveBuffers::default(),
             candidates,
         })
