@@ -1,6 +1,6 @@
 """Steps per second and the scenes' figures: coulomb's impulse stepper against MuJoCo.
 
-    python benches/peer_step.py [--quick]
+    python benches/peer_step.py [--quick] [--repeats N]
 
 The same scenes, data and step size in both (see benches/mujoco_scenes.py for MuJoCo's side):
 a 1 kg box sent down a 20 deg ramp at 1 m/s (mu 0.4; gravity tilted, as in MuJoCo's model), a
@@ -35,11 +35,15 @@ ROOT = Path(__file__).resolve().parents[1]
 G0 = 9.81
 
 
-def _best(build, t_end: float, h: float, solver: str, repeats: int = 3):
+#: timed runs per scene, the best kept (both coulomb's and MuJoCo's; --repeats sets it).
+REPEATS = 3
+
+
+def _best(build, t_end: float, h: float, solver: str):
     """Builds the scene (not timed, as MuJoCo's model compile is not) and times simulate."""
     best = math.inf
     out = None
-    for _ in range(repeats):
+    for _ in range(REPEATS):
         scene = build()
         start = time.perf_counter()
         out = scene.simulate(t_end, h, solver)
@@ -158,7 +162,7 @@ def coulomb_pile(count: int, h: float, solver: str, t_end: float = 1.0) -> dict:
         scene.contact_spheres(mu=0.5)
         return scene
 
-    tr, sec = _best(run, t_end, h, solver, repeats=3)
+    tr, sec = _best(run, t_end, h, solver)
     pos = tr.q.reshape(len(tr.t), count, 7)[:, :, :3]
     moved = float(np.max(np.linalg.norm(pos - pos[0], axis=2)))
     solved = int(np.sum(np.isin(tr.solver_status, ["solved", "no_contact"])))
@@ -195,7 +199,11 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="skip the 1000-sphere pile")
     ap.add_argument("--no-write", action="store_true", help="print only")
+    ap.add_argument("--repeats", type=int, default=3,
+                    help="timed runs per scene, the best kept (more on a loaded machine)")
     args = ap.parse_args()
+    global REPEATS
+    REPEATS = mj.REPEATS = max(1, args.repeats)
     h = 1e-3
     rows = []
 
@@ -243,7 +251,8 @@ def main() -> int:
         f"{datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC (revision {rev}; "
         f"coulomb {coulomb.__version__}, MuJoCo {mujoco.__version__}, Python "
         f"{platform.python_version()}, {platform.machine()}). Command: "
-        f"`python benches/peer_step.py`. h = 1 ms for every scene; best wall time of 3 runs; "
+        f"`python benches/peer_step.py --repeats {REPEATS}`. h = 1 ms for every scene; "
+        f"best wall time of {REPEATS} runs; "
         f"MuJoCo's loop in C++ by `mujoco.rollout`, coulomb's in Rust by "
         f"`Scene.simulate` (which also records every step's state, impulses and checks). "
         f"'vs MuJoCo': steps/s over MuJoCo's on the same scene in the same run. Load average "

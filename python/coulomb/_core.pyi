@@ -237,4 +237,5 @@ def model_simulate(
     drift_bias: float = 0.2,
     restitution: str = "newton",
     record_every: int = 1,
+    locate_impacts: bool = False,
 ) -> _ModelSimulateDict: ...

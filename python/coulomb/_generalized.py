@@ -200,15 +200,18 @@ class Model:
         drift_bias: float = 0.2,
         restitution: Literal["newton", "poisson"] = "newton",
         record_every: int = 1,
+        locate_impacts: bool = False,
     ) -> Trajectory:
         """Runs ``ceil(t_end / h)`` impulse steps; options as :meth:`Scene.simulate`
-        (Newton's or Poisson's law, the drift corrections, the fallback, ``record_every``),
-        except ``locate_impacts`` (scenes only). The Rust stepper runs the loop and calls
-        ``mass_matrix``, ``force``, the contacts' functions and ``potential`` back at each
-        state (holding the GIL only then), and the contacts' functions once more in a step
-        with active contacts, at the predicted state ``q + h v_free``, for the gaps'
-        second-order term over the step (as scenes have); an exception raised in one of them
-        stops the run and is raised as it is."""
+        (Newton's or Poisson's law, the drift corrections, the fallback, ``record_every``,
+        ``locate_impacts``: an isolated impact's instant is found on the step's free path
+        from the contacts' gap functions, called at the sampled and bisected instants, and
+        the law is applied there with ``M`` and the Jacobian at that instant). The Rust
+        stepper runs the loop and calls ``mass_matrix``, ``force``, the contacts' functions
+        and ``potential`` back at each state (holding the GIL only then), and the contacts'
+        functions once more in a step with active contacts, at the predicted state
+        ``q + h v_free``, for the gaps' second-order term over the step (as scenes have); an
+        exception raised in one of them stops the run and is raised as it is."""
         t_end, h = _positive("t_end", t_end), _positive("h", h)
         steps = _steps(t_end, h)
         solver, tol, max_iter, relaxation, facets = _solver_options(
@@ -218,6 +221,7 @@ class Model:
         fallback = _validate.boolean("fallback", fallback)
         # drift, drift_bias and restitution are checked by the core (type, value, range)
         record_every = _validate.count("record_every", record_every)
+        locate_impacts = _validate.boolean("locate_impacts", locate_impacts)
         raw = _core.model_simulate(
             self.dim,
             [(float(c.mu), float(c.e)) for c in self.contacts],
@@ -231,6 +235,7 @@ class Model:
             facets=facets, gap_tolerance=gap_tolerance, warm_start=warm_start,
             fallback=fallback, drift=drift, drift_bias=drift_bias,
             restitution=restitution, record_every=record_every,
+            locate_impacts=locate_impacts,
         )
         return Trajectory._from_core(raw, scene=None, h=h, solver=solver,
                                      record_every=record_every,

@@ -25,6 +25,7 @@ use faer::sparse::linalg::solvers::Llt;
 use faer::sparse::{SparseColMat, Triplet};
 use faer::Side;
 
+use crate::contact::sparse::TileScratch;
 use crate::contact::BlockCsr;
 use crate::error::{check_finite, CoulombError, Result};
 
@@ -311,9 +312,12 @@ pub struct WAssembly {
     blocks: usize,
     /// the dense W, row-major `n x n` (empty after a sparse assembly).
     w: Vec<f64>,
-    rows: Vec<usize>,
-    cols: Vec<usize>,
-    vals: Vec<f64>,
+    /// the tiles `(i, j, W_ij part)` of a sparse assembly, in product order, mirrors included.
+    tiles: Vec<(usize, usize, [[f64; 3]; 3])>,
+    /// whether the last assembly was sparse, and its block CSR once built.
+    sparse: bool,
+    csr: Option<BlockCsr>,
+    scratch: TileScratch,
     dim: usize,
     n: usize,
 }
@@ -360,26 +364,23 @@ impl WAssembly {
         if !sparse {
             self.w.resize(n * n, 0.0);
         }
-        self.rows.clear();
-        self.cols.clear();
-        self.vals.clear();
+        self.sparse = sparse;
+        self.tiles.clear();
         for list in &self.incidence[..self.blocks] {
             for (p, &(i, ki)) in list.iter().enumerate() {
                 for &(j, kj) in &list[p..] {
                     let blk = product((i, ki), (j, kj));
                     let mirror = i != j;
                     if sparse {
-                        for al in 0..dim {
-                            for be in 0..dim {
-                                self.rows.push(i * dim + al);
-                                self.cols.push(j * dim + be);
-                                self.vals.push(blk[al][be]);
-                                if mirror {
-                                    self.rows.push(j * dim + be);
-                                    self.cols.push(i * dim + al);
-                                    self.vals.push(blk[al][be]);
+                        self.tiles.push((i, j, blk));
+                        if mirror {
+                            let mut t = [[0.0; 3]; 3];
+                            for al in 0..dim {
+                                for be in 0..dim {
+                                    t[be][al] = blk[al][be];
                                 }
                             }
+                            self.tiles.push((j, i, t));
                         }
                     } else {
                         for al in 0..dim {
@@ -406,9 +407,22 @@ impl WAssembly {
         std::mem::take(&mut self.w)
     }
 
-    /// the W of the last (sparse) assembly in block CSR.
-    pub fn block_csr(&self) -> Result<BlockCsr> {
-        BlockCsr::from_coo(self.dim, self.n, &self.rows, &self.cols, &self.vals)
+    /// the W of the last (sparse) assembly in block CSR (its storage kept for the next
+    /// assembly); refuses non-finite entries.
+    pub fn block_csr(&mut self) -> Result<&BlockCsr> {
+        let nc = self.n.checked_div(self.dim).unwrap_or(0);
+        let csr = self.csr.get_or_insert_with(BlockCsr::empty);
+        csr.rebuild_from_tiles(self.dim.max(1), nc, &self.tiles, &mut self.scratch)?;
+        Ok(csr)
+    }
+
+    /// W of the last assembly as the contact problem stores it: the dense W and no block CSR
+    /// after a dense assembly, or an empty dense W and the block CSR after a sparse one.
+    pub fn storage(&mut self) -> Result<(&[f64], Option<&BlockCsr>)> {
+        if self.sparse {
+            self.block_csr()?;
+        }
+        Ok((&self.w, if self.sparse { self.csr.as_ref() } else { None }))
     }
 }
 

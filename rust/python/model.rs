@@ -132,12 +132,14 @@ impl GeneralizedSystem for PySystem {
                     solver="nsgs", tol=1e-12, max_iter=None, relaxation=1.0, facets=None,
                     gap_tolerance=1e-9, warm_start=true, fallback=true,
                     drift=Keyword::Default("none"), drift_bias=Keyword::Default(0.2),
-                    restitution=Keyword::Default("newton"), record_every=1))]
+                    restitution=Keyword::Default("newton"), record_every=1,
+                    locate_impacts=false))]
 #[pyo3(
     text_signature = "(dim, laws, mass, force, contacts, potential, q0, v0, h, steps, \
                          solver='nsgs', tol=1e-12, max_iter=None, relaxation=1.0, \
                          facets=None, gap_tolerance=1e-09, warm_start=True, fallback=True, \
-                         drift='none', drift_bias=0.2, restitution='newton', record_every=1)"
+                         drift='none', drift_bias=0.2, restitution='newton', record_every=1, \
+                         locate_impacts=False)"
 )]
 #[allow(clippy::too_many_arguments)]
 pub(super) fn model_simulate<'py>(
@@ -164,6 +166,7 @@ pub(super) fn model_simulate<'py>(
     drift_bias: Keyword<f64>,
     restitution: Keyword<&'static str>,
     record_every: usize,
+    locate_impacts: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let settings = settings_from(
         py,
@@ -181,7 +184,7 @@ pub(super) fn model_simulate<'py>(
         &drift,
         &drift_bias,
         &restitution,
-        false,
+        locate_impacts,
     )?;
     let mut system = PySystem {
         dim,

@@ -35,7 +35,10 @@
 //! the rebound to the next one, which then fell back to the plain law (O(h) energy).
 
 use super::bodies::displace_body;
-use super::{frame, ContactRecord, Geometry, Restitution, StepRecord, Stepper};
+use super::solve::SolveBuffers;
+use super::{
+    frame, Active, ContactRecord, Geometry, Restitution, StepRecord, StepSettings, Stepper,
+};
 use crate::contact::{solve_nsgs, ContactProblem, NsgsSettings};
 use crate::error::Result;
 
@@ -56,19 +59,139 @@ pub(super) enum Located {
 }
 
 /// the impact of a located step: contact, instant, impulse and velocities.
-struct Hit {
+pub(super) struct Hit {
     /// index into the step's active contacts.
-    active: usize,
+    pub(super) active: usize,
     /// the impulse, contact frame.
-    impulse: [f64; 3],
+    pub(super) impulse: [f64; 3],
     /// the approach normal velocity.
-    approach: f64,
+    pub(super) approach: f64,
     /// the contact velocity after the impact.
-    velocity: [f64; 3],
-    error: f64,
-    scaled_error: f64,
-    iterations: usize,
-    residual: f64,
+    pub(super) velocity: [f64; 3],
+    pub(super) error: f64,
+    pub(super) scaled_error: f64,
+    pub(super) iterations: usize,
+    /// the momentum balance `M dv = G P` at the impact, relative to `|G P|`.
+    pub(super) residual: f64,
+}
+
+/// The impulse of one contact's impact (W its `dim x dim` Delassus block row-major, u its
+/// contact velocity before), shared by the scenes' and the models' located steps: Newton's
+/// law `0 <= P_n ⊥ u_n^+ + e min(u_n^-, 0) >= 0` with Coulomb friction by NSGS on the single
+/// contact, or Poisson's by Routh's method (module `poisson`); with the solve's error, scaled
+/// error and iterations.
+pub(super) fn impact_law(
+    settings: &StepSettings,
+    dim: usize,
+    w: &[f64; 9],
+    u: [f64; 3],
+    mu: f64,
+    e: f64,
+) -> Result<([f64; 3], (f64, f64), usize)> {
+    match settings.restitution {
+        Restitution::Poisson => {
+            let mut w3 = [[0.0; 3]; 3];
+            for a in 0..dim {
+                for c in 0..dim {
+                    w3[a][c] = w[a * dim + c];
+                }
+            }
+            Ok((super::routh(dim, &w3, u, mu, e, 0.0), (0.0, 0.0), 0))
+        }
+        Restitution::Newton => {
+            let mut q = u;
+            q[0] += e * u[0].min(0.0);
+            let mu = [mu];
+            let problem = ContactProblem::new(dim, &w[..dim * dim], &q[..dim], &mu)?;
+            let nsgs = NsgsSettings {
+                tol: 1e-14,
+                max_iter: 100,
+                ..NsgsSettings::default()
+            };
+            let sol = solve_nsgs(&problem, &nsgs)?;
+            let mut p = [0.0; 3];
+            p[..dim].copy_from_slice(&sol.impulse);
+            Ok((
+                p,
+                (sol.measures.error, sol.measures.scaled_error),
+                sol.iterations,
+            ))
+        }
+    }
+}
+
+/// The first instant in `(0, h]` at which the smallest gap over the step's active contacts,
+/// `min_gap(s)` on the free path, reaches zero, to rounding: sampled at [`SAMPLES`] instants,
+/// then bisected; `None` when no gap vanishes within the step. Shared by both drivers.
+pub(super) fn first_touch(
+    h: f64,
+    mut min_gap: impl FnMut(f64) -> Result<f64>,
+) -> Result<Option<f64>> {
+    let mut lo = 0.0;
+    let mut hi = None;
+    for j in 1..=SAMPLES {
+        let s = h * j as f64 / SAMPLES as f64;
+        if min_gap(s)? <= 0.0 {
+            hi = Some(s);
+            break;
+        }
+        lo = s;
+    }
+    let Some(mut hi) = hi else {
+        return Ok(None);
+    };
+    for _ in 0..BISECTIONS {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            break;
+        }
+        if min_gap(mid)? <= 0.0 {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    Ok(Some(hi))
+}
+
+/// The contact answer of a free located step, shared by both drivers: zero impulses, which
+/// the contact law on the true gaps (all positive through the step) admits; each contact's
+/// approach is its velocity at the step's start.
+pub(super) fn free_answer(
+    dim: usize,
+    active: &mut [Active],
+    solve: &mut SolveBuffers,
+    record: &mut StepRecord,
+) {
+    solve.impulse.clear();
+    solve.impulse.resize(active.len() * dim, 0.0);
+    solve.basis.clear();
+    solve.corrected = false;
+    for a in active {
+        a.approach = a.vn_k;
+    }
+    record.status = Some(crate::contact::ContactStatus::Solved);
+}
+
+/// The step record of a located impact (one contact, friction `mu`, restitution `e`), shared
+/// by both drivers: the law's verdict, the momentum balance, the cone violation and Newton's
+/// complementarity `|P_n (u_n^+ + e u_n^-)|` (0 for Poisson's law, exact by construction).
+pub(super) fn located_record(settings: &StepSettings, hit: &Hit, mu: f64, e: f64) -> StepRecord {
+    let pt = (hit.impulse[1] * hit.impulse[1] + hit.impulse[2] * hit.impulse[2]).sqrt();
+    let bound = match settings.restitution {
+        Restitution::Newton => hit.velocity[0] + e * hit.approach,
+        Restitution::Poisson => 0.0,
+    };
+    let mut record = Stepper::blank_record(1);
+    record.status = Some(crate::contact::ContactStatus::Solved);
+    record.error = hit.error;
+    record.scaled_error = hit.scaled_error;
+    record.iterations = hit.iterations;
+    record.momentum_residual = hit.residual;
+    record.min_normal_impulse = hit.impulse[0];
+    record.cone_violation = (pt - mu * hit.impulse[0]).max(0.0);
+    record.complementarity = (hit.impulse[0] * bound).abs();
+    record
 }
 
 impl Stepper {
@@ -162,18 +285,9 @@ impl Stepper {
         Ok(Located::Done(self.finish_located(hit, contacts)))
     }
 
-    /// the contact answer of a free located step (see [`Located::Free`]): zero impulses,
-    /// which the contact law on the true gaps (all positive through the step) admits.
+    /// the contact answer of a free located step (see [`Located::Free`], [`free_answer`]).
     pub(super) fn free_of_contacts(&mut self, record: &mut StepRecord) {
-        let n = self.active.len() * self.dim;
-        self.solve.impulse.clear();
-        self.solve.impulse.resize(n, 0.0);
-        self.solve.basis.clear();
-        self.solve.corrected = false;
-        for a in &mut self.active {
-            a.approach = a.vn_k;
-        }
-        record.status = Some(crate::contact::ContactStatus::Solved);
+        free_answer(self.dim, &mut self.active, &mut self.solve, record);
     }
 
     /// back to `(q_k, v_k)`, bodies frozen there.
@@ -184,34 +298,14 @@ impl Stepper {
     }
 
     /// the first instant in `(0, h]` at which an active contact's true gap vanishes on the
-    /// free path, to rounding; `None` when no gap vanishes within the step.
+    /// free path ([`first_touch`]).
     fn impact_instant(&mut self) -> Option<f64> {
         let h = self.settings.h;
-        let mut lo = 0.0;
-        let mut hi = None;
-        for j in 1..=SAMPLES {
-            let s = h * j as f64 / SAMPLES as f64;
+        let found: Result<Option<f64>> = first_touch(h, |s| {
             self.follow(s);
-            if self.closest().0 <= 0.0 {
-                hi = Some(s);
-                break;
-            }
-            lo = s;
-        }
-        let mut hi = hi?;
-        for _ in 0..BISECTIONS {
-            let mid = 0.5 * (lo + hi);
-            if mid <= lo || mid >= hi {
-                break;
-            }
-            self.follow(mid);
-            if self.closest().0 <= 0.0 {
-                hi = mid;
-            } else {
-                lo = mid;
-            }
-        }
-        Some(hi)
+            Ok(self.closest().0)
+        });
+        found.ok().flatten()
     }
 
     /// applies the impact law to active contact `which` at the current state (the path at
@@ -237,7 +331,7 @@ impl Stepper {
         }
         let approach = u[0].min(0.0);
         let (impulse, (error, scaled_error), iterations) =
-            self.impact_law(&w, u, cand.mu, cand.e)?;
+            impact_law(&self.settings, dim, &w, u, cand.mu, cand.e)?;
         // v+ = q'(s*) + M^{-1} G P, and the momentum balance M dv = G P at q(s*)
         let mut residual: f64 = 0.0;
         let mut scale: f64 = 0.0;
@@ -306,49 +400,6 @@ impl Stepper {
         (cols, bcols)
     }
 
-    /// the impulse of one contact's impact (W its `dim x dim` Delassus block row-major, u its
-    /// contact velocity before): Newton's law by NSGS on the single contact, or Poisson's by
-    /// Routh's method; with the solve's error and iterations.
-    fn impact_law(
-        &self,
-        w: &[f64; 9],
-        u: [f64; 3],
-        mu: f64,
-        e: f64,
-    ) -> Result<([f64; 3], (f64, f64), usize)> {
-        let dim = self.dim;
-        match self.settings.restitution {
-            Restitution::Poisson => {
-                let mut w3 = [[0.0; 3]; 3];
-                for a in 0..dim {
-                    for c in 0..dim {
-                        w3[a][c] = w[a * dim + c];
-                    }
-                }
-                Ok((super::routh(dim, &w3, u, mu, e, 0.0), (0.0, 0.0), 0))
-            }
-            Restitution::Newton => {
-                let mut q = u;
-                q[0] += e * u[0].min(0.0);
-                let mu = [mu];
-                let problem = ContactProblem::new(dim, &w[..dim * dim], &q[..dim], &mu)?;
-                let settings = NsgsSettings {
-                    tol: 1e-14,
-                    max_iter: 100,
-                    ..NsgsSettings::default()
-                };
-                let sol = solve_nsgs(&problem, &settings)?;
-                let mut p = [0.0; 3];
-                p[..dim].copy_from_slice(&sol.impulse);
-                Ok((
-                    p,
-                    (sol.measures.error, sol.measures.scaled_error),
-                    sol.iterations,
-                ))
-            }
-        }
-    }
-
     /// the records of a located step, the contacts' states, and the clock.
     fn finish_located(&mut self, hit: Hit, contacts: &mut Vec<ContactRecord>) -> StepRecord {
         let dim = self.dim;
@@ -370,20 +421,7 @@ impl Stepper {
             gap: a.gap,
             closed: true,
         });
-        let pt = (hit.impulse[1] * hit.impulse[1] + hit.impulse[2] * hit.impulse[2]).sqrt();
-        let bound = match self.settings.restitution {
-            Restitution::Newton => hit.velocity[0] + cand.e * hit.approach,
-            Restitution::Poisson => 0.0,
-        };
-        let mut record = Self::blank_record(1);
-        record.status = Some(crate::contact::ContactStatus::Solved);
-        record.error = hit.error;
-        record.scaled_error = hit.scaled_error;
-        record.iterations = hit.iterations;
-        record.momentum_residual = hit.residual;
-        record.min_normal_impulse = hit.impulse[0];
-        record.cone_violation = (pt - cand.mu * hit.impulse[0]).max(0.0);
-        record.complementarity = (hit.impulse[0] * bound).abs();
+        let record = located_record(&self.settings, &hit, cand.mu, cand.e);
         self.step_index += 1;
         self.t = self.step_index as f64 * self.settings.h;
         record

@@ -20,67 +20,32 @@
 //! records ([`Trajectory`], whose `scaled_error` carries each step's verdict). W is assembled
 //! by the one assembly, [`crate::contact::assembly::WAssembly`].
 //!
-//! A system's callbacks may fail (a user function raising): the error stops the run and is
-//! returned as it is. Located impacts ([`StepSettings::locate_impacts`]) are scenes' only.
+//! With [`StepSettings::locate_impacts`] an isolated impact is located within its step as
+//! for scenes (module `generalized_event`). A system's callbacks may fail (a user function
+//! raising): the error stops the run and is returned as it is.
 
 use super::super::impact::ImpactMemory;
+use super::driver::{self, Driver};
+use super::event::Located;
+use super::law::SolveWork;
 use super::persistence::CandState;
+use super::record::{run_recorded, Recorded};
 use super::solve::{SolveBuffers, SPARSE_FROM};
-use super::{Active, ContactRecord, StepRecord, Stepper, Trajectory, TINY};
+use super::{Active, ContactRecord, StepRecord, Trajectory};
 use crate::contact::assembly::{cholesky_in_place, solve_cholesky, WAssembly};
 use crate::error::{check_finite, CoulombError, Result};
-use crate::step::{Drift, StepSettings};
+use crate::step::StepSettings;
 
 #[path = "generalized_drift.rs"]
 mod generalized_drift;
+#[path = "generalized_event.rs"]
+mod generalized_event;
+#[path = "generalized_system.rs"]
+mod generalized_system;
+
+pub use self::generalized_system::GeneralizedSystem;
 #[path = "generalized_law.rs"]
 mod generalized_law;
-
-/// A mechanism in generalized coordinates (`dq/dt = v`, so `nq = nv`) whose mass matrix,
-/// forces and contacts the stepper asks for at each state it reaches.
-pub trait GeneralizedSystem {
-    /// 2 (a contact has a normal and one tangent) or 3 (two tangents).
-    fn dim(&self) -> usize;
-    /// the number of generalized coordinates and velocities.
-    fn nv(&self) -> usize;
-    /// per contact, its friction coefficient `mu >= 0` and restitution `e` in `[0, 1]`.
-    fn laws(&self) -> Vec<(f64, f64)>;
-    /// `M(q)`, row-major `nv x nv`, symmetric positive definite, into `m`.
-    fn mass(&mut self, q: &[f64], m: &mut [f64]) -> Result<()>;
-    /// the generalized forces `f(q, v, t)` into `f` (`nv` entries).
-    fn force(&mut self, q: &[f64], v: &[f64], t: f64, f: &mut [f64]) -> Result<()>;
-    /// per contact i its gap `gaps[i]` (> 0 when separated) and the rows of its Jacobian,
-    /// normal first then the tangents, at `rows[(i dim + α) nv ..][..nv]`. Called at each
-    /// state, and once more in a step with active contacts at the predicted state
-    /// `q_k + h v_free` (whose gaps give the gap's second-order term over the step).
-    fn contacts(&mut self, q: &[f64], gaps: &mut [f64], rows: &mut [f64]) -> Result<()>;
-    /// the potential energy `V(q)` of the forces, for the records (0 when not known).
-    fn potential(&mut self, q: &[f64]) -> Result<f64>;
-}
-
-impl<T: GeneralizedSystem + ?Sized> GeneralizedSystem for &mut T {
-    fn dim(&self) -> usize {
-        (**self).dim()
-    }
-    fn nv(&self) -> usize {
-        (**self).nv()
-    }
-    fn laws(&self) -> Vec<(f64, f64)> {
-        (**self).laws()
-    }
-    fn mass(&mut self, q: &[f64], m: &mut [f64]) -> Result<()> {
-        (**self).mass(q, m)
-    }
-    fn force(&mut self, q: &[f64], v: &[f64], t: f64, f: &mut [f64]) -> Result<()> {
-        (**self).force(q, v, t, f)
-    }
-    fn contacts(&mut self, q: &[f64], gaps: &mut [f64], rows: &mut [f64]) -> Result<()> {
-        (**self).contacts(q, gaps, rows)
-    }
-    fn potential(&mut self, q: &[f64]) -> Result<f64> {
-        (**self).potential(q)
-    }
-}
 
 /// relative symmetry tolerance on `M(q)`.
 const SYM_TOL: f64 = 1e-10;
@@ -125,27 +90,96 @@ pub struct GeneralizedStepper<S: GeneralizedSystem> {
     qc: Vec<f64>,
     q1: Vec<f64>,
     mu: Vec<f64>,
-    restitution: Vec<f64>,
     poisson_impact: bool,
-    initial: Vec<f64>,
-    basis_guess: Vec<usize>,
-    p_impact: Vec<f64>,
+    /// the contact solve's buffers kept from step to step.
+    work: SolveWork,
     solve: SolveBuffers,
     gp: Vec<f64>,
     v_next: Vec<f64>,
+    /// `(q_k, v_k)` while a located step follows its path (module `generalized_event`), and
+    /// whether `m` and `chol` were factored on the path since.
+    saved_q: Vec<f64>,
+    saved_v: Vec<f64>,
+    mass_moved: bool,
+    /// `f . v` at each recorded state of the run.
+    load_power: Vec<f64>,
+}
+
+impl<S: GeneralizedSystem> Driver for GeneralizedStepper<S> {
+    fn settings(&self) -> &StepSettings {
+        &self.settings
+    }
+    fn prepare_state(&mut self) -> Result<()> {
+        self.prepare()
+    }
+    fn search(&mut self) {
+        self.search_contacts();
+    }
+    fn active_len(&self) -> usize {
+        self.active.len()
+    }
+    fn locate(&mut self, contacts: &mut Vec<ContactRecord>) -> Result<Located> {
+        self.located_step(contacts)
+    }
+    fn free_answer(&mut self, record: &mut StepRecord) {
+        self.free_of_contacts(record);
+    }
+    fn solve(&mut self, record: &mut StepRecord) -> Result<()> {
+        self.assemble(record)?;
+        self.solve_contacts(record)
+    }
+    fn start_velocities(&mut self) -> Vec<f64> {
+        let mut v_next = std::mem::take(&mut self.v_next);
+        v_next.copy_from_slice(&self.v_free);
+        self.gp.fill(0.0);
+        v_next
+    }
+    fn apply(&mut self, v_next: &mut [f64]) {
+        self.apply_impulses(v_next);
+    }
+    fn momentum(&self, v_next: &[f64]) -> f64 {
+        self.momentum_residual(v_next)
+    }
+    fn remember(&mut self, v_next: &[f64], contacts: &mut Vec<ContactRecord>) {
+        GeneralizedStepper::remember(self, v_next, contacts);
+    }
+    fn energy(&mut self) -> Result<f64> {
+        GeneralizedStepper::energy(self)
+    }
+    fn advance(&mut self, v_next: Vec<f64>) {
+        self.v.copy_from_slice(&v_next);
+        self.v_next = v_next;
+        let h = self.settings.h;
+        for (q, v) in self.q.iter_mut().zip(&self.v) {
+            *q += h * v;
+        }
+        self.step_index += 1;
+        self.t = self.step_index as f64 * h;
+    }
+    fn project(&mut self, e_start: f64) -> Result<f64> {
+        GeneralizedStepper::project(self, e_start)
+    }
+}
+
+impl<S: GeneralizedSystem> Recorded for GeneralizedStepper<S> {
+    fn step(&mut self, contacts: &mut Vec<ContactRecord>) -> Result<StepRecord> {
+        GeneralizedStepper::step(self, contacts)
+    }
+    fn record_state(&mut self, out: &mut Trajectory) -> Result<()> {
+        self.push_state(out)
+    }
+    fn state_finite(&self) -> bool {
+        self.v.iter().chain(self.q.iter()).all(|x| x.is_finite())
+    }
+    fn step_cost(&self) -> usize {
+        self.nv * self.nv + 64
+    }
 }
 
 impl<S: GeneralizedSystem> GeneralizedStepper<S> {
     /// Checks the settings and the system's sizes and laws, and sizes every workspace.
     pub fn new(system: S, q0: &[f64], v0: &[f64], settings: &StepSettings) -> Result<Self> {
         settings.validate()?;
-        if settings.locate_impacts {
-            return Err(CoulombError::InvalidParameter(
-                "located impacts are available for scenes only, not for models in generalized \
-                 coordinates"
-                    .into(),
-            ));
-        }
         let (dim, nv) = (system.dim(), system.nv());
         if dim != 2 && dim != 3 {
             return Err(CoulombError::InvalidParameter(format!(
@@ -197,14 +231,15 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
             qc: Vec::new(),
             q1: Vec::new(),
             mu: Vec::new(),
-            restitution: Vec::new(),
             poisson_impact: false,
-            initial: Vec::new(),
-            basis_guess: Vec::new(),
-            p_impact: Vec::new(),
+            work: SolveWork::default(),
             solve: SolveBuffers::default(),
             gp: vec![0.0; nv],
             v_next: vec![0.0; nv],
+            saved_q: vec![0.0; nv],
+            saved_v: vec![0.0; nv],
+            mass_moved: false,
+            load_power: Vec::new(),
             laws,
         })
     }
@@ -281,36 +316,7 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
     /// One impulse time step from `(t_k, q_k, v_k)`; appends the active contacts to
     /// `contacts` and returns the step's checks.
     pub fn step(&mut self, contacts: &mut Vec<ContactRecord>) -> Result<StepRecord> {
-        self.prepare()?;
-        self.search_contacts();
-        let nc = self.active.len();
-        let mut record = Stepper::blank_record(nc);
-        let mut v_next = std::mem::take(&mut self.v_next);
-        v_next.copy_from_slice(&self.v_free);
-        self.gp.fill(0.0);
-        if nc > 0 {
-            self.assemble(&mut record)?;
-            self.solve_contacts(&mut record)?;
-            self.apply_impulses(&mut v_next);
-        }
-        record.momentum_residual = self.momentum_residual(&v_next);
-        if nc > 0 {
-            self.remember(&v_next, contacts);
-        }
-        let project = self.settings.drift == Drift::Projection && nc > 0;
-        let e_start = if project { self.energy()? } else { 0.0 };
-        self.v.copy_from_slice(&v_next);
-        self.v_next = v_next;
-        let h = self.settings.h;
-        for (q, v) in self.q.iter_mut().zip(&self.v) {
-            *q += h * v;
-        }
-        self.step_index += 1;
-        self.t = self.step_index as f64 * h;
-        if project {
-            record.projection = self.project(e_start)?;
-        }
-        Ok(record)
+        driver::step(self, contacts)
     }
 
     /// The contact search: a contact closed (`g <= gap_tolerance`), owed a rebound, or open
@@ -414,31 +420,10 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
         }
     }
 
-    /// `||M (v_{k+1} - v_free) - G P||` relative to `max(||G P||, ||M v_free||,
-    /// ||M v_{k+1}||)` (the absolute norm when all are zero).
+    /// the momentum balance of the step ([`super::record::momentum_residual`]), M one block.
     fn momentum_residual(&self, v_next: &[f64]) -> f64 {
-        let nv = self.nv;
-        let (mut res2, mut gp2, mut mf2, mut mn2) = (0.0, 0.0, 0.0, 0.0);
-        for a in 0..nv {
-            let row = &self.m[a * nv..(a + 1) * nv];
-            let (mut mdv, mut mf, mut mn) = (0.0, 0.0, 0.0);
-            for c in 0..nv {
-                mdv += row[c] * (v_next[c] - self.v_free[c]);
-                mf += row[c] * self.v_free[c];
-                mn += row[c] * v_next[c];
-            }
-            let r = mdv - self.gp[a];
-            res2 += r * r;
-            gp2 += self.gp[a] * self.gp[a];
-            mf2 += mf * mf;
-            mn2 += mn * mn;
-        }
-        let scale2 = gp2.max(mf2).max(mn2);
-        if scale2.sqrt() > TINY {
-            (res2 / scale2).sqrt()
-        } else {
-            res2.sqrt()
-        }
+        let blocks = std::iter::once((&self.m[..], self.nv, 0, self.nv));
+        super::record::momentum_residual(blocks, v_next, &self.v_free, &self.gp)
     }
 
     /// Each active contact keeps its impulse, basis and impact record (as the scenes'
@@ -490,7 +475,7 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
     }
 
     /// records the current state into `out` (and `f . v` into `load_power`).
-    fn push_state(&mut self, out: &mut Trajectory, load_power: &mut Vec<f64>) -> Result<()> {
+    fn push_state(&mut self, out: &mut Trajectory) -> Result<()> {
         self.prepare()?;
         out.t.push(self.t);
         out.q.extend_from_slice(&self.q);
@@ -502,7 +487,8 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
             .push(self.gaps.iter().copied().fold(f64::INFINITY, f64::min));
         out.negative_gaps
             .push(self.gaps.iter().filter(|&&g| g < -tol).count());
-        load_power.push(dot(&self.f, &self.v));
+        let power = dot(&self.f, &self.v);
+        self.load_power.push(power);
         Ok(())
     }
 }
@@ -557,57 +543,10 @@ pub fn simulate_generalized<S: GeneralizedSystem>(
         "record fewer states with record_every",
     )?;
     let reserve = rows.min(4096);
-    let mut out = Trajectory {
-        dim: st.dim,
-        nq: nv,
-        nv,
-        t: Vec::with_capacity(reserve),
-        q: Vec::with_capacity(reserve * nv),
-        v: Vec::with_capacity(reserve * nv),
-        kinetic_energy: Vec::with_capacity(reserve),
-        potential_energy: Vec::with_capacity(reserve),
-        min_gap: Vec::with_capacity(reserve),
-        negative_gaps: Vec::with_capacity(reserve),
-        steps: Vec::with_capacity(reserve),
-        contacts: Vec::new(),
-        stopped: None,
-    };
-    let mut load_power = Vec::with_capacity(reserve);
-    st.push_state(&mut out, &mut load_power)?;
-    let mut pending: Option<StepRecord> = None;
-    for k in 0..steps {
-        if crate::interrupt::poll(nv * nv + 64) {
-            break;
-        }
-        let kept = out.contacts.len();
-        let mut rec = st.step(&mut out.contacts)?;
-        if let Some(p) = pending.take() {
-            rec.fold(&p);
-        }
-        let row = out.steps.len();
-        out.contacts[kept..].iter_mut().for_each(|c| c.step = row);
-        if !st.v.iter().chain(st.q.iter()).all(|x| x.is_finite()) {
-            out.stopped = Some(format!(
-                "step {k} produced a non-finite state (contact solver: {})",
-                rec.status.map_or("no contacts", |s| s.as_str())
-            ));
-            out.contacts.truncate(kept);
-            break;
-        }
-        if (k + 1) % every != 0 && k + 1 != steps {
-            out.contacts.truncate(kept);
-            pending = Some(rec);
-            continue;
-        }
-        crate::limits::check_bytes(
-            &format!("recording {} contact records", out.contacts.len()),
-            out.contacts.len(),
-            std::mem::size_of::<ContactRecord>(),
-            "record fewer states with record_every",
-        )?;
-        out.steps.push(rec);
-        st.push_state(&mut out, &mut load_power)?;
-    }
+    let mut out = Trajectory::reserved(st.dim, nv, nv, reserve);
+    st.load_power = Vec::with_capacity(reserve);
+    run_recorded(&mut st, steps, every, &mut out)?;
+    let load_power = std::mem::take(&mut st.load_power);
     Ok(GeneralizedTrajectory {
         trajectory: out,
         load_power,

@@ -4,13 +4,10 @@
 //! the gap's curvature term), the warm start and Lemke's guessed basis by contact, then the
 //! same solve (NSGS with its fallbacks, or Lemke) over the dense or block-sparse W.
 
-use super::super::law::{curvature_term, normal_term, solve_phases, warm_start_of, Phases};
-use super::super::solve::SPARSE_FROM;
-use super::super::Active;
+use super::super::law::{contact_solve, curvature_term, normal_term, ContactSolve};
 use super::{dot, GeneralizedStepper, GeneralizedSystem};
 use crate::error::{check_finite, Result};
 use crate::step::StepRecord;
-use crate::step::{PolyhedralSettings, StepSolver};
 
 impl<S: GeneralizedSystem> GeneralizedStepper<S> {
     /// `q_c = G^T v_free` plus each contact's restitution, bias or gap term
@@ -69,84 +66,25 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
         check_finite("the contact gaps", &self.gaps_pred)
     }
 
-    /// The contact solve into `self.solve.impulse` by the scenes' phases ([`solve_phases`]):
-    /// the warm start (polished once more after a correcting solve) and Lemke's guessed basis
-    /// by contact, Poisson's impact phase when it has work, then the step's solve.
+    /// The contact solve into `self.solve.impulse`, as the scenes' ([`contact_solve`]).
     pub(super) fn solve_contacts(&mut self, record: &mut StepRecord) -> Result<()> {
-        let dim = self.dim;
-        let nc = self.active.len();
-        let w_sparse = if nc >= SPARSE_FROM {
-            Some(self.delassus.block_csr()?)
-        } else {
-            None
-        };
-        let mut initial = std::mem::take(&mut self.initial);
-        let corrected = warm_start_of(&self.settings, dim, &self.active, &self.state, &mut initial);
-        let mut basis = std::mem::take(&mut self.basis_guess);
-        self.basis_of_active(&mut basis);
-        self.restitution.clear();
-        if self.poisson_impact {
-            self.restitution
-                .extend(self.active.iter().map(|a| self.laws[a.cand].1));
-        }
-        let mut p_impact = std::mem::take(&mut self.p_impact);
-        let out = solve_phases(
-            &Phases {
+        let laws = &self.laws;
+        contact_solve(
+            &ContactSolve {
                 settings: &self.settings,
-                dim,
-                dense: self.delassus.dense(),
-                sparse: w_sparse.as_ref(),
+                dim: self.dim,
                 active: &self.active,
-                e: &self.restitution,
+                state: &self.state,
+                law_of: &|c| laws[c],
                 q1: &self.q1,
                 mu: &self.mu,
-                warm: (!initial.is_empty()).then_some(initial.as_slice()),
-                corrected,
-                guess: &basis,
                 poisson_impact: self.poisson_impact,
             },
+            &mut self.delassus,
             &mut self.qc,
-            record,
+            &mut self.work,
             &mut self.solve,
-            &mut p_impact,
-        );
-        self.initial = initial;
-        self.basis_guess = basis;
-        self.p_impact = p_impact;
-        out
-    }
-
-    /// Lemke's guessed basis from the active contacts' last bases (as the scenes' stepper).
-    fn basis_of_active(&self, out: &mut Vec<usize>) {
-        out.clear();
-        let facets = match &self.settings.solver {
-            StepSolver::Lemke(s) => s.facets,
-            StepSolver::Nsgs(_) => PolyhedralSettings::for_dim(self.dim).facets,
-        };
-        if facets + 2 > 64 || !self.settings.warm_start {
-            return;
-        }
-        let nc = self.active.len();
-        let frictional = |a: &Active| self.laws[a.cand].0 > 0.0;
-        let nf = self.active.iter().filter(|a| frictional(a)).count();
-        let (mut beta, mut lambda) = (nc, nc + nf * facets);
-        for (i, a) in self.active.iter().enumerate() {
-            let bits = self.state[a.cand].basis;
-            if bits & 1 != 0 {
-                out.push(i);
-            }
-            if frictional(a) {
-                for k in 0..facets {
-                    if bits & (1 << (2 + k)) != 0 {
-                        out.push(beta + k);
-                    }
-                }
-                if bits & 2 != 0 {
-                    out.push(lambda);
-                }
-                beta += facets;
-                lambda += 1;
-            }
-        }
+            record,
+        )
     }
 }

@@ -7,61 +7,37 @@
 use super::super::poisson::{restitution_with_friction, routh};
 use super::persistence::CandState;
 use super::solve::{solve_step_problem, step_problem, SolveBuffers, SPARSE_FROM};
-use super::{dot6, dot_v, Active, Drift, Restitution, StepRecord, StepSettings, Stepper};
+use super::{
+    dot6, dot_v, Active, Drift, PolyhedralSettings, Restitution, StepRecord, StepSettings,
+    StepSolver, Stepper,
+};
+use crate::contact::assembly::WAssembly;
 use crate::contact::{BlockCsr, ContactProblem, Delassus};
 use crate::error::Result;
 
 impl Stepper {
     /// The contact solve of a step with active contacts into `self.solve.impulse`: W and the
-    /// contact terms, the warm start and Lemke's guessed basis by contact identity, Poisson's
-    /// impact phase when it has work, then the step's solve (whose impulses the impact
-    /// phase's are added to).
+    /// contact terms, then the shared solve ([`contact_solve`]).
     pub(super) fn solve_contacts(&mut self, record: &mut StepRecord) -> Result<()> {
-        let dim = self.dim;
-        let nc = self.active.len();
         self.assemble(record);
-        // W's storage: dense for few contacts, block CSR for many
-        let w_sparse = if nc >= SPARSE_FROM {
-            // every contact's diagonal block is present (a contact touches a body)
-            Some(self.delassus.block_csr()?)
-        } else {
-            None
-        };
-        let mut initial = std::mem::take(&mut self.initial);
-        let corrected = warm_start_of(&self.settings, dim, &self.active, &self.state, &mut initial);
-        let mut basis = std::mem::take(&mut self.basis_guess);
-        self.basis_of_active(&mut basis);
-        let mut restitution = std::mem::take(&mut self.restitution);
-        restitution.clear();
-        if self.poisson_impact {
-            restitution.extend(self.active.iter().map(|a| self.candidates[a.cand].e));
-        }
-        let mut p_impact = std::mem::take(&mut self.p_impact);
-        let out = solve_phases(
-            &Phases {
+        let candidates = &self.candidates;
+        contact_solve(
+            &ContactSolve {
                 settings: &self.settings,
-                dim,
-                dense: self.delassus.dense(),
-                sparse: w_sparse.as_ref(),
+                dim: self.dim,
                 active: &self.active,
-                e: &restitution,
+                state: &self.state,
+                law_of: &|c| (candidates[c].mu, candidates[c].e),
                 q1: &self.q1,
                 mu: &self.mu,
-                warm: (!initial.is_empty()).then_some(initial.as_slice()),
-                corrected,
-                guess: &basis,
                 poisson_impact: self.poisson_impact,
             },
+            &mut self.delassus,
             &mut self.qc,
-            record,
+            &mut self.work,
             &mut self.solve,
-            &mut p_impact,
-        );
-        self.initial = initial;
-        self.basis_guess = basis;
-        self.restitution = restitution;
-        self.p_impact = p_impact;
-        out
+            record,
+        )
     }
 
     /// The step's contact problem from the active contacts: W (dense below [`SPARSE_FROM`]
@@ -109,10 +85,11 @@ impl Stepper {
         self.mu.clear();
         self.poisson_impact = false;
         for i in 0..nc {
-            let ai = self.active[i];
-            let cand = self.candidates[ai.cand];
-            let st = self.state[ai.cand];
-            self.mu.push(cand.mu);
+            // by reference: an active contact carries its G and M^{-1} G columns
+            let ai = &self.active[i];
+            let c = ai.cand;
+            let (mu, e) = (self.candidates[c].mu, self.candidates[c].e);
+            self.mu.push(mu);
             // q_c = G^T v_free (and q_1 = G^T v_k for Poisson's impact phase), then the
             // normal's restitution or gap term
             for si in &ai.sides[..ai.nsides] {
@@ -125,15 +102,15 @@ impl Stepper {
             let bound = normal_term(
                 &self.settings,
                 &mut self.active[i],
-                &st,
-                cand.e,
+                &self.state[c],
+                e,
                 &mut self.q1[i * dim],
                 &mut self.poisson_impact,
                 record,
             );
             // the gap's second-order remainder over the step on v_free (module `narrow`)
-            let c = self.gap_curvature(ai.cand, &self.geo_cache[ai.cand], &self.v_free);
-            self.qc[i * dim] += bound + curvature_term(c, h);
+            let curvature = self.gap_curvature(c, &self.geo_cache[c], &self.v_free);
+            self.qc[i * dim] += bound + curvature_term(curvature, h);
         }
     }
 }
@@ -213,6 +190,127 @@ pub(super) fn warm_start_of(
         initial.extend_from_slice(&state[a.cand].warm[..dim]);
     }
     !initial.is_empty() && active.iter().any(|a| state[a.cand].corrected)
+}
+
+/// The polyhedral LCP's guessed basis from the active contacts' last bases
+/// ([`CandState::basis`]), shared by both drivers, in the layout of
+/// [`crate::contact::polyhedral::PolyhedralLcp`]: normals `0..nc`, then each frictional
+/// contact's `facets` β, then their λ; `mu_of(c)` is candidate c's friction coefficient.
+/// Empty when warm starts are off or a contact's variables do not fit the 64 bits.
+pub(super) fn basis_guess(
+    settings: &StepSettings,
+    dim: usize,
+    active: &[Active],
+    state: &[CandState],
+    mu_of: impl Fn(usize) -> f64,
+    out: &mut Vec<usize>,
+) {
+    out.clear();
+    let facets = match &settings.solver {
+        StepSolver::Lemke(s) => s.facets,
+        StepSolver::Nsgs(_) => PolyhedralSettings::for_dim(dim).facets,
+    };
+    if facets + 2 > 64 || !settings.warm_start {
+        return;
+    }
+    let nc = active.len();
+    let nf = active.iter().filter(|a| mu_of(a.cand) > 0.0).count();
+    let (mut beta, mut lambda) = (nc, nc + nf * facets);
+    for (i, a) in active.iter().enumerate() {
+        let bits = state[a.cand].basis;
+        if bits & 1 != 0 {
+            out.push(i);
+        }
+        if mu_of(a.cand) > 0.0 {
+            for k in 0..facets {
+                if bits & (1 << (2 + k)) != 0 {
+                    out.push(beta + k);
+                }
+            }
+            if bits & 2 != 0 {
+                out.push(lambda);
+            }
+            beta += facets;
+            lambda += 1;
+        }
+    }
+}
+
+/// The buffers of a step's contact solve kept from step to step (the warm start, Lemke's
+/// guessed basis, the restitution coefficients and Poisson's impact impulses).
+#[derive(Default)]
+pub(super) struct SolveWork {
+    initial: Vec<f64>,
+    basis: Vec<usize>,
+    restitution: Vec<f64>,
+    p_impact: Vec<f64>,
+}
+
+/// What [`contact_solve`] reads: the active contacts, their states and laws, and the contact
+/// terms built by the driver.
+pub(super) struct ContactSolve<'a> {
+    pub(super) settings: &'a StepSettings,
+    pub(super) dim: usize,
+    pub(super) active: &'a [Active],
+    pub(super) state: &'a [CandState],
+    /// `(mu, e)` of a candidate.
+    pub(super) law_of: &'a dyn Fn(usize) -> (f64, f64),
+    pub(super) q1: &'a [f64],
+    pub(super) mu: &'a [f64],
+    pub(super) poisson_impact: bool,
+}
+
+/// The contact solve of a step, shared by both drivers, once W (`delassus`) and the contact
+/// terms (`qc`, `q1`, mu) are built: the warm start by contact identity (polished once more
+/// after a correcting solve, [`warm_start_of`]), Lemke's guessed basis ([`basis_guess`]),
+/// Poisson's impact phase when it has work, then the step's solve ([`solve_phases`]) into
+/// `solve.impulse`.
+pub(super) fn contact_solve(
+    input: &ContactSolve<'_>,
+    delassus: &mut WAssembly,
+    qc: &mut [f64],
+    work: &mut SolveWork,
+    solve: &mut SolveBuffers,
+    record: &mut StepRecord,
+) -> Result<()> {
+    let (settings, dim, active) = (input.settings, input.dim, input.active);
+    let corrected = warm_start_of(settings, dim, active, input.state, &mut work.initial);
+    let law_of = input.law_of;
+    basis_guess(
+        settings,
+        dim,
+        active,
+        input.state,
+        |c| law_of(c).0,
+        &mut work.basis,
+    );
+    work.restitution.clear();
+    if input.poisson_impact {
+        work.restitution
+            .extend(active.iter().map(|a| law_of(a.cand).1));
+    }
+    // W's storage: dense for few contacts, block CSR for many
+    let (dense, sparse) = delassus.storage()?;
+    solve_phases(
+        &Phases {
+            settings,
+            dim,
+            dense,
+            sparse,
+            active,
+            e: &work.restitution,
+            q1: input.q1,
+            mu: input.mu,
+            warm: (!work.initial.is_empty()).then_some(work.initial.as_slice()),
+            corrected,
+            guess: &work.basis,
+            poisson_impact: input.poisson_impact,
+        },
+        qc,
+        record,
+        solve,
+        &mut work.p_impact,
+    )
 }
 
 /// What a step's contact solve reads once W and the contact terms are built.

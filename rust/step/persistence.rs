@@ -6,7 +6,7 @@
 use super::super::impact::ImpactMemory;
 use super::bodies::norm3;
 use super::narrow::{pad, Candidate};
-use super::{dot_v, ContactRecord, Pair, PolyhedralSettings, Scene, StepSolver, Stepper};
+use super::{dot_v, ContactRecord, Pair, Scene, Stepper};
 
 /// What a candidate carries from one step to the next (reset when it is far).
 #[derive(Clone, Copy, Debug, Default)]
@@ -162,46 +162,6 @@ impl Stepper {
                 e,
                 id: self.n_static + i as usize * nb + j as usize,
             });
-        }
-    }
-
-    /// The polyhedral LCP's guessed basis from the active contacts' last bases (see
-    /// [`CandState::basis`]), in the layout of [`PolyhedralLcp`]: normals `0..nc`, then each
-    /// frictional contact's `facets` β, then their λ.
-    pub(super) fn basis_of_active(&self, out: &mut Vec<usize>) {
-        out.clear();
-        let facets = match &self.settings.solver {
-            StepSolver::Lemke(s) => s.facets,
-            StepSolver::Nsgs(_) => PolyhedralSettings::for_dim(self.dim).facets,
-        };
-        if facets + 2 > 64 || !self.settings.warm_start {
-            return;
-        }
-        let nc = self.active.len();
-        let nf = self
-            .active
-            .iter()
-            .filter(|a| self.candidates[a.cand].mu > 0.0)
-            .count();
-        let mut beta = nc;
-        let mut lambda = nc + nf * facets;
-        for (i, a) in self.active.iter().enumerate() {
-            let bits = self.state[a.cand].basis;
-            if bits & 1 != 0 {
-                out.push(i);
-            }
-            if self.candidates[a.cand].mu > 0.0 {
-                for k in 0..facets {
-                    if bits & (1 << (2 + k)) != 0 {
-                        out.push(beta + k);
-                    }
-                }
-                if bits & 2 != 0 {
-                    out.push(lambda);
-                }
-                beta += facets;
-                lambda += 1;
-            }
         }
     }
 }

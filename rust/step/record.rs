@@ -4,7 +4,7 @@
 //! ([`ContactRecord`]) in a [`Trajectory`], folding the records of unrecorded steps into the
 //! next recorded one.
 
-use super::Stepper;
+use super::{Stepper, TINY};
 use crate::contact::ContactStatus;
 use crate::error::Result;
 use crate::step::{Scene, StepSettings};
@@ -136,36 +136,72 @@ pub fn simulate_recorded(
         &format!("record fewer states with record_every >= {needed:.0}"),
     )?;
     let reserve = rows.min(4096);
-    let mut out = Trajectory {
-        dim: st.dim,
-        nq: st.nq,
-        nv: st.nv,
-        t: Vec::with_capacity(reserve),
-        q: Vec::with_capacity(reserve * st.nq),
-        v: Vec::with_capacity(reserve * st.nv),
-        kinetic_energy: Vec::with_capacity(reserve),
-        potential_energy: Vec::with_capacity(reserve),
-        min_gap: Vec::with_capacity(reserve),
-        negative_gaps: Vec::with_capacity(reserve),
-        steps: Vec::with_capacity(reserve),
-        contacts: Vec::new(),
-        stopped: None,
-    };
-    st.push_state(&mut out);
+    let mut out = Trajectory::reserved(st.dim, st.nq, st.nv, reserve);
+    run_recorded(&mut st, steps, every, &mut out)?;
+    Ok(out)
+}
+
+impl Trajectory {
+    /// an empty trajectory of `dim`, `nq` coordinates and `nv` velocities, with room for
+    /// `reserve` states.
+    pub(super) fn reserved(dim: usize, nq: usize, nv: usize, reserve: usize) -> Self {
+        Trajectory {
+            dim,
+            nq,
+            nv,
+            t: Vec::with_capacity(reserve),
+            q: Vec::with_capacity(reserve * nq),
+            v: Vec::with_capacity(reserve * nv),
+            kinetic_energy: Vec::with_capacity(reserve),
+            potential_energy: Vec::with_capacity(reserve),
+            min_gap: Vec::with_capacity(reserve),
+            negative_gaps: Vec::with_capacity(reserve),
+            steps: Vec::with_capacity(reserve),
+            contacts: Vec::new(),
+            stopped: None,
+        }
+    }
+}
+
+/// What the recording loop ([`run_recorded`]) asks of a driver (a scene's [`Stepper`] or a
+/// model's [`super::generalized::GeneralizedStepper`]).
+pub(super) trait Recorded {
+    /// one step, its active contacts appended to `contacts`.
+    fn step(&mut self, contacts: &mut Vec<ContactRecord>) -> Result<StepRecord>;
+    /// appends the current state (time, q, v, energies, gaps) to `out`.
+    fn record_state(&mut self, out: &mut Trajectory) -> Result<()>;
+    /// whether the current q and v are finite.
+    fn state_finite(&self) -> bool;
+    /// the work of one step, for the interrupt hook's polling ([`crate::interrupt::poll`]).
+    fn step_cost(&self) -> usize;
+}
+
+/// The recording loop shared by both drivers: `steps` steps from the current state, which is
+/// recorded first, keeping the state after every `every`-th step and after the last. The
+/// records of unrecorded steps are folded into the next recorded one
+/// ([`StepRecord::fold`]) and their contact records dropped; a non-finite state stops the
+/// run (`out.stopped` says why); the contact records are checked against the memory budget
+/// as they grow; the caller's interrupt hook can stop the run.
+pub(super) fn run_recorded<D: Recorded>(
+    d: &mut D,
+    steps: usize,
+    every: usize,
+    out: &mut Trajectory,
+) -> Result<()> {
+    d.record_state(out)?;
     let mut pending: Option<StepRecord> = None;
     for k in 0..steps {
-        if crate::interrupt::poll(st.nq * st.nv + 64) {
+        if crate::interrupt::poll(d.step_cost()) {
             break; // the caller's interrupt hook asked to stop (see crate::interrupt)
         }
         let kept = out.contacts.len();
-        let mut rec = st.step(&mut out.contacts)?;
+        let mut rec = d.step(&mut out.contacts)?;
         if let Some(p) = pending.take() {
             rec.fold(&p);
         }
         let row = out.steps.len();
         out.contacts[kept..].iter_mut().for_each(|c| c.step = row);
-        let finite = st.v.iter().chain(st.q.iter()).all(|x| x.is_finite());
-        if !finite {
+        if !d.state_finite() {
             out.stopped = Some(format!(
                 "step {k} produced a non-finite state (contact solver: {})",
                 rec.status.map_or("no contacts", |s| s.as_str())
@@ -178,16 +214,81 @@ pub fn simulate_recorded(
             pending = Some(rec);
             continue;
         }
+        check_contact_records(out.contacts.len())?;
+        out.steps.push(rec);
+        d.record_state(out)?;
+    }
+    Ok(())
+}
+
+impl Recorded for Stepper {
+    fn step(&mut self, contacts: &mut Vec<ContactRecord>) -> Result<StepRecord> {
+        Stepper::step(self, contacts)
+    }
+    fn record_state(&mut self, out: &mut Trajectory) -> Result<()> {
+        self.push_state(out);
+        Ok(())
+    }
+    fn state_finite(&self) -> bool {
+        self.v.iter().chain(self.q.iter()).all(|x| x.is_finite())
+    }
+    fn step_cost(&self) -> usize {
+        self.nq * self.nv + 64
+    }
+}
+
+/// The momentum balance of a step, shared by both drivers: `||M (v_{k+1} - v_free) - G P||`
+/// relative to the momenta involved, `max(||G P||, ||M v_free||, ||M v_{k+1}||)` (rounding is
+/// relative to the largest; the absolute norm when all are zero). M is given by its diagonal
+/// blocks `(m, stride, off, n)`: entry `(a, c)` of a block is `m[a stride + c]`, acting on the
+/// velocities `off..off + n` (a body of a scene, or a model's whole M).
+pub(super) fn momentum_residual<'a>(
+    blocks: impl Iterator<Item = (&'a [f64], usize, usize, usize)>,
+    v_next: &[f64],
+    v_free: &[f64],
+    gp: &[f64],
+) -> f64 {
+    let (mut res2, mut gp2, mut mf2, mut mn2) = (0.0, 0.0, 0.0, 0.0);
+    for (m, stride, off, n) in blocks {
+        for a in 0..n {
+            let (mut mdv, mut mf, mut mn) = (0.0, 0.0, 0.0);
+            for c in 0..n {
+                let (vn, vf) = (v_next[off + c], v_free[off + c]);
+                mdv += m[a * stride + c] * (vn - vf);
+                mf += m[a * stride + c] * vf;
+                mn += m[a * stride + c] * vn;
+            }
+            let r = mdv - gp[off + a];
+            res2 += r * r;
+            gp2 += gp[off + a] * gp[off + a];
+            mf2 += mf * mf;
+            mn2 += mn * mn;
+        }
+    }
+    let scale2 = gp2.max(mf2).max(mn2);
+    if scale2.sqrt() > TINY {
+        (res2 / scale2).sqrt()
+    } else {
+        res2.sqrt()
+    }
+}
+
+/// the contact records' size against the memory budget ([`crate::limits::check_bytes`]), its
+/// message formed only when refused (the check runs after every recorded step).
+fn check_contact_records(count: usize) -> Result<()> {
+    let item = std::mem::size_of::<ContactRecord>();
+    let within = count
+        .checked_mul(item)
+        .is_some_and(|b| b <= crate::limits::memory_budget());
+    if !within {
         crate::limits::check_bytes(
-            &format!("recording {} contact records", out.contacts.len()),
-            out.contacts.len(),
-            std::mem::size_of::<ContactRecord>(),
+            &format!("recording {count} contact records"),
+            count,
+            item,
             "record fewer states with record_every",
         )?;
-        out.steps.push(rec);
-        st.push_state(&mut out);
     }
-    Ok(out)
+    Ok(())
 }
 
 impl StepRecord {

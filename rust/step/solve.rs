@@ -97,7 +97,7 @@ impl SolveBuffers {
 
 /// The polyhedral-cone LCP of `problem` by Lemke's method (as
 /// [`crate::contact::solve_polyhedral`]), started from `guess` (the previous step's basis of
-/// the same contacts, see [`Stepper::basis_of_active`]) when the settings give none: if the
+/// the same contacts, see [`super::law::basis_guess`]) when the settings give none: if the
 /// guess still solves the LCP no pivot is made. Lemke's tableau is reused across steps.
 pub(super) fn solve_polyhedral_warm(
     problem: &ContactProblem<'_>,

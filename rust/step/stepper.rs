@@ -11,6 +11,8 @@
 mod bodies;
 #[path = "drift.rs"]
 mod drift;
+#[path = "driver.rs"]
+mod driver;
 #[path = "event.rs"]
 mod event;
 #[path = "generalized.rs"]
@@ -27,7 +29,7 @@ mod record;
 mod solve;
 
 use self::bodies::{bodies_of, norm3, BodyInfo, Frozen};
-use self::event::Located;
+use self::law::SolveWork;
 use self::narrow::{declared_candidates, frame, Candidate, Geometry};
 use self::persistence::{sphere_points, CandState};
 pub use self::record::{simulate, simulate_recorded, ContactRecord, StepRecord, Trajectory};
@@ -142,12 +144,8 @@ pub struct Stepper {
     auto_keys: Vec<u64>,
     old_keys: Vec<u64>,
     old_state: Vec<CandState>,
-    /// the solve's warm start, Lemke's guessed basis and Poisson's impact impulse.
-    initial: Vec<f64>,
-    basis_guess: Vec<usize>,
-    p_impact: Vec<f64>,
-    /// the active contacts' restitution coefficients (Poisson's impact phase).
-    restitution: Vec<f64>,
+    /// the contact solve's buffers kept from step to step.
+    work: SolveWork,
     solve: SolveBuffers,
     gp: Vec<f64>,
     v_next: Vec<f64>,
@@ -205,10 +203,7 @@ impl Stepper {
             auto_keys: Vec::new(),
             old_keys: Vec::new(),
             old_state: Vec::new(),
-            initial: Vec::new(),
-            basis_guess: Vec::new(),
-            p_impact: Vec::new(),
-            restitution: Vec::new(),
+            work: SolveWork::default(),
             solve: SolveBuffers::default(),
             candidates,
         })
@@ -284,50 +279,7 @@ impl Stepper {
     /// contact solve (impact law, W, solver), `v_{k+1} = v_free + M^{-1} G P`, the momentum
     /// check, the contacts' memory and records, the positions, the drift projection.
     pub fn step(&mut self, contacts: &mut Vec<ContactRecord>) -> Result<StepRecord> {
-        self.prepare();
-        self.search_contacts();
-        let mut free = false;
-        if self.settings.locate_impacts {
-            match self.located_step(contacts)? {
-                Located::Done(record) => return Ok(record),
-                Located::Free => free = true,
-                Located::Plain => {}
-            }
-        }
-        let nc = self.active.len();
-        let mut record = Self::blank_record(nc);
-        let mut v_next = std::mem::take(&mut self.v_next);
-        v_next.copy_from_slice(&self.v_free);
-        self.gp.fill(0.0);
-        if nc > 0 {
-            if free {
-                self.free_of_contacts(&mut record);
-            } else {
-                self.solve_contacts(&mut record)?;
-            }
-            self.apply_impulses(&mut v_next);
-        }
-        record.momentum_residual = self.momentum_residual(&v_next);
-        if nc > 0 {
-            self.remember(&v_next, contacts);
-        }
-        // the energy at the start of the step bounds the projection's
-        let project = self.settings.drift == Drift::Projection && nc > 0;
-        let e_start = if project {
-            let (t, v) = self.energies();
-            t + v
-        } else {
-            0.0
-        };
-        self.v.copy_from_slice(&v_next);
-        self.v_next = v_next;
-        self.integrate_positions();
-        if project {
-            record.projection = self.project(e_start)?;
-        }
-        self.step_index += 1;
-        self.t = self.step_index as f64 * self.settings.h;
-        Ok(record)
+        driver::step(self, contacts)
     }
 
     /// The contact search, which must find the closed and the imminently closing contacts
@@ -418,35 +370,11 @@ impl Stepper {
         }
     }
 
-    /// the momentum balance `||M (v_{k+1} - v_free) - G P||` relative to the momenta
-    /// involved, `max(||G P||, ||M v_free||, ||M v_{k+1}||)` (rounding is relative to the
-    /// largest; the absolute norm when all are zero).
+    /// the momentum balance of the step ([`record::momentum_residual`]), body by body.
     fn momentum_residual(&self, v_next: &[f64]) -> f64 {
-        let mut res2 = 0.0;
-        let (mut gp2, mut mf2, mut mn2) = (0.0, 0.0, 0.0);
-        for (bi, b) in self.bodies.iter().enumerate() {
-            let m = &self.frozen[bi].m;
-            for a in 0..b.nv {
-                let (mut mdv, mut mf, mut mn) = (0.0, 0.0, 0.0);
-                for c in 0..b.nv {
-                    let (vn, vf) = (v_next[b.off_v + c], self.v_free[b.off_v + c]);
-                    mdv += m[a * 6 + c] * (vn - vf);
-                    mf += m[a * 6 + c] * vf;
-                    mn += m[a * 6 + c] * vn;
-                }
-                let r = mdv - self.gp[b.off_v + a];
-                res2 += r * r;
-                gp2 += self.gp[b.off_v + a] * self.gp[b.off_v + a];
-                mf2 += mf * mf;
-                mn2 += mn * mn;
-            }
-        }
-        let scale2 = gp2.max(mf2).max(mn2);
-        if scale2.sqrt() > TINY {
-            (res2 / scale2).sqrt()
-        } else {
-            res2.sqrt()
-        }
+        let blocks =
+            (self.bodies.iter().zip(&self.frozen)).map(|(b, f)| (&f.m[..], 6, b.off_v, b.nv));
+        record::momentum_residual(blocks, v_next, &self.v_free, &self.gp)
     }
 
     fn push_state(&mut self, out: &mut Trajectory) {
