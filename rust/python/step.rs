@@ -119,6 +119,7 @@ fn scene_from_dict(d: &Bound<'_, PyDict>) -> PyResult<Scene> {
         shapes,
         half_spaces,
         pairs,
+        solids: Vec::new(),
     })
 }
 

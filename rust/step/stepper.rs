@@ -23,6 +23,8 @@ mod narrow;
 mod persistence;
 #[path = "record.rs"]
 mod record;
+#[path = "solid_pairs.rs"]
+mod solid_pairs;
 #[path = "solve.rs"]
 mod solve;
 
@@ -154,6 +156,8 @@ pub struct Stepper {
     /// `(q_k, v_k)` while a located step follows its path (module `event`).
     saved_q: Vec<f64>,
     saved_v: Vec<f64>,
+    /// the solids' pairs and their candidates' names (module `solid_pairs`).
+    solid_pairs: solid_pairs::SolidPairs,
 }
 
 impl Stepper {
@@ -167,6 +171,7 @@ impl Stepper {
         let candidates = declared_candidates(scene);
         let nc = candidates.len();
         let (auto, balls, declared_balls) = sphere_points(scene);
+        let solid_pairs = solid_pairs::SolidPairs::of(scene, nc, nc + balls.len() * balls.len());
         Ok(Self {
             dim,
             settings: settings.clone(),
@@ -211,6 +216,7 @@ impl Stepper {
             restitution: Vec::new(),
             solve: SolveBuffers::default(),
             candidates,
+            solid_pairs,
         })
     }
 
@@ -246,9 +252,11 @@ impl Stepper {
             }
             self.speed_bounds[bi] = sb;
         }
+        self.save_solid_state();
         if self.auto.is_some() {
             self.broad_phase();
         }
+        self.solid_phase();
         self.geo_cache.clear();
         for c in 0..self.candidates.len() {
             let geo = self.geometry(c);
