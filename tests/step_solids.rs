@@ -241,17 +241,19 @@ fn bad_solids_and_pairs_are_refused() {
 fn debug_slide() {
     let scene = box_on_box(2, 1.0, 0.3, 1.5, false);
     let tr = run(&scene, &StepSettings::new(1e-3, 150));
-    for k in 135..146 {
+    for k in 0..6 {
         let cs: Vec<_> = tr
             .contacts
             .iter()
             .filter(|c| c.step == k)
-            .map(|c| (c.id, c.gap, c.impulse[0], c.closed))
+            .map(|c| (c.id, c.velocity, c.closed, c.approach))
             .collect();
         println!(
-            "{k} active {} y {:e} {:?}",
+            "{k} {:?} active {} q {:?} v {:?} {:?}",
+            tr.steps[k],
             tr.steps[k].active,
-            tr.q[k * tr.nq + 1] - 0.05,
+            &tr.q[k * tr.nq..(k + 1) * tr.nq],
+            &tr.v[k * tr.nv..(k + 1) * tr.nv],
             cs
         );
     }
@@ -284,6 +286,25 @@ fn debug_tower() {
                 "{k} {:?} {} {:e} v {vmax:e} {:?}",
                 s.status, s.iterations, s.scaled_error, imp
             );
+        }
+    }
+}
+
+#[test]
+#[ignore]
+fn debug_normal() {
+    use coulomb::geometry::{contacts2, ContactCache2};
+    use nalgebra::{Isometry2, Vector2};
+    let top = ok(Shape2::rectangle([0.1, 0.05]));
+    let low = ok(Shape2::rectangle([2.0, 0.1]));
+    let pb = Isometry2::new(Vector2::new(0.0, -0.1), 0.0);
+    let mut cache = ContactCache2::default();
+    for (x, y, th) in [(0.004482342000000209, 0.0499999999999993, 7.202807794648437e-15), (0.004482342000000209, 0.0499999999999993, 7.202807794648437e-15), (0.0029911710000002176, 0.049999999999999274, 7.367773058319926e-15), (0.004482342000000209, 0.0499999999999993, 7.202807794648437e-15)] {
+        let pa = Isometry2::new(Vector2::new(x, y), th);
+        let mut out = vec![];
+        ok(contacts2(&top, &pa, &low, &pb, 1e-3, &mut cache, &mut out));
+        for p in &out {
+            println!("{x} n {:?} gap {:e} pa {:?} id {:?}", p.normal, p.gap, p.point_a, p.id);
         }
     }
 }
