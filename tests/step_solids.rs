@@ -109,8 +109,9 @@ fn a_box_tower_stands_with_exact_sticking_under_nsgs_and_lemke() {
             let n = 6;
             let scene = tower(dim, n, 0.1, 0.5);
             let mut settings = StepSettings::new(1e-3, 2000);
-            // a stack's W is singular (more contact rows than velocities: the impulses inside
-            // a face are not unique), where NSGS's error can stall just above 1e-12
+            // a face's contact rows outnumber the relative velocities they constrain (in 2D
+            // two tangential rows for one sliding direction: the split of the friction
+            // between the two corners is not unique), where NSGS's error can stall at 1.5e-12
             if let StepSolver::Nsgs(s) = &mut settings.solver {
                 s.tol = 1e-10;
             }
@@ -132,15 +133,17 @@ fn a_box_tower_stands_with_exact_sticking_under_nsgs_and_lemke() {
     }
 }
 
-/// A box dropped on its edge or corner onto a static box with e = 1 (frictionless, so
-/// Newton's law gives back the energy exactly at an isolated impact): the energy after the
-/// first bounce differs from the start by O(h), the error at h / 4 at most about a quarter
-/// of that at h (ratio below 0.4), in 2D (edge) and 3D (edge and corner).
+/// A box dropped on its edge or corner onto a static box with e = 1 (frictionless: Newton's
+/// law gives back the energy exactly at an isolated impact, and the plain step loses or gains
+/// up to `h m_eff |v_n^-| |g''|` per bounce, module docs of the stepper): over a run with
+/// several bounces the energy error stays within `20 h E_0` at four h from 4e-4 to 5e-5 (the
+/// ratio `|ΔE| / (h E_0)` measured up to 8.1; its sign varies with where in the step each impact
+/// falls), in 2D (an edge: a corner of the rectangle) and 3D (an edge, a corner).
 #[test]
 fn a_box_dropped_on_its_corner_with_e_one_keeps_its_energy_within_o_h() {
     for (dim, tilt) in [(2, [0.3, 0.0]), (3, [0.3, 0.0]), (3, [0.3, 0.4])] {
-        let mut errors = vec![];
-        for h in [4e-4, 1e-4] {
+        let mut ratios = vec![];
+        for h in [4e-4, 2e-4, 1e-4, 5e-5] {
             let scene = dropped_box(dim, tilt, 1.0);
             let steps = (0.25 / h) as usize;
             let tr = run(&scene, &StepSettings::new(h, steps));
@@ -150,12 +153,12 @@ fn a_box_dropped_on_its_corner_with_e_one_keeps_its_energy_within_o_h() {
             let e1 = tr.kinetic_energy[steps] + tr.potential_energy[steps];
             let bounced = tr.contacts.iter().any(|c| c.impulse[0] > 0.0);
             assert!(bounced, "{case}: the box must hit the lower one");
-            errors.push((e1 - e0).abs() / e0.abs().max(1e-300));
+            ratios.push((e1 - e0).abs() / (h * e0.abs()));
         }
-        assert!(errors[0] < 0.05, "{dim} {tilt:?}: energy error {errors:?}");
+        let worst = ratios.iter().fold(0.0f64, |m, r| m.max(*r));
         assert!(
-            errors[1] < 0.4 * errors[0] + 1e-9,
-            "{dim} {tilt:?}: not O(h): {errors:?}"
+            worst <= 20.0,
+            "dim {dim}, tilt {tilt:?}: |dE| / (h E0) = {ratios:?}"
         );
     }
 }
@@ -234,77 +237,4 @@ fn bad_solids_and_pairs_are_refused() {
         });
     });
     let _ = (Body::clone, BodyKind::Particle, HalfSpace::clone);
-}
-
-#[test]
-#[ignore]
-fn debug_slide() {
-    let scene = box_on_box(2, 1.0, 0.3, 1.5, false);
-    let tr = run(&scene, &StepSettings::new(1e-3, 150));
-    for k in 0..6 {
-        let cs: Vec<_> = tr
-            .contacts
-            .iter()
-            .filter(|c| c.step == k)
-            .map(|c| (c.id, c.velocity, c.closed, c.approach))
-            .collect();
-        println!(
-            "{k} {:?} active {} q {:?} v {:?} {:?}",
-            tr.steps[k],
-            tr.steps[k].active,
-            &tr.q[k * tr.nq..(k + 1) * tr.nq],
-            &tr.v[k * tr.nv..(k + 1) * tr.nv],
-            cs
-        );
-    }
-}
-
-#[test]
-#[ignore]
-fn debug_tower() {
-    let scene = tower(2, 6, 0.1, 0.5);
-    let tr = run(&scene, &StepSettings::new(1e-3, 400));
-    for k in 0..400 {
-        let s = &tr.steps[k];
-        if s.status != Some(ContactStatus::Solved) || k < 3 || (310..318).contains(&k) {
-            let ids: Vec<_> = tr
-                .contacts
-                .iter()
-                .filter(|c| c.step == k)
-                .map(|c| c.id)
-                .collect();
-            let vmax = tr.v[k * tr.nv..(k + 1) * tr.nv]
-                .iter()
-                .fold(0.0f64, |m, x| m.max(x.abs()));
-            let imp: Vec<_> = tr
-                .contacts
-                .iter()
-                .filter(|c| c.step == k)
-                .map(|c| format!("{:.3e}/{:.2e}/{:.1e}", c.impulse[0], c.impulse[1], c.gap))
-                .collect();
-            println!(
-                "{k} {:?} {} {:e} v {vmax:e} {:?}",
-                s.status, s.iterations, s.scaled_error, imp
-            );
-        }
-    }
-}
-
-#[test]
-#[ignore]
-fn debug_normal() {
-    use coulomb::geometry::{contacts2, ContactCache2};
-    use nalgebra::{Isometry2, Vector2};
-    let top = ok(Shape2::rectangle([0.1, 0.05]));
-    let low = ok(Shape2::rectangle([2.0, 0.1]));
-    let pb = Isometry2::new(Vector2::new(0.0, -0.1), 0.0);
-    let mut cache = ContactCache2::default();
-    for (x, y, th) in [(0.004482342000000209, 0.0499999999999993, 7.202807794648437e-15), (0.004482342000000209, 0.0499999999999993, 7.202807794648437e-15), (0.0029911710000002176, 0.049999999999999274, 7.367773058319926e-15), (0.004482342000000209, 0.0499999999999993, 7.202807794648437e-15)] {
-        let pa = Isometry2::new(Vector2::new(x, y), th);
-        let mut out = vec![];
-        ok(contacts2(&top, &pa, &low, &pb, 1e-3, &mut cache, &mut out));
-        for p in &out {
-            println!("{x} n {:?} gap {:e} pa {:?} id {:?}", p.normal, p.gap, p.point_a, p.id);
-        }
-    }
 }

@@ -26,7 +26,11 @@
 //!
 //! In 3D parry appends GJK's closest pair, with unknown features, to the clipped polygon
 //! points; it lies among them, so it is dropped unless it is deeper than all of them (a
-//! redundant point would make the contact Delassus matrix singular).
+//! redundant point would make the contact Delassus matrix singular). For the same reason a
+//! point is dropped when the manifold already has one at the same place on both shapes (two
+//! equal boxes face to face: parry clips each face's corners against the other, giving each
+//! corner twice). A face contact's normal is the face's own (polygons and polyhedra): parry
+//! takes GJK's direction, accurate near touch only to about 1e-7.
 //!
 //! Allocation: a warm query between separated shapes allocates nothing; a touching one still
 //! allocates inside parry (its half-space manifold replaces the point buffer, its polygon
@@ -195,6 +199,9 @@ fn shared_face(fids: impl Iterator<Item = Option<u32>>) -> Option<u32> {
     face
 }
 
+/// Two points of one manifold closer than this (in the query's unit) on both shapes are one.
+const SAME_POINT: f64 = 1e-9;
+
 /// Below this cosine between parry's normal and a face's, the face is not the contact's.
 const SAME_NORMAL: f64 = 0.999_999;
 
@@ -238,6 +245,7 @@ macro_rules! contacts_impl {
                 .contact_manifolds(&pos12, a, b, query, manifolds, workspace)
                 .map_err(|_| unsupported(format!("{:?} and {:?}", a.shape_type(), b.shape_type())))?;
             for m in manifolds.iter() {
+                let first = out.len();
                 let part_a = m.subshape_pos1.unwrap_or_else($iso::identity);
                 let part_b = m.subshape_pos2.unwrap_or_else($iso::identity);
                 let mut normal = pose_a.rotation * (part_a.rotation * m.local_n1);
@@ -285,7 +293,13 @@ macro_rules! contacts_impl {
                     } else {
                         p.dist * unit - back
                     };
-                    if gap <= prediction {
+                    // a point twice (two equal faces clip to each one's corners: the same
+                    // corner from either side) would make the contact Delassus matrix singular
+                    let twice = out[first..].iter().any(|q: &$point| {
+                        (q.point_a - point_a).norm() <= SAME_POINT * unit
+                            && (q.point_b - point_b).norm() <= SAME_POINT * unit
+                    });
+                    if gap <= prediction && !twice {
                         out.push($point {
                             normal,
                             gap,

@@ -155,10 +155,12 @@ fn solid_shape(s: &Bound<'_, PyDict>, dim: usize) -> Result<SolidShape, CoulombE
             .flatten()
             .ok_or_else(|| CoulombError::Shape(format!("solid entry {key:?} is missing")))
     };
-    fn ex<'py, T: FromPyObjectOwned<'py>>(v: Bound<'py, PyAny>, key: &str) -> Result<T, CoulombError> {
-        v.extract::<T>().map_err(|_| {
-            CoulombError::Shape(format!("solid entry {key:?} has the wrong type"))
-        })
+    fn ex<'py, T: FromPyObjectOwned<'py>>(
+        v: Bound<'py, PyAny>,
+        key: &str,
+    ) -> Result<T, CoulombError> {
+        v.extract::<T>()
+            .map_err(|_| CoulombError::Shape(format!("solid entry {key:?} has the wrong type")))
     }
     let f = |key: &str| -> Result<f64, CoulombError> { ex(get(key)?, key) };
     let kind: String = ex(get("kind")?, "kind")?;
@@ -530,7 +532,9 @@ pub(super) fn solid_check(solid: &Bound<'_, PyDict>, dim: usize) -> PyResult<()>
             CoulombError::InvalidParameter(format!("dim must be 2 or 3, got {dim}")),
         ));
     }
-    solid_shape(solid, dim).map(|_| ()).map_err(|e| to_py(py, e))
+    solid_shape(solid, dim)
+        .map(|_| ())
+        .map_err(|e| to_py(py, e))
 }
 
 /// registers the stepper's functions in `coulomb._core`.
