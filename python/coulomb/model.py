@@ -4,11 +4,17 @@ r"""Scenes: bodies, contact shapes, half-spaces and contact pairs, simulated by 
 A planar scene (``dim=2``) has particles ``(x, y)`` and planar rigid bodies ``(x, y, theta)``;
 a spatial scene (``dim=3``) has particles ``(x, y, z)`` and spatial rigid bodies (position, unit
 quaternion ``(w, x, y, z)``; velocities: linear, then the angular velocity in the world frame;
-inertia in the body frame). Contact shapes are sets of body-frame points with a radius
+inertia in the body frame). The point shapes are sets of body-frame points with a radius
 (:class:`Point`, :class:`Sphere`/:class:`Disk`, :class:`Segment` ends, :class:`Box` and
-:class:`Polygon` corners); a pair is a shape against a static :class:`HalfSpace` (floor, ramp,
-wall) or a sphere against a sphere, each with its friction coefficient ``mu`` and Newton
-restitution coefficient ``e``.
+:class:`Polygon` corners): against a static :class:`HalfSpace` (floor, ramp, wall) they touch
+by their points, a sphere against a sphere by the centres. Every shape with a volume is also a
+solid (:class:`Sphere`, :class:`Box`, :class:`Polygon`, :class:`Segment` with a radius or in
+2D, :class:`Capsule`, :class:`Cylinder`, :class:`Cone`, :class:`ConvexHull`,
+:class:`Compound`; static :class:`TriangleMesh` and :class:`Heightfield` added to the scene),
+and any two solids touch: each step the narrow phase (dimforge's parry, corrected) gives their
+contact points. Pairs are declared by :meth:`Scene.contact` or found each step by a broad
+phase (:meth:`Scene.contact_spheres`, :meth:`Scene.contact_all`), each with its friction
+coefficient ``mu`` and Newton restitution coefficient ``e``.
 
 >>> import coulomb
 >>> scene = coulomb.Scene(dim=2, gravity=(0.0, -9.81))

@@ -62,7 +62,12 @@
 //! ends, a box's or polygon's corners. Pairs ([`Pair`]): shape vs a static half-space, and
 //! sphere vs sphere (every point of one shape against every point of the other), declared one
 //! by one or found each step by the broad phase ([`Pair::Spheres`], a uniform grid over the
-//! spheres, O(N) per step: [`broad`]).
+//! spheres, O(N) per step: [`broad`]). Solids ([`Solid`]) are the geometry layer's shapes on
+//! bodies or static (meshes, heightfields, obstacles): any two of them, or one and a
+//! half-space, declared ([`Pair::SolidSolid`], [`Pair::SolidHalfSpace`]) or found each step by
+//! a broad phase over their bounding boxes ([`Pair::Solids`]), get their contact points at
+//! each state from [`crate::geometry::contacts3`] / [`crate::geometry::contacts2`], named by
+//! their features so that warm starts and impact memory follow the same contact point.
 //!
 //! Drift: a velocity-level condition does not enforce `g(q_{k+1}) >= 0` exactly
 //! (Stewart 2000). Each contact's normal condition carries the gap's second-order remainder over the step on

@@ -6,7 +6,9 @@
 //! another body (spheres: gap `|x_a - x_b| - r_a - r_b`, normal `(x_a - x_b) / |x_a - x_b|`).
 //! The candidates of declared pairs are built once, in declaration order (their index is the
 //! contact's identity); the sphere pairs of [`Pair::Spheres`] are found each step by the broad
-//! phase (module `persistence`).
+//! phase (module `persistence`). A solid contact (module `solid_pairs`) is a witness point on
+//! body a against the plane through a static witness (the half-space candidate, radius 0), or
+//! two witness points on two bodies with the normal fixed in one body's frame ([`Turn`]).
 
 use nalgebra::Vector3;
 

@@ -14,6 +14,8 @@ use crate::error::{check_finite, CoulombError, Result};
 use crate::geometry::{Shape2, Shape3};
 
 /// A shape of the geometry layer in a scene of either dimension.
+// built once per scene and never moved in a step: the variants' sizes do not matter
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug)]
 pub enum SolidShape {
     /// a 2D shape (disk, convex polygon, segment, capsule, half-plane), for `dim = 2`.

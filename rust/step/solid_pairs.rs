@@ -264,7 +264,7 @@ impl Stepper {
                 taken: false,
             });
         }
-        sp.old.sort_unstable_by(|x, y| x.key.cmp(&y.key));
+        sp.old.sort_unstable_by_key(|x| x.key);
         self.candidates.truncate(sp.start);
         self.state.truncate(sp.start);
         sp.keys.clear();
