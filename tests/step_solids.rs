@@ -374,3 +374,72 @@ fn a_sliding_contact_keeps_its_identity_from_step_to_step() {
         assert!(sweeps <= 20 * (steps - 10), "dim {dim}: {sweeps} sweeps");
     }
 }
+
+/// A box sliding over a flat triangle-mesh floor (a 6 x 6 grid, 72 triangles: its face
+/// crosses the triangles' shared edges) decelerates at `mu g` to 1e-9 relative with no
+/// lift-off above 1e-9 m, every step solved: the points on a shared edge are not counted
+/// twice and each triangle's contact takes the triangle's normal.
+#[test]
+fn a_box_sliding_over_a_mesh_floor_decelerates_at_mu_g() {
+    let (n, side) = (6usize, 6.0);
+    let mut verts = vec![];
+    for i in 0..=n {
+        for j in 0..=n {
+            let (x, y) = (
+                -side / 2.0 + side * i as f64 / n as f64,
+                -side / 2.0 + side * j as f64 / n as f64,
+            );
+            verts.push([x, y, 0.0]);
+        }
+    }
+    let mut tris = vec![];
+    for i in 0..n as u32 {
+        for j in 0..n as u32 {
+            let (a, b) = (i * (n as u32 + 1) + j, (i + 1) * (n as u32 + 1) + j);
+            tris.push([a, b, b + 1]);
+            tris.push([a, b + 1, a + 1]);
+        }
+    }
+    let mesh = static_solid(SolidShape::Spatial(ok(Shape3::triangle_mesh(
+        &verts, &tris,
+    ))));
+    let half = [0.1, 0.07, 0.05];
+    let (mu, v0, h) = (0.3, 1.5, 1e-3);
+    let mut v = moving(3, v0);
+    v[1] = 0.4; // a diagonal slide, across both families of edges
+    let scene = Scene {
+        dim: 3,
+        gravity: gravity(3),
+        bodies: vec![box_body(3, 1.0, half, at(3, -0.9, half[2]), v)],
+        shapes: vec![],
+        half_spaces: vec![],
+        pairs: vec![Pair::SolidSolid {
+            a: 0,
+            b: 1,
+            mu,
+            e: 0.0,
+        }],
+        solids: vec![on_body(0, box_shape(3, half)), mesh],
+    };
+    let speed0 = (v0 * v0 + 0.16f64).sqrt();
+    let stop = speed0 / (mu * G);
+    let steps = ((stop + 0.1) / h) as usize;
+    let tr = run(&scene, &StepSettings::new(h, steps));
+    all_solved(&tr, "mesh floor");
+    for k in 0..=steps {
+        let t = k as f64 * h;
+        let v = &tr.v[k * tr.nv..(k + 1) * tr.nv];
+        let speed = (v[0] * v[0] + v[1] * v[1]).sqrt();
+        let want = (speed0 - mu * G * t).max(0.0);
+        assert!(
+            (speed - want).abs() < 1e-9 * speed0,
+            "t = {t}: {speed} vs {want}"
+        );
+        let z = tr.q[k * tr.nq + 2];
+        assert!(
+            (z - half[2]).abs() < 1e-9,
+            "t = {t}: lift-off {:e}",
+            z - half[2]
+        );
+    }
+}

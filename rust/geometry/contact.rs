@@ -27,9 +27,10 @@
 //! In 3D parry appends GJK's closest pair, with unknown features, to the clipped polygon
 //! points; it lies among them, so it is dropped unless it is deeper than all of them (a
 //! redundant point would make the contact Delassus matrix singular). For the same reason a
-//! point is dropped when the manifold already has one at the same place on both shapes (two
-//! equal boxes face to face: parry clips each face's corners against the other, giving each
-//! corner twice). A face contact's normal is the face's own (polygons and polyhedra): parry
+//! point is dropped when the answer already has one at the same place on both shapes with the
+//! same normal (two equal boxes face to face: parry clips each face's corners against the
+//! other, giving each corner twice; two triangles of a mesh both give the points on their
+//! shared edge). A face contact's normal is the face's own (polygons and polyhedra): parry
 //! takes GJK's direction, accurate near touch only to about 1e-7.
 //!
 //! Allocation: a warm query between separated shapes allocates nothing; a touching one still
@@ -186,6 +187,22 @@ fn face_normal3(shape: &dyn Parry3, fid: u32) -> Option<Vector3<f64>> {
         .and_then(|p| p.faces().get(idx).map(|f| f.normal.into_inner()))
 }
 
+/// The unit normal of triangle `part` of a triangle mesh or heightfield (its winding's, which
+/// the mesh's validation makes the outward one), in the shape's frame.
+fn part_normal3(shape: &dyn Parry3, part: u32) -> Option<Vector3<f64>> {
+    let tri = if let Some(mesh) = shape.as_trimesh() {
+        (part < mesh.num_triangles() as u32).then(|| mesh.triangle(part))?
+    } else {
+        shape.as_heightfield()?.triangle_at_id(part)?
+    };
+    tri.normal().map(|n| n.into_inner())
+}
+
+/// 2D shapes have no parts with faces of their own.
+fn part_normal2(_shape: &dyn Parry2, _part: u32) -> Option<Vector2<f64>> {
+    None
+}
+
 /// The face a manifold's points all lie on, when they share one face feature (`fid` of each
 /// point, unknown ones skipped).
 fn shared_face(fids: impl Iterator<Item = Option<u32>>) -> Option<u32> {
@@ -202,13 +219,17 @@ fn shared_face(fids: impl Iterator<Item = Option<u32>>) -> Option<u32> {
 /// Two points of one manifold closer than this (in the query's unit) on both shapes are one.
 const SAME_POINT: f64 = 1e-9;
 
+/// Normals closer than this are one (parry's GJK normals of two coplanar triangles of a mesh
+/// differ by about 1e-7; a real fold of a surface by far more).
+const SAME_NORMAL_DUP: f64 = 1e-6;
+
 /// Below this cosine between parry's normal and a face's, the face is not the contact's.
 const SAME_NORMAL: f64 = 0.999_999;
 
 macro_rules! contacts_impl {
     ($(#[$doc:meta])* $name:ident, $raw:ident, $shape:ty, $iso:ident, $vec:ident, $point:ident,
      $cache:ident, $dispatcher:ident, $check_pose:ident, $manifold:ty, $workspace:ty,
-     $dynshape:ty, $tracked:ident, $face:ident) => {
+     $dynshape:ty, $tracked:ident, $face:ident, $part_face:ident) => {
         /// parry's manifolds of `a` at `pose_a` and `b` at `pose_b` translated by `shift`,
         /// converted; gaps taken back to the unshifted poses (`g - n · shift`, exact while the
         /// same features touch), kept when `<= prediction`.
@@ -245,7 +266,6 @@ macro_rules! contacts_impl {
                 .contact_manifolds(&pos12, a, b, query, manifolds, workspace)
                 .map_err(|_| unsupported(format!("{:?} and {:?}", a.shape_type(), b.shape_type())))?;
             for m in manifolds.iter() {
-                let first = out.len();
                 let part_a = m.subshape_pos1.unwrap_or_else($iso::identity);
                 let part_b = m.subshape_pos2.unwrap_or_else($iso::identity);
                 let mut normal = pose_a.rotation * (part_a.rotation * m.local_n1);
@@ -255,15 +275,24 @@ macro_rules! contacts_impl {
                     let f = if on_b { p.fid2 } else { p.fid1 };
                     (!f.is_unknown()).then_some(f.0)
                 };
-                let simple = m.subshape_pos1.is_none() && m.subshape_pos2.is_none();
-                let face_b = shared_face(m.points.iter().map(|p| fid(p, true)))
-                    .and_then(|f| $face(b, f))
-                    .map(|n| -(pose_b.rotation * n));
-                let face_a = shared_face(m.points.iter().map(|p| fid(p, false)))
-                    .and_then(|f| $face(a, f))
-                    .map(|n| pose_a.rotation * n);
+                // a convex polygon's or polyhedron's face, or a mesh's or heightfield's
+                // triangle (whose parts are in the shape's own frame)
+                let face_b = match shared_face(m.points.iter().map(|p| fid(p, true))) {
+                    Some(f) if m.subshape_pos2.is_none() => {
+                        $face(b, f).or_else(|| $part_face(b, m.subshape2))
+                    }
+                    _ => None,
+                }
+                .map(|n| -(pose_b.rotation * n));
+                let face_a = match shared_face(m.points.iter().map(|p| fid(p, false))) {
+                    Some(f) if m.subshape_pos1.is_none() => {
+                        $face(a, f).or_else(|| $part_face(a, m.subshape1))
+                    }
+                    _ => None,
+                }
+                .map(|n| pose_a.rotation * n);
                 let snapped = match (face_b, face_a) {
-                    (Some(n), _) | (None, Some(n)) if simple && n.dot(&normal) > SAME_NORMAL => {
+                    (Some(n), _) | (None, Some(n)) if n.dot(&normal) > SAME_NORMAL => {
                         normal = n;
                         true
                     }
@@ -294,10 +323,12 @@ macro_rules! contacts_impl {
                         p.dist * unit - back
                     };
                     // a point twice (two equal faces clip to each one's corners: the same
-                    // corner from either side) would make the contact Delassus matrix singular
-                    let twice = out[first..].iter().any(|q: &$point| {
+                    // corner from either side; two triangles of a mesh both give the points on
+                    // their shared edge) would make the contact Delassus matrix singular
+                    let twice = out.iter().any(|q: &$point| {
                         (q.point_a - point_a).norm() <= SAME_POINT * unit
                             && (q.point_b - point_b).norm() <= SAME_POINT * unit
+                            && (q.normal - normal).norm() <= SAME_NORMAL_DUP
                     });
                     if gap <= prediction && !twice {
                         out.push($point {
@@ -399,11 +430,11 @@ contacts_impl!(
     /// `n · shift`), and the answer with the larger deepest gap is kept (the second one unless
     /// the first beats it by more than `1e-12 L`).
     contacts3, raw3, Shape3, Isometry3, Vector3, ContactPoint3, ContactCache3, Dispatcher3,
-    check_pose3, Manifold3<(), ()>, Workspace3, dyn Parry3, Tracked3, face_normal3
+    check_pose3, Manifold3<(), ()>, Workspace3, dyn Parry3, Tracked3, face_normal3, part_normal3
 );
 
 contacts_impl!(
     /// [`contacts3`] in 2D.
     contacts2, raw2, Shape2, Isometry2, Vector2, ContactPoint2, ContactCache2, Dispatcher2,
-    check_pose2, Manifold2<(), ()>, Workspace2, dyn Parry2, Tracked2, face_normal2
+    check_pose2, Manifold2<(), ()>, Workspace2, dyn Parry2, Tracked2, face_normal2, part_normal2
 );

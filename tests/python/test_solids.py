@@ -211,3 +211,41 @@ def test_a_2d_capsule_and_polygon_rest_on_each_other() -> None:
     tr = scene.simulate(t_end=0.5, h=1e-3)
     assert tr.success
     assert np.max(np.abs(tr.q[-1] - tr.q[0])) < 1e-12
+
+
+def _ramp_mesh(angle: float, n: int = 6, side: float = 6.0) -> coulomb.TriangleMesh:
+    s, c = math.sin(angle), math.cos(angle)
+    xs = np.linspace(-side / 2, side / 2, n + 1)
+    verts = [(x * c, y, -x * s) for x in xs for y in xs]
+    tris = []
+    for i in range(n):
+        for j in range(n):
+            a, b = i * (n + 1) + j, (i + 1) * (n + 1) + j
+            tris += [(a, b, b + 1), (a, b + 1, a + 1)]
+    return coulomb.TriangleMesh(vertices=verts, triangles=tris)
+
+
+def test_a_box_slides_over_a_mesh_ramp_at_the_analytic_rate_and_another_sticks() -> None:
+    """examples/mesh_floor.py: a box crossing the edges of a 72-triangle ramp (20 deg,
+    mu 0.2) moves at g (sin a - mu cos a) to 1e-7, another (mu 0.5) sticks (drift < 1e-12)."""
+    a, h = math.radians(20.0), 1e-3
+    scene = coulomb.Scene(dim=3)
+    ramp = scene.add(_ramp_mesh(a))
+    half = (0.1, 0.1, 0.05)
+    quat = (math.cos(a / 2), 0.0, math.sin(a / 2), 0.0)
+    normal = np.array([math.sin(a), 0.0, math.cos(a)])
+    for k, mu in enumerate((0.2, 0.5)):
+        on = np.array([-1.5, -1.0 + 2.0 * k, 1.5 * math.tan(a)])
+        body = scene.add(coulomb.RigidBody3D(mass=1.0, inertia=(0.004, 0.004, 0.007),
+                                             position=tuple(on + half[2] * normal),
+                                             orientation=quat))
+        scene.contact(scene.attach(body, coulomb.Box(half_extents=half)), ramp, mu=mu)
+    tr = scene.simulate(1.0, h)
+    assert tr.success
+    x = tr.body(0).q[:, :3] - tr.body(0).q[0, :3]
+    dist = x @ np.array([math.cos(a), 0.0, -math.sin(a)])
+    got = 2.0 * dist[-1] / (tr.t[-1] * (tr.t[-1] + h))
+    want = G * (math.sin(a) - 0.2 * math.cos(a))
+    assert abs(got - want) < 1e-7 * want
+    assert np.max(np.abs(x @ normal)) < 1e-8
+    assert np.max(np.abs(tr.body(1).q - tr.body(1).q[0])) < 1e-12
