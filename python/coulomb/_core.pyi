@@ -25,6 +25,7 @@ __all__ = [
     "read_siconos_lcp",
     "set_memory_budget",
     "simd_level",
+    "solid_check",
     "step_simulate",
 ]
 

@@ -434,8 +434,9 @@ class Scene:
     def _needs_solid(self, shape: Shape) -> None:
         if shape._solid(self.dim) is None:
             raise InvalidParameterError(
-                f"a {type(shape).__name__} of no volume (a point, a zero radius, a 3D segment "
-                "without radius) touches only half-spaces and spheres")
+                f"this {type(shape).__name__} has no solid form (a point, a sphere of radius 0, "
+                "a 3D segment without radius, a polygon with a radius): it touches only "
+                "half-spaces and spheres")
 
     def contact_spheres(self, mu: float = 0.0, e: float = 0.0) -> None:
         """Lets every pair of spheres on different bodies touch, with friction coefficient

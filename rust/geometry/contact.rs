@@ -203,12 +203,14 @@ fn part_normal2(_shape: &dyn Parry2, _part: u32) -> Option<Vector2<f64>> {
     None
 }
 
-/// The face a manifold's points all lie on, when they share one face feature (`fid` of each
-/// point, unknown ones skipped).
+/// The face of one shape that a manifold's points lie on: the one face feature among the
+/// points' features on that shape (`fid` of each point; vertices, edges and unknown features
+/// skipped: in a polygon clip the other shape's corners lie on this reference face and its
+/// edges cross this face's edges), `None` when there is none or more than one.
 fn shared_face(fids: impl Iterator<Item = Option<u32>>) -> Option<u32> {
     let mut face = None;
-    for f in fids.flatten() {
-        if f >> 30 != 3 || face.is_some_and(|g| g != f) {
+    for f in fids.flatten().filter(|f| f >> 30 == 3) {
+        if face.is_some_and(|g| g != f) {
             return None;
         }
         face = Some(f);
@@ -223,8 +225,13 @@ const SAME_POINT: f64 = 1e-9;
 /// differ by about 1e-7; a real fold of a surface by far more).
 const SAME_NORMAL_DUP: f64 = 1e-6;
 
-/// Below this cosine between parry's normal and a face's, the face is not the contact's.
+/// Below this cosine between parry's normal and a face's (an angle of 1.4e-3), the face is not
+/// the contact's; the face's normal is taken only for a manifold within [`NEAR`] of touching,
+/// so that a closest pair whose normal is not the face's moves by at most `1e-6 g <= 1e-9 L`.
 const SAME_NORMAL: f64 = 0.999_999;
+
+/// The gap (relative to the query's unit) within which a face contact takes the face's normal.
+const NEAR: f64 = 1e-3;
 
 macro_rules! contacts_impl {
     ($(#[$doc:meta])* $name:ident, $raw:ident, $shape:ty, $iso:ident, $vec:ident, $point:ident,
@@ -291,8 +298,9 @@ macro_rules! contacts_impl {
                     _ => None,
                 }
                 .map(|n| pose_a.rotation * n);
+                let near = m.points.iter().any(|p| p.dist <= NEAR);
                 let snapped = match (face_b, face_a) {
-                    (Some(n), _) | (None, Some(n)) if n.dot(&normal) > SAME_NORMAL => {
+                    (Some(n), _) | (None, Some(n)) if near && n.dot(&normal) > SAME_NORMAL => {
                         normal = n;
                         true
                     }
