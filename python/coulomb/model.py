@@ -389,9 +389,12 @@ class Scene:
         if any(s is shape for _, s in self.shapes):
             raise InvalidParameterError("this shape is already attached to a body")
         shape._points(self.dim)
-        spec = shape._solid(self.dim)
-        if spec is not None:
-            _check_solid(spec, self.dim)
+        if not shape._point_form:
+            # a solid shape is checked now; a point shape's solid form (a polygon's hull) when
+            # a pair needs it
+            spec = shape._solid(self.dim)
+            if spec is not None:
+                _check_solid(spec, self.dim)
         self.shapes.append((body, shape))
         return shape
 
@@ -431,8 +434,24 @@ class Scene:
         self._needs_solid(other)
         self.pairs.append(("solid", shape, other, mu, e))
 
+    def _solid_of(self, shape: Shape) -> dict[str, Any] | None:
+        """a shape's solid form, checked, or None (no volume, or a degenerate hull of a
+        point shape's points)."""
+        form = shape._solid(self.dim)
+        if form is None:
+            return None
+        if shape._point_form:
+            try:
+                _check_solid(form, self.dim)
+            except InvalidParameterError:
+                return None
+        return form
+
     def _needs_solid(self, shape: Shape) -> None:
-        if shape._solid(self.dim) is None:
+        form = shape._solid(self.dim)
+        if form is not None and shape._point_form:
+            _check_solid(form, self.dim)
+        if form is None:
             raise InvalidParameterError(
                 f"this {type(shape).__name__} has no solid form (a point, a sphere of radius 0, "
                 "a 3D segment without radius, a polygon with a radius): it touches only "
@@ -466,7 +485,8 @@ class Scene:
         asks the narrow phase for their contact points. Half-spaces are not included: declare
         each shape's contact with a floor by :meth:`contact`. A pair declared by
         :meth:`contact` keeps that declaration's ``mu`` and ``e`` (per-pair overrides).
-        Shapes of no volume (:class:`Point`, a sphere of radius 0) are left out.
+        Shapes of no volume (:class:`Point`, a sphere of radius 0, a :class:`Polygon` of
+        collinear points) are left out.
 
         A contact found this way is named by its pair of shapes and its touching features,
         so warm starts and impact memory follow the same contact point from step to step;
@@ -502,8 +522,8 @@ class Scene:
         solids: list[dict[str, Any]] = []
         solid_index: dict[int, int] = {}
         for body, shape in self.shapes:
-            form = shape._solid(self.dim)
-            if form is not None and (auto or id(shape) in wanted):
+            form = self._solid_of(shape) if (auto or id(shape) in wanted) else None
+            if form is not None:
                 form["body"] = body_index[id(body)]
                 solid_index[id(shape)] = len(solids)
                 solids.append(form)

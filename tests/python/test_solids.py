@@ -250,3 +250,21 @@ def test_a_box_slides_over_a_mesh_ramp_at_the_analytic_rate_and_another_sticks()
     assert abs(got - want) < 1e-12 * want
     assert np.max(np.abs(x @ normal)) < 1e-12
     assert np.max(np.abs(tr.body(1).q - tr.body(1).q[0])) < 1e-12
+
+
+def test_a_polygon_of_collinear_points_attaches_and_contact_all_leaves_it_out() -> None:
+    """a point shape is a set of contact points first: a Polygon of collinear points (a
+    block on a row of feet) attaches, touches the floor by its points, and contact_all leaves
+    it out rather than refuse its degenerate hull."""
+    scene = coulomb.Scene(dim=2)
+    body = scene.add(coulomb.RigidBody2D(mass=2.0, inertia=0.05, position=(0.0, 0.05)))
+    feet = scene.attach(body, coulomb.Polygon([(x, -0.05) for x in np.linspace(-0.2, 0.2, 5)]))
+    scene.contact(feet, scene.add(_floor(2)), mu=0.5)
+    other = scene.add(_body(2, 0.5))
+    scene.attach(other, coulomb.Box(half_extents=(0.1, 0.1)))
+    scene.contact_all(mu=0.5)
+    tr = scene.simulate(0.2, 1e-3)
+    assert tr.success
+    assert np.max(np.abs(tr.body(0).q - tr.body(0).q[0])) < 1e-12
+    with pytest.raises(InvalidParameterError, match="degenerate"):
+        scene.contact(feet, scene.shapes[1][1])
