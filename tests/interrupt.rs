@@ -145,6 +145,7 @@ fn bouncing_ball() -> Scene {
             mu: 0.2,
             e: 0.5,
         }],
+        solids: Vec::new(),
     }
 }
 

@@ -49,6 +49,7 @@ fn point_on_plane(
             mu,
             e,
         }],
+        solids: Vec::new(),
     }
 }
 
@@ -368,6 +369,7 @@ fn cube_scene(mu: f64) -> Scene {
             mu,
             e: 0.0,
         }],
+        solids: Vec::new(),
     }
 }
 
@@ -436,6 +438,7 @@ fn painleve_rod() -> Scene {
             mu,
             e: 0.0,
         }],
+        solids: Vec::new(),
     }
 }
 
@@ -668,6 +671,7 @@ fn ball_drop(declared: bool) -> Scene {
             normal: vec![0.0, 0.0, 1.0],
         }],
         pairs: vec![],
+        solids: Vec::new(),
     };
     let i = 0.4 * r * r;
     for k in 0..count {

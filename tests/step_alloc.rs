@@ -73,6 +73,7 @@ fn scene() -> Scene {
             })
             .chain([Pair::Spheres { mu: 0.5, e: 0.0 }])
             .collect(),
+        solids: Vec::new(),
     }
 }
 

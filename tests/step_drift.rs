@@ -23,6 +23,7 @@ fn stack() -> Scene {
             normal: vec![0.0, 0.0, 1.0],
         }],
         pairs: vec![Pair::Spheres { mu: 0.5, e: 0.0 }],
+        solids: Vec::new(),
     };
     let i = 0.4 * R * R;
     for k in 0..5 {

@@ -72,6 +72,7 @@ fn pivoting_rod(dim: usize, e: f64, h: f64) -> Scene {
             mu: 0.0,
             e,
         }],
+        solids: Vec::new(),
     }
 }
 

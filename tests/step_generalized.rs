@@ -147,6 +147,7 @@ fn particle_on_ramp(mu: f64, v0: [f64; 2]) -> (Diagonal, Scene) {
             mu,
             e: 0.0,
         }],
+        solids: Vec::new(),
     };
     (sys, scene)
 }
@@ -210,6 +211,7 @@ fn rod(mu: f64, e: f64, q0: [f64; 3], v0: [f64; 3], gravity: f64) -> (Diagonal, 
             mu,
             e,
         }],
+        solids: Vec::new(),
     };
     (sys, scene)
 }
@@ -420,6 +422,7 @@ fn particle_row(dim: usize, mu: f64, e: f64) -> (Diagonal, Scene, Vec<f64>, Vec<
             normal: up,
         }],
         pairs,
+        solids: Vec::new(),
     };
     (sys, scene, q0, v0)
 }
@@ -507,6 +510,7 @@ fn poissons_law_integrates_an_impact_alone_beside_a_resting_uncoupled_contact() 
                 normal: vec![0.0, 1.0],
             }],
             pairs: vec![pair(0), pair(1)],
+            solids: Vec::new(),
         };
         let mut st = settings(h, 20);
         st.restitution = Restitution::Poisson;

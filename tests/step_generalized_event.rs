@@ -152,6 +152,7 @@ fn bouncing(dim: usize, mu: f64, e: f64) -> (Diagonal, Scene, Vec<f64>, Vec<f64>
             mu,
             e,
         }],
+        solids: Vec::new(),
     };
     (sys, scene, q, v)
 }
@@ -231,6 +232,7 @@ fn rod(mu: f64, e: f64, q0: [f64; 3], v0: [f64; 3]) -> (Diagonal, Scene) {
             mu,
             e,
         }],
+        solids: Vec::new(),
     };
     (sys, scene)
 }

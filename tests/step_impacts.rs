@@ -50,6 +50,7 @@ fn on_floor(dim: usize, b: Body, points: Vec<Vec<f64>>, r: f64, mu: f64, e: f64)
             mu,
             e,
         }],
+        solids: Vec::new(),
     }
 }
 
@@ -226,6 +227,7 @@ fn two_spheres(dim: usize, auto: bool, drop: f64, mu: f64, e: f64) -> Scene {
         ],
         half_spaces: vec![],
         pairs: vec![],
+        solids: Vec::new(),
     };
     scene.pairs.push(if auto {
         Pair::Spheres { mu, e }

@@ -85,6 +85,7 @@ fn box_at_rest(dim: usize, half: [f64; 3], tilt: f64, mu: f64) -> Scene {
             mu,
             e: 0.0,
         }],
+        solids: Vec::new(),
     }
 }
 

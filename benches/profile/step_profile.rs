@@ -70,6 +70,7 @@ fn one_box(gravity: [f64; 3], half: [f64; 3], v0: [f64; 3], mu: f64) -> Scene {
             mu,
             e: 0.0,
         }],
+        solids: Vec::new(),
     }
 }
 
@@ -88,6 +89,7 @@ fn pile(count: usize, declared: bool) -> Scene {
         shapes: vec![],
         half_spaces: vec![],
         pairs: vec![],
+        solids: Vec::new(),
     };
     for (p, n) in [
         ([0.0, 0.0, 0.0], [0.0, 0.0, 1.0]),

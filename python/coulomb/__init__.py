@@ -62,9 +62,15 @@ from .contact import ContactResult
 from .lcp import LcpResult
 from .model import (
     Box,
+    Capsule,
+    Compound,
+    Cone,
+    ConvexHull,
+    Cylinder,
     Disk,
     GapContact,
     HalfSpace,
+    Heightfield,
     Model,
     Particle,
     Point,
@@ -74,6 +80,7 @@ from .model import (
     Scene,
     Segment,
     Sphere,
+    TriangleMesh,
 )
 from .settings import (
     LemkeSettings,
@@ -87,10 +94,16 @@ from .trajectory import Trajectory
 
 __all__ = [
     "Box",
+    "Capsule",
+    "Compound",
+    "Cone",
     "ContactResult",
+    "ConvexHull",
+    "Cylinder",
     "Disk",
     "GapContact",
     "HalfSpace",
+    "Heightfield",
     "LcpResult",
     "LemkeSettings",
     "Model",
@@ -110,6 +123,7 @@ __all__ = [
     "Status",
     "StepSettings",
     "Trajectory",
+    "TriangleMesh",
     "__version__",
     "contact",
     "errors",

@@ -7,7 +7,10 @@ a :class:`~coulomb.Sphere` as a disk (2D) or a wireframe sphere (3D) with a radi
 turns with the body, a :class:`~coulomb.Segment` as a line (with its end disks when it has a
 radius), a :class:`~coulomb.Box` as its outline (2D: a filled rectangle; 3D: its 12 edges), a
 :class:`~coulomb.Polygon` as a filled polygon (2D) or its vertices (3D), a
-:class:`~coulomb.Point` as a dot; a body without a shape as a dot at its centre of mass. A
+:class:`~coulomb.Point` as a dot, a :class:`~coulomb.Capsule` as a :class:`~coulomb.Segment`
+with a radius, a 2D :class:`~coulomb.ConvexHull` as a filled polygon, the other solids
+(cylinder, cone, 3D hull, compound) as dots at points of their surface (static meshes and
+heightfields are not drawn); a body without a shape as a dot at its centre of mass. A
 :class:`~coulomb.HalfSpace` is its boundary line with the solid side shaded (2D) or a shaded
 patch of its plane (3D).
 """
@@ -274,7 +277,7 @@ class SceneAnimation:
     def _draw_2d(self, q: np.ndarray) -> list[Any]:
         from matplotlib.patches import Circle, Polygon
 
-        from .model import Box, Segment, Sphere
+        from .model import Box, Capsule, ConvexHull, Segment, Sphere
         from .model import Polygon as PolygonShape
 
         ax = self.ax
@@ -290,13 +293,13 @@ class SceneAnimation:
                 rot = poses(self.scene, q)[i][1]
                 tip = c + rot @ np.array([r, 0.0])
                 arts += ax.plot([c[0], tip[0]], [c[1], tip[1]], color="k", lw=1.0, zorder=4)
-            elif isinstance(shape, (Box, PolygonShape)) and len(pts) >= 3:
+            elif isinstance(shape, (Box, PolygonShape, ConvexHull)) and len(pts) >= 3:
                 arts.append(ax.add_patch(Polygon(pts, closed=True, facecolor=color,
                                                  edgecolor="k", lw=1.0, zorder=3)))
                 for c in pts if r > 0 else ():
                     arts.append(ax.add_patch(Circle(c, r, facecolor=color, edgecolor="k",
                                                     lw=0.5, zorder=3)))
-            elif isinstance(shape, (Segment, PolygonShape)) and len(pts) >= 2:
+            elif isinstance(shape, (Segment, PolygonShape, Capsule)) and len(pts) >= 2:
                 arts += ax.plot(pts[:, 0], pts[:, 1], color=color, lw=3.0, zorder=3,
                                 solid_capstyle="round")
                 for c in pts if r > 0 else ():
@@ -312,7 +315,7 @@ class SceneAnimation:
         return arts
 
     def _draw_3d(self, q: np.ndarray) -> list[Any]:
-        from .model import Box, Segment, Sphere
+        from .model import Box, Capsule, Segment, Sphere
 
         ax = self.ax
         arts: list[Any] = []
@@ -333,7 +336,7 @@ class SceneAnimation:
             elif isinstance(shape, Box):
                 for a, b in _box_edges_3d():
                     arts += ax.plot(*np.column_stack([pts[a], pts[b]]), color=color, lw=2.0)
-            elif isinstance(shape, Segment):
+            elif isinstance(shape, (Segment, Capsule)):
                 arts += ax.plot(*pts.T, color=color, lw=3.0)
             else:
                 arts.append(ax.scatter(*pts.T, color=color, edgecolor="k", s=20,

@@ -25,6 +25,7 @@ __all__ = [
     "read_siconos_lcp",
     "set_memory_budget",
     "simd_level",
+    "solid_check",
     "step_simulate",
 ]
 
@@ -196,6 +197,7 @@ def contact_post_velocity(m: _Triplets, g: _Triplets, v_free: _F64, r: _F64) -> 
 def simd_level() -> str: ...
 def memory_budget() -> int: ...
 def set_memory_budget(bytes: int) -> int: ...
+def solid_check(solid: dict[str, Any], dim: int) -> None: ...
 def step_simulate(
     scene: dict[str, Any],
     h: float,

@@ -4,11 +4,17 @@ r"""Scenes: bodies, contact shapes, half-spaces and contact pairs, simulated by 
 A planar scene (``dim=2``) has particles ``(x, y)`` and planar rigid bodies ``(x, y, theta)``;
 a spatial scene (``dim=3``) has particles ``(x, y, z)`` and spatial rigid bodies (position, unit
 quaternion ``(w, x, y, z)``; velocities: linear, then the angular velocity in the world frame;
-inertia in the body frame). Contact shapes are sets of body-frame points with a radius
+inertia in the body frame). The point shapes are sets of body-frame points with a radius
 (:class:`Point`, :class:`Sphere`/:class:`Disk`, :class:`Segment` ends, :class:`Box` and
-:class:`Polygon` corners); a pair is a shape against a static :class:`HalfSpace` (floor, ramp,
-wall) or a sphere against a sphere, each with its friction coefficient ``mu`` and Newton
-restitution coefficient ``e``.
+:class:`Polygon` corners): against a static :class:`HalfSpace` (floor, ramp, wall) they touch
+by their points, a sphere against a sphere by the centres. Every shape with a volume is also a
+solid (:class:`Sphere`, :class:`Box`, :class:`Polygon`, :class:`Segment` with a radius or in
+2D, :class:`Capsule`, :class:`Cylinder`, :class:`Cone`, :class:`ConvexHull`,
+:class:`Compound`; static :class:`TriangleMesh` and :class:`Heightfield` added to the scene),
+and any two solids touch: each step the narrow phase (dimforge's parry, corrected) gives their
+contact points. Pairs are declared by :meth:`Scene.contact` or found each step by a broad
+phase (:meth:`Scene.contact_spheres`, :meth:`Scene.contact_all`), each with its friction
+coefficient ``mu`` and Newton restitution coefficient ``e``.
 
 >>> import coulomb
 >>> scene = coulomb.Scene(dim=2, gravity=(0.0, -9.81))
@@ -52,6 +58,19 @@ import numpy as np
 from . import _core, _validate
 from ._arguments import Solver, _dim, _positive, _solver_options, _steps, _vector
 from ._generalized import GapContact, Model
+from ._solids import (
+    Capsule,
+    Compound,
+    Cone,
+    ConvexHull,
+    Cylinder,
+    Heightfield,
+    Shape,
+    StaticSolid,
+    TriangleMesh,
+    _check_solid,
+    _pose,
+)
 from .errors import (
     InvalidParameterError,
     NonFiniteError,
@@ -63,9 +82,15 @@ from .trajectory import Trajectory
 __all__ = [
     "Body",
     "Box",
+    "Capsule",
+    "Compound",
+    "Cone",
+    "ConvexHull",
+    "Cylinder",
     "Disk",
     "GapContact",
     "HalfSpace",
+    "Heightfield",
     "Model",
     "Particle",
     "Point",
@@ -76,6 +101,7 @@ __all__ = [
     "Segment",
     "Shape",
     "Sphere",
+    "TriangleMesh",
 ]
 
 
@@ -194,14 +220,6 @@ class RigidBody3D(Body):
 
 
 @dataclass(eq=False)
-class Shape:
-    """Base class of contact shapes: body-frame points with a common radius."""
-
-    def _points(self, dim: int) -> tuple[list[list[float]], float]:
-        raise NotImplementedError
-
-
-@dataclass(eq=False)
 class Point(Shape):
     """A single body-frame point (default the centre of mass)."""
 
@@ -226,6 +244,12 @@ class Sphere(Shape):
             raise InvalidParameterError(f"radius must be finite and >= 0, got {r}")
         return [_vector("center", c, dim)], r
 
+    def _solid(self, dim: int) -> dict[str, Any] | None:
+        pts, r = self._points(dim)
+        if r == 0.0:
+            return None
+        return {"kind": "sphere", "radius": r, "pose": _pose(dim, pts[0], None)}
+
 
 Disk = Sphere
 
@@ -244,6 +268,15 @@ class Segment(Shape):
             raise InvalidParameterError(f"radius must be finite and >= 0, got {r}")
         return [_vector("a", self.a, dim), _vector("b", self.b, dim)], r
 
+    def _solid(self, dim: int) -> dict[str, Any] | None:
+        pts, r = self._points(dim)
+        pose = _pose(dim, None, None)
+        if r > 0.0:
+            return {"kind": "capsule", "a": pts[0], "b": pts[1], "radius": r, "pose": pose}
+        if dim == 2:
+            return {"kind": "segment", "a": pts[0], "b": pts[1], "pose": pose}
+        return None
+
 
 @dataclass(eq=False)
 class Box(Shape):
@@ -257,6 +290,11 @@ class Box(Shape):
             raise InvalidParameterError(f"half_extents must be > 0, got {he.tolist()}")
         signs = np.array(np.meshgrid(*([[-1.0, 1.0]] * dim), indexing="ij")).reshape(dim, -1).T
         return (signs * he).tolist(), 0.0
+
+    def _solid(self, dim: int) -> dict[str, Any] | None:
+        he = _vector("half_extents", self.half_extents, dim)
+        self._points(dim)
+        return {"kind": "box", "half_extents": he, "pose": _pose(dim, None, None)}
 
 
 @dataclass(eq=False)
@@ -273,6 +311,12 @@ class Polygon(Shape):
         if not math.isfinite(r) or r < 0.0:
             raise InvalidParameterError(f"radius must be finite and >= 0, got {r}")
         return [_vector(f"vertex {i}", v, dim) for i, v in enumerate(self.vertices)], r
+
+    def _solid(self, dim: int) -> dict[str, Any] | None:
+        pts, r = self._points(dim)
+        if r > 0.0 or len(pts) < dim + 1:
+            return None
+        return {"kind": "convex_hull", "points": pts, "pose": _pose(dim, None, None)}
 
 
 @dataclass(eq=False)
@@ -312,11 +356,13 @@ class Scene:
         self.gravity = _vector("gravity", g, dim)
         self.bodies: list[Body] = []
         self.half_spaces: list[HalfSpace] = []
+        self.statics: list[StaticSolid] = []
         self.shapes: list[tuple[Body, Shape]] = []
         self.pairs: list[tuple[str, Any, Any, float, float]] = []
 
-    def add(self, item: Body | HalfSpace) -> Any:
-        """Adds a body or a half-space; returns it (use it as a handle)."""
+    def add(self, item: Body | HalfSpace | StaticSolid) -> Any:
+        """Adds a body, a half-space or a static solid (:class:`TriangleMesh`,
+        :class:`Heightfield`); returns it (use it as a handle)."""
         if isinstance(item, Body):
             item._spec(self.dim)  # checked now, before any work
             self.bodies.append(item)
@@ -326,6 +372,11 @@ class Scene:
             if not np.any(n != 0.0):
                 raise InvalidParameterError("a half-space's normal must be nonzero")
             self.half_spaces.append(item)
+        elif isinstance(item, StaticSolid):
+            if any(x is item for x in self.statics):
+                raise InvalidParameterError("this static solid was already added")
+            _check_solid(item._solid(self.dim), self.dim)
+            self.statics.append(item)
         else:
             raise InvalidParameterError(f"cannot add {type(item).__name__} to a scene")
         return item
@@ -333,29 +384,78 @@ class Scene:
     def attach(self, body: Body, shape: Shape) -> Shape:
         """Attaches a contact shape to a body; returns the shape (a handle for contacts)."""
         _index(self.bodies, body, "body")
+        if not isinstance(shape, Shape):
+            raise InvalidParameterError(f"cannot attach {type(shape).__name__}: not a Shape")
         if any(s is shape for _, s in self.shapes):
             raise InvalidParameterError("this shape is already attached to a body")
         shape._points(self.dim)
+        if not shape._point_form:
+            # a solid shape is checked now; a point shape's solid form (a polygon's hull) when
+            # a pair needs it
+            spec = shape._solid(self.dim)
+            if spec is not None:
+                _check_solid(spec, self.dim)
         self.shapes.append((body, shape))
         return shape
 
-    def contact(self, shape: Shape, other: Shape | HalfSpace, mu: float = 0.0,
+    def contact(self, shape: Shape, other: Shape | HalfSpace | StaticSolid, mu: float = 0.0,
                 e: float = 0.0) -> None:
-        """Declares that ``shape`` may touch ``other`` (a half-space, or a sphere on another
-        body), with friction coefficient ``mu >= 0`` and Newton restitution ``e`` in [0, 1]."""
+        """Declares that ``shape`` may touch ``other`` (a half-space, a static solid, or a
+        shape on another body), with friction coefficient ``mu >= 0`` and Newton restitution
+        ``e`` in [0, 1].
+
+        A point shape against a half-space touches by its points (closed form), a sphere
+        against a sphere by their centres; any other pair touches as solids, its contact points
+        from the narrow phase each step (a :class:`Point` or a sphere of radius 0 has no
+        solid). A pair declared here keeps its ``mu`` and ``e`` when :meth:`contact_all` finds
+        it too."""
         mu = _validate.real("mu", mu, low=0.0, data=True)
         e = _validate.real("e", e, low=0.0, high=1.0, data=True)
         a = _index([s for _, s in self.shapes], shape, "shape")
         if isinstance(other, HalfSpace):
-            self.pairs.append(("half_space", a, _index(self.half_spaces, other, "half-space"),
-                               mu, e))
+            _index(self.half_spaces, other, "half-space")
+            if shape._point_form:
+                self.pairs.append(("half_space", shape, other, mu, e))
+            else:
+                self.pairs.append(("solid_half_space", shape, other, mu, e))
+            return
+        if isinstance(other, StaticSolid):
+            _index(self.statics, other, "static solid")
+            self._needs_solid(shape)
+            self.pairs.append(("solid", shape, other, mu, e))
             return
         b = _index([s for _, s in self.shapes], other, "shape")
-        if not (isinstance(shape, Sphere) and isinstance(other, Sphere)):
-            raise InvalidParameterError("shape-shape contacts are sphere vs sphere only")
         if self.shapes[a][0] is self.shapes[b][0]:
-            raise InvalidParameterError("both spheres are on the same body")
-        self.pairs.append(("sphere", a, b, mu, e))
+            raise InvalidParameterError("both shapes are on the same body")
+        if isinstance(shape, Sphere) and isinstance(other, Sphere):
+            self.pairs.append(("sphere", shape, other, mu, e))
+            return
+        self._needs_solid(shape)
+        self._needs_solid(other)
+        self.pairs.append(("solid", shape, other, mu, e))
+
+    def _solid_of(self, shape: Shape) -> dict[str, Any] | None:
+        """a shape's solid form, checked, or None (no volume, or a degenerate hull of a
+        point shape's points)."""
+        form = shape._solid(self.dim)
+        if form is None:
+            return None
+        if shape._point_form:
+            try:
+                _check_solid(form, self.dim)
+            except InvalidParameterError:
+                return None
+        return form
+
+    def _needs_solid(self, shape: Shape) -> None:
+        form = shape._solid(self.dim)
+        if form is not None and shape._point_form:
+            _check_solid(form, self.dim)
+        if form is None:
+            raise InvalidParameterError(
+                f"this {type(shape).__name__} has no solid form (a point, a sphere of radius 0, "
+                "a 3D segment without radius, a polygon with a radius): it touches only "
+                "half-spaces and spheres")
 
     def contact_spheres(self, mu: float = 0.0, e: float = 0.0) -> None:
         """Lets every pair of spheres on different bodies touch, with friction coefficient
@@ -365,12 +465,41 @@ class Scene:
         (:class:`Sphere`; a :class:`Point` counts as a sphere of radius 0). A pair also
         declared with :meth:`contact` keeps that declaration's ``mu`` and ``e``. Contact ids
         of these pairs are ``D + i B + j`` (``D`` declared candidates, ``B`` spheres, ``i < j``
-        the spheres' indices in the order they were attached)."""
+        the spheres' indices in the order they were attached). Not with :meth:`contact_all`,
+        which covers the spheres too."""
         mu = _validate.real("mu", mu, low=0.0, data=True)
         e = _validate.real("e", e, low=0.0, high=1.0, data=True)
         if any(p[0] == "spheres" for p in self.pairs):
             raise InvalidParameterError("contact_spheres was already called on this scene")
+        if any(p[0] == "solids" for p in self.pairs):
+            raise InvalidParameterError(
+                "contact_all already lets every pair of shapes touch, spheres included")
         self.pairs.append(("spheres", 0, 0, mu, e))
+
+    def contact_all(self, mu: float = 0.0, e: float = 0.0) -> None:
+        """Lets every pair of attached shapes on different bodies touch, and every attached
+        shape touch every static solid (:class:`TriangleMesh`, :class:`Heightfield`), with
+        friction coefficient ``mu >= 0`` and Newton restitution ``e`` in [0, 1], without
+        declaring the pairs: the stepper finds the pairs whose bounding boxes (grown by what
+        a step can close) meet, every step (a broad phase, a uniform grid, O(N) per step), and
+        asks the narrow phase for their contact points. Half-spaces are not included: declare
+        each shape's contact with a floor by :meth:`contact`. A pair declared by
+        :meth:`contact` keeps that declaration's ``mu`` and ``e`` (per-pair overrides).
+        Shapes of no volume (:class:`Point`, a sphere of radius 0, a :class:`Polygon` of
+        collinear points) are left out.
+
+        A contact found this way is named by its pair of shapes and its touching features,
+        so warm starts and impact memory follow the same contact point from step to step;
+        its ``contact_id`` is given when the contact first appears, above every id of the
+        declared pairs and of :meth:`contact_spheres`, and kept while it persists."""
+        mu = _validate.real("mu", mu, low=0.0, data=True)
+        e = _validate.real("e", e, low=0.0, high=1.0, data=True)
+        if any(p[0] == "solids" for p in self.pairs):
+            raise InvalidParameterError("contact_all was already called on this scene")
+        if any(p[0] == "spheres" for p in self.pairs):
+            raise InvalidParameterError(
+                "contact_spheres was called on this scene: contact_all covers the spheres too")
+        self.pairs.append(("solids", 0, 0, mu, e))
 
     def _spec(self) -> dict[str, Any]:
         bodies = []
@@ -379,11 +508,47 @@ class Scene:
             f = b.force if b.force is not None else np.zeros(self.dim)
             spec["force"] = _vector("force", f, self.dim)
             bodies.append(spec)
-        shapes = []
+        body_index = {id(b): i for i, b in enumerate(self.bodies)}
+        shapes: list[dict[str, Any]] = []
+        shape_index: dict[int, int] = {}
         for body, shape in self.shapes:
-            pts, r = shape._points(self.dim)
-            shapes.append({"body": _index(self.bodies, body, "body"), "points": pts,
-                           "radius": r})
+            if shape._point_form:
+                pts, r = shape._points(self.dim)
+                shape_index[id(shape)] = len(shapes)
+                shapes.append({"body": body_index[id(body)], "points": pts, "radius": r})
+        auto = any(p[0] == "solids" for p in self.pairs)
+        wanted = {id(x) for k, a, b, _, _ in self.pairs if k in ("solid", "solid_half_space")
+                  for x in (a, b)}
+        solids: list[dict[str, Any]] = []
+        solid_index: dict[int, int] = {}
+        for body, shape in self.shapes:
+            form = self._solid_of(shape) if (auto or id(shape) in wanted) else None
+            if form is not None:
+                form["body"] = body_index[id(body)]
+                solid_index[id(shape)] = len(solids)
+                solids.append(form)
+        for st in self.statics:
+            form = st._solid(self.dim)
+            form["body"] = None
+            solid_index[id(st)] = len(solids)
+            solids.append(form)
+        hs_index = {id(h): i for i, h in enumerate(self.half_spaces)}
+        pairs = []
+        for k, a, b, mu, e in self.pairs:
+            if k in ("spheres", "solids"):
+                ia = ib = 0
+            elif k == "half_space":
+                ia, ib = shape_index[id(a)], hs_index[id(b)]
+            elif k == "solid_half_space":
+                ia, ib = solid_index[id(a)], hs_index[id(b)]
+            elif k == "sphere" and not (auto and id(a) in solid_index
+                                        and id(b) in solid_index):
+                ia, ib = shape_index[id(a)], shape_index[id(b)]
+            else:
+                # a declared sphere pair under contact_all is a solid pair, so the broad
+                # phase leaves it to the declaration
+                k, ia, ib = "solid", solid_index[id(a)], solid_index[id(b)]
+            pairs.append({"kind": k, "a": ia, "b": ib, "mu": mu, "e": e})
         return {
             "dim": self.dim,
             "gravity": self.gravity,
@@ -394,8 +559,8 @@ class Scene:
                  "normal": _vector("normal", h.normal, self.dim)}
                 for h in self.half_spaces
             ],
-            "pairs": [{"kind": k, "a": a, "b": b, "mu": mu, "e": e}
-                      for k, a, b, mu, e in self.pairs],
+            "pairs": pairs,
+            "solids": solids,
         }
 
     def layout(self) -> list[tuple[slice, slice]]:

@@ -13,8 +13,10 @@
 //! parry updates a manifold incrementally when the relative motion since the last call is
 //! small (it re-projects the old points with absolute thresholds of 1e-3 length and 1 degree).
 //! That update is neither exact nor scale invariant, so here every call recomputes the points
-//! from the geometry: the cache keeps only parry's manifold buffers (and the last normal, which
-//! seeds GJK) and the workspace of composite shapes, so a steady call allocates nothing.
+//! from the geometry: the cache keeps only parry's manifold buffers and the workspace of
+//! composite shapes. The last normal, which parry keeps to seed GJK, is cleared too: seeded by
+//! it, GJK returned a face contact's normal tilted by 4e-7 rad (a box sliding on a box), which
+//! let the box sink at 6e-7 m/s; unseeded, the answer depends on the poses alone.
 //!
 //! parry's GJK and EPA use absolute tolerances (a squared distance below about 1e-14 counts as
 //! an overlap): between shapes of size 1e-4 touching within 1e-15, parry found no contact at
@@ -24,7 +26,12 @@
 //!
 //! In 3D parry appends GJK's closest pair, with unknown features, to the clipped polygon
 //! points; it lies among them, so it is dropped unless it is deeper than all of them (a
-//! redundant point would make the contact Delassus matrix singular).
+//! redundant point would make the contact Delassus matrix singular). For the same reason a
+//! point is dropped when the answer already has one at the same place on both shapes with the
+//! same normal (two equal boxes face to face: parry clips each face's corners against the
+//! other, giving each corner twice; two triangles of a mesh both give the points on their
+//! shared edge). A face contact's normal is the face's own (polygons and polyhedra): parry
+//! takes GJK's direction, accurate near touch only to about 1e-7.
 //!
 //! Allocation: a warm query between separated shapes allocates nothing; a touching one still
 //! allocates inside parry (its half-space manifold replaces the point buffer, its polygon
@@ -161,10 +168,75 @@ fn unsupported(what: String) -> CoulombError {
     CoulombError::InvalidParameter(format!("no contact manifold for {what}"))
 }
 
+/// The outward unit normal of face `fid` (parry's packed id) of a convex polygon, in its frame
+/// (parry numbers a polygon's vertices `2 i` and its faces `2 i + 1`).
+fn face_normal2(shape: &dyn Parry2, fid: u32) -> Option<Vector2<f64>> {
+    let idx = ((fid & 0x3fff_ffff) as usize).checked_sub(1)? / 2;
+    (fid >> 30 == 3)
+        .then(|| shape.as_convex_polygon())
+        .flatten()
+        .and_then(|p| p.normals().get(idx).map(|n| n.into_inner()))
+}
+
+/// The outward unit normal of face `fid` of a convex polyhedron, in its frame.
+fn face_normal3(shape: &dyn Parry3, fid: u32) -> Option<Vector3<f64>> {
+    let idx = (fid & 0x3fff_ffff) as usize;
+    (fid >> 30 == 3)
+        .then(|| shape.as_convex_polyhedron())
+        .flatten()
+        .and_then(|p| p.faces().get(idx).map(|f| f.normal.into_inner()))
+}
+
+/// The unit normal of triangle `part` of a triangle mesh or heightfield (its winding's, which
+/// the mesh's validation makes the outward one), in the shape's frame.
+fn part_normal3(shape: &dyn Parry3, part: u32) -> Option<Vector3<f64>> {
+    let tri = if let Some(mesh) = shape.as_trimesh() {
+        (part < mesh.num_triangles() as u32).then(|| mesh.triangle(part))?
+    } else {
+        shape.as_heightfield()?.triangle_at_id(part)?
+    };
+    tri.normal().map(|n| n.into_inner())
+}
+
+/// 2D shapes have no parts with faces of their own.
+fn part_normal2(_shape: &dyn Parry2, _part: u32) -> Option<Vector2<f64>> {
+    None
+}
+
+/// The face of one shape that a manifold's points lie on: the one face feature among the
+/// points' features on that shape (`fid` of each point; vertices, edges and unknown features
+/// skipped: in a polygon clip the other shape's corners lie on this reference face and its
+/// edges cross this face's edges), `None` when there is none or more than one.
+fn shared_face(fids: impl Iterator<Item = Option<u32>>) -> Option<u32> {
+    let mut face = None;
+    for f in fids.flatten().filter(|f| f >> 30 == 3) {
+        if face.is_some_and(|g| g != f) {
+            return None;
+        }
+        face = Some(f);
+    }
+    face
+}
+
+/// Two points of one manifold closer than this (in the query's unit) on both shapes are one.
+const SAME_POINT: f64 = 1e-9;
+
+/// Normals closer than this are one (parry's GJK normals of two coplanar triangles of a mesh
+/// differ by about 1e-7; a real fold of a surface by far more).
+const SAME_NORMAL_DUP: f64 = 1e-6;
+
+/// Below this cosine between parry's normal and a face's (an angle of 1.4e-3), the face is not
+/// the contact's; the face's normal is taken only for a manifold within [`NEAR`] of touching,
+/// so that a closest pair whose normal is not the face's moves by at most `1e-6 g <= 1e-9 L`.
+const SAME_NORMAL: f64 = 0.999_999;
+
+/// The gap (relative to the query's unit) within which a face contact takes the face's normal.
+const NEAR: f64 = 1e-3;
+
 macro_rules! contacts_impl {
     ($(#[$doc:meta])* $name:ident, $raw:ident, $shape:ty, $iso:ident, $vec:ident, $point:ident,
      $cache:ident, $dispatcher:ident, $check_pose:ident, $manifold:ty, $workspace:ty,
-     $dynshape:ty, $tracked:ident) => {
+     $dynshape:ty, $tracked:ident, $face:ident, $part_face:ident) => {
         /// parry's manifolds of `a` at `pose_a` and `b` at `pose_b` translated by `shift`,
         /// converted; gaps taken back to the unshifted poses (`g - n · shift`, exact while the
         /// same features touch), kept when `<= prediction`.
@@ -181,8 +253,12 @@ macro_rules! contacts_impl {
             out: &mut Vec<$point>,
         ) -> Result<()> {
             out.clear();
+            // no history: parry's incremental update needs old points, and GJK's seed from the
+            // last normal tilted a face contact's normal by 4e-7 (a box sliding on a box)
             for m in manifolds.iter_mut() {
                 m.points.clear();
+                m.local_n1.fill(0.0);
+                m.local_n2.fill(0.0);
             }
             // the query in units of `unit` (a power of two: exact)
             let inv = 1.0 / unit;
@@ -199,7 +275,37 @@ macro_rules! contacts_impl {
             for m in manifolds.iter() {
                 let part_a = m.subshape_pos1.unwrap_or_else($iso::identity);
                 let part_b = m.subshape_pos2.unwrap_or_else($iso::identity);
-                let normal = pose_a.rotation * (part_a.rotation * m.local_n1);
+                let mut normal = pose_a.rotation * (part_a.rotation * m.local_n1);
+                // a face contact's normal is the face's: parry's comes from GJK, which near
+                // touch is accurate only to about 1e-7 (a face normal of b points from b to a)
+                let fid = |p: &$tracked<()>, on_b: bool| {
+                    let f = if on_b { p.fid2 } else { p.fid1 };
+                    (!f.is_unknown()).then_some(f.0)
+                };
+                // a convex polygon's or polyhedron's face, or a mesh's or heightfield's
+                // triangle (whose parts are in the shape's own frame)
+                let face_b = match shared_face(m.points.iter().map(|p| fid(p, true))) {
+                    Some(f) if m.subshape_pos2.is_none() => {
+                        $face(b, f).or_else(|| $part_face(b, m.subshape2))
+                    }
+                    _ => None,
+                }
+                .map(|n| -(pose_b.rotation * n));
+                let face_a = match shared_face(m.points.iter().map(|p| fid(p, false))) {
+                    Some(f) if m.subshape_pos1.is_none() => {
+                        $face(a, f).or_else(|| $part_face(a, m.subshape1))
+                    }
+                    _ => None,
+                }
+                .map(|n| pose_a.rotation * n);
+                let near = m.points.iter().any(|p| p.dist <= NEAR);
+                let snapped = match (face_b, face_a) {
+                    (Some(n), _) | (None, Some(n)) if near && n.dot(&normal) > SAME_NORMAL => {
+                        normal = n;
+                        true
+                    }
+                    _ => false,
+                };
                 let back = normal.dot(&shift);
                 // parry adds GJK's closest pair (features unknown) to the clipped points in 3D:
                 // dropped when a clipped point is at least as deep (it lies among them)
@@ -217,13 +323,27 @@ macro_rules! contacts_impl {
                     if unknown(&p) && known <= p.dist + REDUNDANT {
                         continue;
                     }
-                    let gap = p.dist * unit - back;
-                    if gap <= prediction {
+                    let point_a = (part_a * p.local_p1) * unit;
+                    let point_b = (part_b * p.local_p2) * unit;
+                    let gap = if snapped {
+                        normal.dot(&((pose_b * point_b) - (pose_a * point_a)))
+                    } else {
+                        p.dist * unit - back
+                    };
+                    // a point twice (two equal faces clip to each one's corners: the same
+                    // corner from either side; two triangles of a mesh both give the points on
+                    // their shared edge) would make the contact Delassus matrix singular
+                    let twice = out.iter().any(|q: &$point| {
+                        (q.point_a - point_a).norm() <= SAME_POINT * unit
+                            && (q.point_b - point_b).norm() <= SAME_POINT * unit
+                            && (q.normal - normal).norm() <= SAME_NORMAL_DUP
+                    });
+                    if gap <= prediction && !twice {
                         out.push($point {
                             normal,
                             gap,
-                            point_a: (part_a * p.local_p1) * unit,
-                            point_b: (part_b * p.local_p2) * unit,
+                            point_a,
+                            point_b,
                             id: ContactId {
                                 part_a: m.subshape1,
                                 part_b: m.subshape2,
@@ -318,11 +438,11 @@ contacts_impl!(
     /// `n · shift`), and the answer with the larger deepest gap is kept (the second one unless
     /// the first beats it by more than `1e-12 L`).
     contacts3, raw3, Shape3, Isometry3, Vector3, ContactPoint3, ContactCache3, Dispatcher3,
-    check_pose3, Manifold3<(), ()>, Workspace3, dyn Parry3, Tracked3
+    check_pose3, Manifold3<(), ()>, Workspace3, dyn Parry3, Tracked3, face_normal3, part_normal3
 );
 
 contacts_impl!(
     /// [`contacts3`] in 2D.
     contacts2, raw2, Shape2, Isometry2, Vector2, ContactPoint2, ContactCache2, Dispatcher2,
-    check_pose2, Manifold2<(), ()>, Workspace2, dyn Parry2, Tracked2
+    check_pose2, Manifold2<(), ()>, Workspace2, dyn Parry2, Tracked2, face_normal2, part_normal2
 );

@@ -1,5 +1,5 @@
-//! Geometry: shapes, their contact manifolds, and a broad phase over them (not yet wired into
-//! the stepper).
+//! Geometry: shapes, their contact manifolds, and a broad phase over them; the stepper's
+//! solids ([`crate::step::Solid`]) take their contact points from here.
 //!
 //! The narrow phase is dimforge's parry (`parry3d-f64`, `parry2d-f64`) at version 0.25, the
 //! last release line built on nalgebra: from 0.26 on, parry's math is glam. parry 0.25 depends

@@ -12,9 +12,10 @@ use super::settings::{self, Keyword};
 use super::{guarded, to_py};
 use crate::contact::ContactOrder;
 use crate::error::CoulombError;
+use crate::geometry::{Shape2, Shape3};
 use crate::step::{
-    simulate_recorded, Body, BodyKind, HalfSpace, Pair, Scene, Shape, StepSettings, StepSolver,
-    Trajectory,
+    simulate_recorded, Body, BodyKind, HalfSpace, Pair, Scene, Shape, Solid, SolidShape,
+    StepSettings, StepSolver, Trajectory,
 };
 
 fn item<'py, T: FromPyObjectOwned<'py>>(d: &Bound<'py, PyDict>, key: &str) -> PyResult<T> {
@@ -96,6 +97,10 @@ fn scene_from_dict(d: &Bound<'_, PyDict>) -> PyResult<Scene> {
             pairs.push(Pair::Spheres { mu, e });
             continue;
         }
+        if kind == "solids" {
+            pairs.push(Pair::Solids { mu, e });
+            continue;
+        }
         let (a, b): (usize, usize) = (item(&p, "a")?, item(&p, "b")?);
         pairs.push(match kind.as_str() {
             "half_space" => Pair::ShapeHalfSpace {
@@ -105,6 +110,13 @@ fn scene_from_dict(d: &Bound<'_, PyDict>) -> PyResult<Scene> {
                 e,
             },
             "sphere" => Pair::SphereSphere { a, b, mu, e },
+            "solid" => Pair::SolidSolid { a, b, mu, e },
+            "solid_half_space" => Pair::SolidHalfSpace {
+                solid: a,
+                half_space: b,
+                mu,
+                e,
+            },
             other => {
                 return Err(to_py(
                     py,
@@ -113,13 +125,136 @@ fn scene_from_dict(d: &Bound<'_, PyDict>) -> PyResult<Scene> {
             }
         });
     }
+    let dim: usize = item(d, "dim")?;
+    let mut solids = vec![];
+    if d.get_item("solids")?.is_some() {
+        for s in dicts(d, "solids")? {
+            solids.push(Solid {
+                body: item(&s, "body")?,
+                pose: item(&s, "pose")?,
+                shape: solid_shape(&s, dim).map_err(|e| to_py(py, e))?,
+            });
+        }
+    }
     Ok(Scene {
-        dim: item(d, "dim")?,
+        dim,
         gravity: item(d, "gravity")?,
         bodies,
         shapes,
         half_spaces,
         pairs,
+        solids,
+    })
+}
+
+/// a solid's shape from its dict (`kind` and the shape's data), built by the geometry
+/// layer's validating constructors.
+fn solid_shape(s: &Bound<'_, PyDict>, dim: usize) -> Result<SolidShape, CoulombError> {
+    let get = |key: &str| -> Result<Bound<'_, PyAny>, CoulombError> {
+        s.get_item(key)
+            .ok()
+            .flatten()
+            .ok_or_else(|| CoulombError::Shape(format!("solid entry {key:?} is missing")))
+    };
+    fn ex<'py, T: FromPyObjectOwned<'py>>(
+        v: Bound<'py, PyAny>,
+        key: &str,
+    ) -> Result<T, CoulombError> {
+        v.extract::<T>()
+            .map_err(|_| CoulombError::Shape(format!("solid entry {key:?} has the wrong type")))
+    }
+    let f = |key: &str| -> Result<f64, CoulombError> { ex(get(key)?, key) };
+    let kind: String = ex(get("kind")?, "kind")?;
+    if dim == 2 {
+        let p2 = |key: &str| -> Result<[f64; 2], CoulombError> { ex(get(key)?, key) };
+        let shape = match kind.as_str() {
+            "disk" | "sphere" => Shape2::disk(f("radius")?)?,
+            "box" => Shape2::rectangle(p2("half_extents")?)?,
+            "polygon" | "convex_hull" => {
+                let pts: Vec<[f64; 2]> = ex(get("points")?, "points")?;
+                Shape2::convex_polygon(&pts)?
+            }
+            "segment" => Shape2::segment(p2("a")?, p2("b")?)?,
+            "capsule" => Shape2::capsule(p2("a")?, p2("b")?, f("radius")?)?,
+            other => {
+                return Err(CoulombError::InvalidParameter(format!(
+                    "no 2D solid of kind {other:?}"
+                )))
+            }
+        };
+        return Ok(SolidShape::Planar(shape));
+    }
+    Ok(SolidShape::Spatial(shape3(s, &kind)?))
+}
+
+/// a 3D shape from a solid's dict (a compound's parts recursively).
+fn shape3(s: &Bound<'_, PyDict>, kind: &str) -> Result<Shape3, CoulombError> {
+    fn ex<'py, T: FromPyObjectOwned<'py>>(
+        s: &Bound<'py, PyDict>,
+        key: &str,
+    ) -> Result<T, CoulombError> {
+        s.get_item(key)
+            .ok()
+            .flatten()
+            .ok_or_else(|| CoulombError::Shape(format!("solid entry {key:?} is missing")))?
+            .extract::<T>()
+            .map_err(|_| CoulombError::Shape(format!("solid entry {key:?} has the wrong type")))
+    }
+    let f = |key: &str| -> Result<f64, CoulombError> { ex(s, key) };
+    let p3 = |key: &str| -> Result<[f64; 3], CoulombError> { ex(s, key) };
+    Ok(match kind {
+        "sphere" => Shape3::sphere(f("radius")?)?,
+        "box" => Shape3::cuboid(p3("half_extents")?)?,
+        "capsule" => Shape3::capsule(p3("a")?, p3("b")?, f("radius")?)?,
+        "cylinder" => Shape3::cylinder(f("half_height")?, f("radius")?)?,
+        "cone" => Shape3::cone(f("half_height")?, f("radius")?)?,
+        "convex_hull" => {
+            let pts: Vec<[f64; 3]> = ex(s, "points")?;
+            Shape3::convex_hull(&pts)?
+        }
+        "triangle_mesh" => {
+            let v: Vec<[f64; 3]> = ex(s, "vertices")?;
+            let t: Vec<[u32; 3]> = ex(s, "triangles")?;
+            Shape3::triangle_mesh(&v, &t)?
+        }
+        "heightfield" => {
+            let rows: usize = ex(s, "rows")?;
+            let cols: usize = ex(s, "cols")?;
+            let h: Vec<f64> = ex(s, "heights")?;
+            Shape3::heightfield(rows, cols, &h, p3("scale")?)?
+        }
+        "compound" => {
+            let parts: Vec<Bound<'_, PyDict>> = ex(s, "parts")?;
+            let mut out = Vec::with_capacity(parts.len());
+            for p in &parts {
+                let k: String = ex(p, "kind")?;
+                let pose: Vec<f64> = ex(p, "pose")?;
+                if pose.len() != 7 {
+                    return Err(CoulombError::Shape(format!(
+                        "a compound part's pose has {} entries, expected 7",
+                        pose.len()
+                    )));
+                }
+                crate::error::check_finite("compound part pose", &pose)?;
+                let q = nalgebra::Quaternion::new(pose[3], pose[4], pose[5], pose[6]);
+                if q.norm() == 0.0 {
+                    return Err(CoulombError::InvalidParameter(
+                        "a compound part's orientation is zero".into(),
+                    ));
+                }
+                let iso = nalgebra::Isometry3::from_parts(
+                    nalgebra::Translation3::new(pose[0], pose[1], pose[2]),
+                    nalgebra::UnitQuaternion::from_quaternion(q),
+                );
+                out.push((iso, shape3(p, &k)?));
+            }
+            Shape3::compound(&out)?
+        }
+        other => {
+            return Err(CoulombError::InvalidParameter(format!(
+                "no 3D solid of kind {other:?}"
+            )))
+        }
     })
 }
 
@@ -370,7 +505,25 @@ pub(super) fn step_simulate<'py>(
     trajectory_dict(py, tr, seconds)
 }
 
+/// Checks a solid's description (a dict as in a scene's `solids`) by building its shape:
+/// the geometry layer's errors (a hull of coplanar points, a non-manifold mesh, a zero size)
+/// as `coulomb.errors` exceptions, before any step.
+#[pyfunction]
+pub(super) fn solid_check(solid: &Bound<'_, PyDict>, dim: usize) -> PyResult<()> {
+    let py = solid.py();
+    if dim != 2 && dim != 3 {
+        return Err(to_py(
+            py,
+            CoulombError::InvalidParameter(format!("dim must be 2 or 3, got {dim}")),
+        ));
+    }
+    solid_shape(solid, dim)
+        .map(|_| ())
+        .map_err(|e| to_py(py, e))
+}
+
 /// registers the stepper's functions in `coulomb._core`.
 pub(super) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(step_simulate, m)?)
+    m.add_function(wrap_pyfunction!(step_simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(solid_check, m)?)
 }

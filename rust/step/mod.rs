@@ -62,7 +62,12 @@
 //! ends, a box's or polygon's corners. Pairs ([`Pair`]): shape vs a static half-space, and
 //! sphere vs sphere (every point of one shape against every point of the other), declared one
 //! by one or found each step by the broad phase ([`Pair::Spheres`], a uniform grid over the
-//! spheres, O(N) per step: [`broad`]).
+//! spheres, O(N) per step: [`broad`]). Solids ([`Solid`]) are the geometry layer's shapes on
+//! bodies or static (meshes, heightfields, obstacles): any two of them, or one and a
+//! half-space, declared ([`Pair::SolidSolid`], [`Pair::SolidHalfSpace`]) or found each step by
+//! a broad phase over their bounding boxes ([`Pair::Solids`]), get their contact points at
+//! each state from [`crate::geometry::contacts3`] / [`crate::geometry::contacts2`], named by
+//! their features so that warm starts and impact memory follow the same contact point.
 //!
 //! Drift: a velocity-level condition does not enforce `g(q_{k+1}) >= 0` exactly
 //! (Stewart 2000). Each contact's normal condition carries the gap's second-order remainder over the step on
@@ -76,8 +81,10 @@
 pub mod broad;
 mod impact;
 mod poisson;
+mod solid;
 mod stepper;
 
+pub use solid::{Solid, SolidShape};
 pub use stepper::generalized::{
     simulate_generalized, GeneralizedStepper, GeneralizedSystem, GeneralizedTrajectory,
 };
@@ -194,6 +201,39 @@ pub enum Pair {
         /// Newton restitution coefficient, in `[0, 1]`.
         e: f64,
     },
+    /// solid a against solid b ([`Scene::solids`], not both static nor on one body): their
+    /// contact points each step from the geometry layer's narrow phase.
+    SolidSolid {
+        /// the first solid's index.
+        a: usize,
+        /// the second solid's index.
+        b: usize,
+        /// friction coefficient, `>= 0`.
+        mu: f64,
+        /// Newton restitution coefficient, in `[0, 1]`.
+        e: f64,
+    },
+    /// a solid on a body against a static half-space.
+    SolidHalfSpace {
+        /// the solid's index.
+        solid: usize,
+        /// the half-space's index.
+        half_space: usize,
+        /// friction coefficient, `>= 0`.
+        mu: f64,
+        /// Newton restitution coefficient, in `[0, 1]`.
+        e: f64,
+    },
+    /// every pair of solids on different bodies (or a body's and a static one), found by the
+    /// stepper each step by a broad phase over their bounding boxes (a uniform grid, O(N) per
+    /// step). A pair declared by [`Pair::SolidSolid`] keeps its own mu and e. At most one per
+    /// scene.
+    Solids {
+        /// friction coefficient, `>= 0`.
+        mu: f64,
+        /// Newton restitution coefficient, in `[0, 1]`.
+        e: f64,
+    },
 }
 
 /// A scene: bodies, shapes, half-spaces and contact pairs in a planar (dim 2) or spatial
@@ -212,6 +252,8 @@ pub struct Scene {
     pub half_spaces: Vec<HalfSpace>,
     /// the pairs that may be in contact.
     pub pairs: Vec<Pair>,
+    /// the solids: shapes of the geometry layer on bodies or static (see [`Solid`]).
+    pub solids: Vec<Solid>,
 }
 
 fn bad(msg: String) -> CoulombError {
@@ -270,10 +312,43 @@ impl Scene {
                 return Err(bad(format!("half-space {i}: the normal is zero")));
             }
         }
+        for (i, s) in self.solids.iter().enumerate() {
+            s.validate(i, dim, self.bodies.len())?;
+        }
         for (i, p) in self.pairs.iter().enumerate() {
             self.validate_pair(i, p)?;
         }
         Ok(())
+    }
+
+    /// at most one pair of the kind `is` in the scene.
+    fn once(&self, i: usize, is: fn(&Pair) -> bool, what: &str) -> Result<()> {
+        let count = self.pairs.iter().filter(|p| is(p)).count();
+        if count > 1 {
+            return Err(bad(format!(
+                "pair {i}: the scene asks {count} times for every {what} pair; at most once"
+            )));
+        }
+        Ok(())
+    }
+
+    /// checks the indices of a pair of solids: in range, not both static, not on one body.
+    fn validate_solids(&self, i: usize, a: usize, b: usize) -> Result<()> {
+        let n = self.solids.len();
+        if a >= n || b >= n {
+            return Err(bad(format!(
+                "pair {i}: solid index out of range ({n} solids)"
+            )));
+        }
+        match (self.solids[a].body, self.solids[b].body) {
+            (None, None) => Err(bad(format!(
+                "pair {i}: both solids are static: no contact between them"
+            ))),
+            (Some(x), Some(y)) if x == y => {
+                Err(bad(format!("pair {i}: both solids are on body {x}")))
+            }
+            _ => Ok(()),
+        }
     }
 
     /// checks one contact pair: indices, mu and e.
@@ -303,16 +378,31 @@ impl Scene {
                 (mu, e)
             }
             Pair::Spheres { mu, e } => {
-                let count = self
-                    .pairs
-                    .iter()
-                    .filter(|p| matches!(p, Pair::Spheres { .. }))
-                    .count();
-                if count > 1 {
-                    return Err(bad(format!(
-                            "pair {i}: the scene asks {count} times for every sphere pair;                              at most once"
-                        )));
+                self.once(i, |p| matches!(p, Pair::Spheres { .. }), "sphere")?;
+                (mu, e)
+            }
+            Pair::SolidSolid { a, b, mu, e } => {
+                self.validate_solids(i, a, b)?;
+                (mu, e)
+            }
+            Pair::SolidHalfSpace {
+                solid,
+                half_space,
+                mu,
+                e,
+            } => {
+                if solid >= self.solids.len() || half_space >= self.half_spaces.len() {
+                    return Err(bad(format!("pair {i}: index out of range")));
                 }
+                if self.solids[solid].body.is_none() {
+                    return Err(bad(format!(
+                        "pair {i}: solid {solid} is static: no contact with a half-space"
+                    )));
+                }
+                (mu, e)
+            }
+            Pair::Solids { mu, e } => {
+                self.once(i, |p| matches!(p, Pair::Solids { .. }), "solid")?;
                 (mu, e)
             }
         };

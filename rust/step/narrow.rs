@@ -6,7 +6,9 @@
 //! another body (spheres: gap `|x_a - x_b| - r_a - r_b`, normal `(x_a - x_b) / |x_a - x_b|`).
 //! The candidates of declared pairs are built once, in declaration order (their index is the
 //! contact's identity); the sphere pairs of [`Pair::Spheres`] are found each step by the broad
-//! phase (module `persistence`).
+//! phase (module `persistence`). A solid contact (module `solid_pairs`) is a witness point on
+//! body a against the plane through a static witness (the half-space candidate, radius 0), or
+//! two witness points on two bodies with the normal fixed in one body's frame ([`Turn`]).
 
 use nalgebra::Vector3;
 
@@ -20,12 +22,28 @@ pub(super) struct Candidate {
     pub(super) a: (usize, [f64; 3], f64),
     /// body b (sphere vs sphere) or `None` (a static half-space).
     pub(super) b: Option<(usize, [f64; 3], f64)>,
-    /// the half-space (point, unit normal) when `b` is `None`.
+    /// the half-space (point, unit normal) when `b` is `None`; for a solid contact between
+    /// two bodies ([`Turn::WithA`], [`Turn::WithB`]), the unit normal in that body's frame
+    /// (the point unused).
     pub(super) plane: ([f64; 3], [f64; 3]),
+    /// how the normal of a two-body candidate moves: along the line of centres (spheres) or
+    /// fixed in one body's frame (solids).
+    pub(super) turn: Turn,
     pub(super) mu: f64,
     pub(super) e: f64,
     /// the identity reported in [`ContactRecord::id`].
     pub(super) id: usize,
+}
+
+/// How the normal of a candidate between two bodies follows their motion.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Turn {
+    /// two spheres: the normal is the line of their centres.
+    Centres,
+    /// a solid contact whose normal is fixed in body a's frame (a face of a touches).
+    WithA,
+    /// a solid contact whose normal is fixed in body b's frame.
+    WithB,
 }
 
 /// The geometry of a candidate at the current state.
@@ -104,6 +122,7 @@ pub(super) fn declared_candidates(scene: &Scene) -> Vec<Candidate> {
                         a: (s.body, pad(p), s.radius),
                         b: None,
                         plane: (pad(&hs.point), n),
+                        turn: Turn::Centres,
                         mu,
                         e,
                         id: candidates.len(),
@@ -118,6 +137,7 @@ pub(super) fn declared_candidates(scene: &Scene) -> Vec<Candidate> {
                             a: (sa.body, pad(pa), sa.radius),
                             b: Some((sb.body, pad(pb), sb.radius)),
                             plane: ([0.0; 3], [0.0; 3]),
+                            turn: Turn::Centres,
                             mu,
                             e,
                             id: candidates.len(),
@@ -125,7 +145,10 @@ pub(super) fn declared_candidates(scene: &Scene) -> Vec<Candidate> {
                     }
                 }
             }
-            Pair::Spheres { .. } => {}
+            Pair::Spheres { .. }
+            | Pair::SolidSolid { .. }
+            | Pair::SolidHalfSpace { .. }
+            | Pair::Solids { .. } => {}
         }
     }
     candidates
@@ -151,6 +174,7 @@ impl Stepper {
                     nsides: 1,
                 }
             }
+            Some(b) if cand.turn != Turn::Centres => self.solid_geometry(cand, b),
             Some((bb, pb, rb)) => {
                 let (xb, wb) = self.world_point(bb, pb);
                 let d = [wa[0] - wb[0], wa[1] - wb[1], wa[2] - wb[2]];
@@ -211,6 +235,22 @@ impl Stepper {
         let (lin_a, rem_a) = moved(cand.a);
         match cand.b {
             None => n.dot(&rem_a),
+            Some(b) if cand.turn != Turn::Centres => {
+                let (lin_b, rem_b) = moved(b);
+                let carrier = match cand.turn {
+                    Turn::WithA => cand.a.0,
+                    _ => b.0,
+                };
+                // the normal turns with its body: n' = R(φ) n
+                let phi = self.rotation_vector(carrier, v);
+                let dn = phi.cross(&n) + rotation_remainder(&phi, &n);
+                let (_, wa) = self.world_point(cand.a.0, cand.a.1);
+                let (_, wb) = self.world_point(b.0, b.1);
+                let d = Vector3::from(wa) - Vector3::from(wb);
+                let delta = (lin_a + rem_a) - (lin_b + rem_b);
+                // g' - g - h J_n v with g = (x_a - x_b) . n, exactly for this model
+                (d + delta).dot(&dn) + n.dot(&(rem_a - rem_b))
+            }
             Some(b) => {
                 let (lin_b, rem_b) = moved(b);
                 let (_, wa) = self.world_point(cand.a.0, cand.a.1);
@@ -227,6 +267,49 @@ impl Stepper {
                 let turn = (delta.norm_squared() - n.dot(&delta) * grow) / s;
                 turn + n.dot(&(rem_a - rem_b))
             }
+        }
+    }
+
+    /// The geometry of a solid contact between two bodies: witness points fixed in their
+    /// bodies, the normal (from b to a) fixed in its body's frame ([`Turn`]), the gap
+    /// `g = (x_a - x_b) . n` (exact at the state the narrow phase computed the points at,
+    /// first order in the displacement elsewhere: exact for a vertex on a face).
+    fn solid_geometry(&self, cand: &Candidate, b: (usize, [f64; 3], f64)) -> Geometry {
+        let (ba, pa, _) = cand.a;
+        let (bb, pb, _) = b;
+        let (xa, wa) = self.world_point(ba, pa);
+        let (xb, wb) = self.world_point(bb, pb);
+        let carrier = if cand.turn == Turn::WithA { ba } else { bb };
+        let n = self.world_direction(carrier, cand.plane.1);
+        let d = [wa[0] - wb[0], wa[1] - wb[1], wa[2] - wb[2]];
+        Geometry {
+            gap: n[0] * d[0] + n[1] * d[1] + n[2] * d[2],
+            normal: n,
+            sides: [
+                (ba, 1.0, [wa[0] - xa[0], wa[1] - xa[1], wa[2] - xa[2]]),
+                (bb, -1.0, [wb[0] - xb[0], wb[1] - xb[1], wb[2] - xb[2]]),
+            ],
+            nsides: 2,
+        }
+    }
+
+    /// a body-frame direction in the world (bodies frozen).
+    pub(super) fn world_direction(&self, body: usize, d: [f64; 3]) -> [f64; 3] {
+        match self.bodies[body].kind {
+            BodyKind::Particle => d,
+            _ => (self.frozen[body].rot * Vector3::from(d)).into(),
+        }
+    }
+
+    /// the rotation vector `h ω` of a body over a step of the velocities v.
+    fn rotation_vector(&self, body: usize, v: &[f64]) -> Vector3<f64> {
+        let b = &self.bodies[body];
+        let vb = &v[b.off_v..b.off_v + b.nv];
+        let h = self.settings.h;
+        match b.kind {
+            BodyKind::Particle => Vector3::zeros(),
+            BodyKind::Planar => Vector3::new(0.0, 0.0, h * vb[2]),
+            BodyKind::Spatial => Vector3::new(h * vb[3], h * vb[4], h * vb[5]),
         }
     }
 

@@ -5,7 +5,7 @@
 
 use super::super::impact::ImpactMemory;
 use super::bodies::norm3;
-use super::narrow::{pad, Candidate};
+use super::narrow::{pad, Candidate, Turn};
 use super::{dot_v, ContactRecord, Pair, Scene, Stepper};
 
 /// What a candidate carries from one step to the next (reset when it is far).
@@ -158,6 +158,7 @@ impl Stepper {
                 a: bi,
                 b: Some(bj),
                 plane: ([0.0; 3], [0.0; 3]),
+                turn: Turn::Centres,
                 mu,
                 e,
                 id: self.n_static + i as usize * nb + j as usize,

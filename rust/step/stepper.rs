@@ -25,6 +25,8 @@ mod narrow;
 mod persistence;
 #[path = "record.rs"]
 mod record;
+#[path = "solid_pairs.rs"]
+mod solid_pairs;
 #[path = "solve.rs"]
 mod solve;
 
@@ -152,6 +154,8 @@ pub struct Stepper {
     /// `(q_k, v_k)` while a located step follows its path (module `event`).
     saved_q: Vec<f64>,
     saved_v: Vec<f64>,
+    /// the solids' pairs and their candidates' names (module `solid_pairs`).
+    solid_pairs: solid_pairs::SolidPairs,
 }
 
 impl Stepper {
@@ -165,6 +169,7 @@ impl Stepper {
         let candidates = declared_candidates(scene);
         let nc = candidates.len();
         let (auto, balls, declared_balls) = sphere_points(scene);
+        let solid_pairs = solid_pairs::SolidPairs::of(scene, nc, nc + balls.len() * balls.len());
         Ok(Self {
             dim,
             settings: settings.clone(),
@@ -206,6 +211,7 @@ impl Stepper {
             work: SolveWork::default(),
             solve: SolveBuffers::default(),
             candidates,
+            solid_pairs,
         })
     }
 
@@ -241,9 +247,11 @@ impl Stepper {
             }
             self.speed_bounds[bi] = sb;
         }
+        self.save_solid_state();
         if self.auto.is_some() {
             self.broad_phase();
         }
+        self.solid_phase();
         self.geo_cache.clear();
         for c in 0..self.candidates.len() {
             let geo = self.geometry(c);

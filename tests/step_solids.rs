@@ -1,0 +1,445 @@
+//! Solids in the stepper: boxes on boxes, towers, corner drops, capsules and cylinders at
+//! rest, in 2D and 3D, against analytic answers (Coulomb's deceleration `mu g`, exact
+//! sticking, Newton's restitution at e = 1 within the integrator's O(h)).
+
+use coulomb::contact::{ContactStatus, PolyhedralSettings};
+use coulomb::geometry::{Shape2, Shape3};
+use coulomb::step::{
+    simulate, Body, BodyKind, HalfSpace, Pair, Scene, SolidShape, StepSettings, StepSolver,
+    Trajectory,
+};
+
+#[path = "step_solids/scenes.rs"]
+mod scenes;
+use scenes::*;
+
+fn run(scene: &Scene, settings: &StepSettings) -> Trajectory {
+    match simulate(scene, settings) {
+        Ok(tr) => tr,
+        Err(e) => panic!("valid scene: {e}"),
+    }
+}
+
+fn all_solved(tr: &Trajectory, case: &str) {
+    for (k, s) in tr.steps.iter().enumerate() {
+        if s.active > 0 {
+            assert_eq!(
+                s.status,
+                Some(ContactStatus::Solved),
+                "{case}: step {k}: {s:?}"
+            );
+        }
+    }
+}
+
+/// A box sliding on a box (the lower one static, or a body resting on the floor) decelerates
+/// at exactly `mu g` (the speed after each step `v0 - mu g t` to 1e-9 relative), never lifts
+/// off (height within 1e-9 m) and, once stopped, does not creep (position constant to 1e-12
+/// m), in 2D and 3D, at two length scales.
+#[test]
+fn a_box_sliding_on_a_box_decelerates_at_mu_g_without_lift_off_or_creep() {
+    for dim in [2, 3] {
+        for scale in [1.0f64, 1e-2] {
+            for lower_is_body in [false, true] {
+                let (mu, v0, h) = (0.3, 1.5 * scale.sqrt(), 1e-3);
+                let scene = box_on_box(dim, scale, mu, v0, lower_is_body);
+                let stop = v0 / (mu * G);
+                let steps = ((stop + 0.3) / h) as usize;
+                let tr = run(&scene, &StepSettings::new(h, steps));
+                let case = format!("dim {dim}, scale {scale}, lower body {lower_is_body}");
+                all_solved(&tr, &case);
+                let nq = tr.nq;
+                let top = if lower_is_body { nq / 2 } else { 0 };
+                let height0 = tr.q[top + dim - 1];
+                let mut rest = None;
+                for k in 0..=steps {
+                    let t = k as f64 * h;
+                    let q = &tr.q[k * nq..(k + 1) * nq];
+                    let v = &tr.v[k * tr.nv..(k + 1) * tr.nv];
+                    let off_v = if lower_is_body { tr.nv / 2 } else { 0 };
+                    let height = q[top + dim - 1];
+                    assert!(
+                        (height - height0).abs() < 1e-9 * scale,
+                        "{case}: lift-off {:e} at step {k}",
+                        height - height0
+                    );
+                    let want = (v0 - mu * G * t).max(0.0);
+                    let got = v[off_v];
+                    assert!(
+                        (got - want).abs() < 1e-9 * v0,
+                        "{case}: speed {got} at t = {t}, want {want}"
+                    );
+                    if t > stop + h {
+                        let x = q[top];
+                        let x0 = *rest.get_or_insert(x);
+                        assert!((x - x0).abs() < 1e-12 * scale, "{case}: creep {:e}", x - x0);
+                    }
+                }
+                assert!(rest.is_some(), "{case}: the run must reach the stop");
+            }
+        }
+    }
+}
+
+/// A capsule and a cylinder lying on the floor (a half-space), and a cylinder standing on
+/// its base, rest: every coordinate constant to 1e-12 m over 1 s, every step solved.
+#[test]
+fn capsules_and_cylinders_on_a_plane_rest() {
+    for (dim, shape, q0) in resting_round_shapes() {
+        let case = format!("{shape:?} in {dim}D");
+        let scene = one_solid_on_floor(dim, shape, q0.clone(), 0.5);
+        let tr = run(&scene, &StepSettings::new(1e-3, 1000));
+        all_solved(&tr, &case);
+        let last = &tr.q[tr.q.len() - tr.nq..];
+        for (a, b) in last.iter().zip(&q0) {
+            assert!(
+                (a - b).abs() < 1e-12,
+                "{case}: moved from {q0:?} to {last:?}"
+            );
+        }
+    }
+}
+
+/// A tower of boxes on the floor stands: every box's drift below 1e-9 m over 2 s, with NSGS
+/// and with Lemke, in 2D and 3D.
+#[test]
+fn a_box_tower_stands_with_exact_sticking_under_nsgs_and_lemke() {
+    for dim in [2, 3] {
+        for lemke in [false, true] {
+            let n = 6;
+            let scene = tower(dim, n, 0.1, 0.5);
+            let mut settings = StepSettings::new(1e-3, 2000);
+            // a face's contact rows outnumber the relative velocities they constrain (in 2D
+            // two tangential rows for one sliding direction: the split of the friction
+            // between the two corners is not unique), where NSGS's error can stall at 1.5e-12
+            if let StepSolver::Nsgs(s) = &mut settings.solver {
+                s.tol = 1e-10;
+            }
+            if lemke {
+                settings.solver = StepSolver::Lemke(PolyhedralSettings::for_dim(dim));
+            }
+            let tr = run(&scene, &settings);
+            let case = format!("dim {dim}, lemke {lemke}");
+            all_solved(&tr, &case);
+            let q0 = &tr.q[..tr.nq];
+            let mut worst = 0.0f64;
+            for q in tr.q.chunks(tr.nq) {
+                for (a, b) in q.iter().zip(q0) {
+                    worst = worst.max((a - b).abs());
+                }
+            }
+            assert!(worst < 1e-9, "{case}: drift {worst:e}");
+        }
+    }
+}
+
+/// A box dropped on its edge or corner onto a static box with e = 1 (frictionless: Newton's
+/// law gives back the energy exactly at an isolated impact, and the plain step loses or gains
+/// up to `h m_eff |v_n^-| |g''|` per bounce, module docs of the stepper): over a run with
+/// several bounces the energy error stays within `20 h E_0` at four h from 4e-4 to 5e-5 (the
+/// ratio `|ΔE| / (h E_0)` measured up to 8.1; its sign varies with where in the step each impact
+/// falls), in 2D (an edge: a corner of the rectangle) and 3D (an edge, a corner).
+#[test]
+fn a_box_dropped_on_its_corner_with_e_one_keeps_its_energy_within_o_h() {
+    for (dim, tilt) in [(2, [0.3, 0.0]), (3, [0.3, 0.0]), (3, [0.3, 0.4])] {
+        let mut ratios = vec![];
+        for h in [4e-4, 2e-4, 1e-4, 5e-5] {
+            let scene = dropped_box(dim, tilt, 1.0);
+            let steps = (0.25 / h) as usize;
+            let tr = run(&scene, &StepSettings::new(h, steps));
+            let case = format!("dim {dim}, tilt {tilt:?}, h {h}");
+            all_solved(&tr, &case);
+            let e0 = tr.kinetic_energy[0] + tr.potential_energy[0];
+            let e1 = tr.kinetic_energy[steps] + tr.potential_energy[steps];
+            let bounced = tr.contacts.iter().any(|c| c.impulse[0] > 0.0);
+            assert!(bounced, "{case}: the box must hit the lower one");
+            ratios.push((e1 - e0).abs() / (h * e0.abs()));
+        }
+        let worst = ratios.iter().fold(0.0f64, |m, r| m.max(*r));
+        assert!(
+            worst <= 20.0,
+            "dim {dim}, tilt {tilt:?}: |dE| / (h E0) = {ratios:?}"
+        );
+    }
+}
+
+/// Bad solids and pairs are refused before any step: a 2D shape in a 3D scene, a mesh on a
+/// body, a bad body index, a non-unit pose quaternion, two static solids, two solids on one
+/// body, a static solid against a half-space, a second `Solids` pair.
+#[test]
+fn bad_solids_and_pairs_are_refused() {
+    let good = one_solid_on_floor(
+        3,
+        SolidShape::Spatial(ok(Shape3::cuboid([0.1, 0.1, 0.1]))),
+        vec![0.0, 0.0, 0.1, 1.0, 0.0, 0.0, 0.0],
+        0.5,
+    );
+    assert!(coulomb::step::Stepper::new(&good, &StepSettings::new(1e-3, 1)).is_ok());
+    let refuse = |f: &dyn Fn(&mut Scene)| {
+        let mut s = good.clone();
+        f(&mut s);
+        assert!(s.validate().is_err());
+    };
+    refuse(&|s| {
+        s.solids[0].shape = SolidShape::Planar(ok(Shape2::disk(1.0)));
+    });
+    refuse(&|s| s.solids[0].body = Some(3));
+    refuse(&|s| s.solids[0].pose[3] = 2.0);
+    refuse(&|s| s.solids[0].pose.pop().map(|_| ()).unwrap_or(()));
+    refuse(&|s| {
+        let mesh = ok(Shape3::triangle_mesh(
+            &[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+            &[[0, 1, 2]],
+        ));
+        s.solids[0].shape = SolidShape::Spatial(mesh);
+    });
+    refuse(&|s| {
+        s.solids
+            .push(static_solid(SolidShape::Spatial(ok(Shape3::sphere(1.0)))));
+        s.solids
+            .push(static_solid(SolidShape::Spatial(ok(Shape3::sphere(1.0)))));
+        s.pairs.push(Pair::SolidSolid {
+            a: 1,
+            b: 2,
+            mu: 0.0,
+            e: 0.0,
+        });
+    });
+    refuse(&|s| {
+        s.solids.push(s.solids[0].clone());
+        s.pairs.push(Pair::SolidSolid {
+            a: 0,
+            b: 1,
+            mu: 0.0,
+            e: 0.0,
+        });
+    });
+    refuse(&|s| {
+        s.solids
+            .push(static_solid(SolidShape::Spatial(ok(Shape3::sphere(1.0)))));
+        s.pairs.push(Pair::SolidHalfSpace {
+            solid: 1,
+            half_space: 0,
+            mu: 0.0,
+            e: 0.0,
+        });
+    });
+    refuse(&|s| {
+        s.pairs.push(Pair::Solids { mu: 0.0, e: 0.0 });
+        s.pairs.push(Pair::Solids { mu: 0.0, e: 0.0 });
+    });
+    refuse(&|s| {
+        s.pairs.push(Pair::SolidHalfSpace {
+            solid: 0,
+            half_space: 0,
+            mu: -1.0,
+            e: 0.0,
+        });
+    });
+    let _ = (Body::clone, BodyKind::Particle, HalfSpace::clone);
+}
+
+/// a random pile of solids (boxes, spheres, capsules, hulls in 3D; rectangles, disks,
+/// capsules in 2D) in a box of side `extent`, with random velocities, and a static solid.
+fn random_pile(dim: usize, n: usize, seed: u64, extent: f64) -> Scene {
+    let mut rng = coulomb::testing::SplitMix64::new(seed);
+    let mut bodies = vec![];
+    let mut solids = vec![];
+    for k in 0..n {
+        let s = rng.range(0.05, 0.3);
+        let shape = match (dim, k % 4) {
+            (2, 0) => SolidShape::Planar(ok(Shape2::rectangle([s, 0.6 * s]))),
+            (2, 1) => SolidShape::Planar(ok(Shape2::disk(s))),
+            (2, _) => SolidShape::Planar(ok(Shape2::capsule([-s, 0.0], [s, 0.0], 0.3 * s))),
+            (_, 0) => SolidShape::Spatial(ok(Shape3::cuboid([s, 0.7 * s, 0.5 * s]))),
+            (_, 1) => SolidShape::Spatial(ok(Shape3::sphere(s))),
+            (_, 2) => {
+                SolidShape::Spatial(ok(Shape3::capsule([0.0, -s, 0.0], [0.0, s, 0.0], 0.4 * s)))
+            }
+            _ => SolidShape::Spatial(ok(Shape3::convex_hull(&[
+                [0.0, 0.0, 0.0],
+                [s, 0.0, 0.0],
+                [0.0, s, 0.0],
+                [0.0, 0.0, s],
+            ]))),
+        };
+        let mut q = at(dim, rng.range(0.0, extent), rng.range(0.0, extent));
+        let mut v = moving(dim, rng.range(-1.0, 1.0));
+        if dim == 3 {
+            q[1] = rng.range(0.0, extent);
+            v[4] = rng.range(-3.0, 3.0);
+        } else {
+            q[2] = rng.range(-3.0, 3.0);
+            v[2] = rng.range(-3.0, 3.0);
+        }
+        bodies.push(box_body(dim, 1.0, [s; 3], q, v));
+        solids.push(on_body(k, shape));
+    }
+    // a static obstacle in the middle of the pile
+    let mut obstacle = static_solid(box_shape(dim, [0.5, 0.5, 0.5]));
+    obstacle.pose[0] = 0.5 * extent;
+    obstacle.pose[dim - 1] = 0.5 * extent;
+    solids.push(obstacle);
+    Scene {
+        dim,
+        gravity: gravity(dim),
+        bodies,
+        shapes: vec![],
+        half_spaces: vec![],
+        pairs: vec![Pair::Solids { mu: 0.3, e: 0.2 }],
+        solids,
+    }
+}
+
+/// The broad phase of `Pair::Solids` finds exactly the contact candidates of declaring every
+/// pair of solids one by one (brute force), at every step of random piles in 2D and 3D: the
+/// number of candidates and each step's active contacts agree.
+#[test]
+fn the_solid_broad_phase_finds_the_candidates_of_every_declared_pair() {
+    let mut compared = 0;
+    for dim in [2, 3] {
+        for seed in 0..6 {
+            let auto = random_pile(dim, 24, seed, 2.0);
+            let mut brute = auto.clone();
+            brute.pairs.clear();
+            let n = brute.solids.len();
+            for i in 0..n {
+                for j in i + 1..n {
+                    let (bi, bj) = (brute.solids[i].body, brute.solids[j].body);
+                    if bi.is_some() && bi != bj {
+                        brute.pairs.push(Pair::SolidSolid {
+                            a: i,
+                            b: j,
+                            mu: 0.3,
+                            e: 0.2,
+                        });
+                    } else if bi.is_none() && bj.is_some() {
+                        brute.pairs.push(Pair::SolidSolid {
+                            a: j,
+                            b: i,
+                            mu: 0.3,
+                            e: 0.2,
+                        });
+                    }
+                }
+            }
+            let settings = StepSettings::new(1e-3, 1);
+            let mut sa = coulomb::step::Stepper::new(&auto, &settings).expect("valid");
+            let mut sb = coulomb::step::Stepper::new(&brute, &settings).expect("valid");
+            for k in 0..30 {
+                let (mut ca, mut cb) = (vec![], vec![]);
+                let ra = sa.step(&mut ca).expect("step");
+                let rb = sb.step(&mut cb).expect("step");
+                let case = format!("dim {dim}, seed {seed}, step {k}");
+                assert_eq!(sa.candidates(), sb.candidates(), "{case}");
+                assert_eq!(ra.active, rb.active, "{case}");
+                compared += sa.candidates();
+                // the same state for the next step
+                sb.q.copy_from_slice(&sa.q);
+                sb.v.copy_from_slice(&sa.v);
+            }
+        }
+    }
+    assert!(
+        compared > 500,
+        "the piles must touch: {compared} candidates"
+    );
+}
+
+/// A contact keeps its record id (and with it its warm start and impact memory) while the
+/// same features touch: a box sliding on a box keeps the ids of its first step over the
+/// whole slide, and after the first steps NSGS reuses the impulses with a few sweeps.
+#[test]
+fn a_sliding_contact_keeps_its_identity_from_step_to_step() {
+    for dim in [2, 3] {
+        let scene = box_on_box(dim, 1.0, 0.3, 1.5, false);
+        let steps = 400;
+        let tr = run(&scene, &StepSettings::new(1e-3, steps));
+        let ids = |k: usize| -> Vec<usize> {
+            let mut v: Vec<usize> = tr
+                .contacts
+                .iter()
+                .filter(|c| c.step == k)
+                .map(|c| c.id)
+                .collect();
+            v.sort_unstable();
+            v
+        };
+        let first = ids(0);
+        assert_eq!(first.len(), if dim == 2 { 2 } else { 4 }, "dim {dim}");
+        for k in 1..steps {
+            assert_eq!(ids(k), first, "dim {dim}: step {k}");
+        }
+        let sweeps: usize = tr.steps[10..].iter().map(|s| s.iterations).sum();
+        assert!(sweeps <= 20 * (steps - 10), "dim {dim}: {sweeps} sweeps");
+    }
+}
+
+/// A box sliding over a flat triangle-mesh floor (a 6 x 6 grid, 72 triangles: its face
+/// crosses the triangles' shared edges) decelerates at `mu g` to 1e-9 relative with no
+/// lift-off above 1e-9 m, every step solved: the points on a shared edge are not counted
+/// twice and each triangle's contact takes the triangle's normal.
+#[test]
+fn a_box_sliding_over_a_mesh_floor_decelerates_at_mu_g() {
+    let (n, side) = (6usize, 6.0);
+    let mut verts = vec![];
+    for i in 0..=n {
+        for j in 0..=n {
+            let (x, y) = (
+                -side / 2.0 + side * i as f64 / n as f64,
+                -side / 2.0 + side * j as f64 / n as f64,
+            );
+            verts.push([x, y, 0.0]);
+        }
+    }
+    let mut tris = vec![];
+    for i in 0..n as u32 {
+        for j in 0..n as u32 {
+            let (a, b) = (i * (n as u32 + 1) + j, (i + 1) * (n as u32 + 1) + j);
+            tris.push([a, b, b + 1]);
+            tris.push([a, b + 1, a + 1]);
+        }
+    }
+    let mesh = static_solid(SolidShape::Spatial(ok(Shape3::triangle_mesh(
+        &verts, &tris,
+    ))));
+    let half = [0.1, 0.07, 0.05];
+    let (mu, v0, h) = (0.3, 1.5, 1e-3);
+    let mut v = moving(3, v0);
+    v[1] = 0.4; // a diagonal slide, across both families of edges
+    let scene = Scene {
+        dim: 3,
+        gravity: gravity(3),
+        bodies: vec![box_body(3, 1.0, half, at(3, -0.9, half[2]), v)],
+        shapes: vec![],
+        half_spaces: vec![],
+        pairs: vec![Pair::SolidSolid {
+            a: 0,
+            b: 1,
+            mu,
+            e: 0.0,
+        }],
+        solids: vec![on_body(0, box_shape(3, half)), mesh],
+    };
+    let speed0 = (v0 * v0 + 0.16f64).sqrt();
+    let stop = speed0 / (mu * G);
+    let steps = ((stop + 0.1) / h) as usize;
+    let tr = run(&scene, &StepSettings::new(h, steps));
+    all_solved(&tr, "mesh floor");
+    for k in 0..=steps {
+        let t = k as f64 * h;
+        let v = &tr.v[k * tr.nv..(k + 1) * tr.nv];
+        let speed = (v[0] * v[0] + v[1] * v[1]).sqrt();
+        let want = (speed0 - mu * G * t).max(0.0);
+        assert!(
+            (speed - want).abs() < 1e-9 * speed0,
+            "t = {t}: {speed} vs {want}"
+        );
+        let z = tr.q[k * tr.nq + 2];
+        assert!(
+            (z - half[2]).abs() < 1e-9,
+            "t = {t}: lift-off {:e}",
+            z - half[2]
+        );
+    }
+}
