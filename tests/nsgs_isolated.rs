@@ -101,7 +101,12 @@ fn isolated_contacts_are_solved_exactly_in_one_sweep() {
             ..Default::default()
         };
         let s = solve_nsgs(&problem, &settings).expect("valid settings");
-        assert_eq!(s.status, ContactStatus::Solved, "case {case}: {}", s.message);
+        assert_eq!(
+            s.status,
+            ContactStatus::Solved,
+            "case {case}: {}",
+            s.message
+        );
         assert_eq!(s.iterations, 1, "case {case}: {}", s.message);
         // the verdict's measure is recomputed from W and q: check the sliding ones are there
         let sliding = (0..nc)
@@ -110,6 +115,9 @@ fn isolated_contacts_are_solved_exactly_in_one_sweep() {
                 r[0] > 0.0 && (r[1].hypot(r[2]) - mu * r[0]).abs() <= 1e-12 * r[0]
             })
             .count();
-        assert!(sliding >= nc / 4, "case {case}: only {sliding} sliding contacts");
+        assert!(
+            sliding >= nc / 4,
+            "case {case}: only {sliding} sliding contacts"
+        );
     }
 }
