@@ -24,7 +24,12 @@
 //! iterate. `b_i` is read from the stored tiles of W's block row i (a dense W with mostly
 //! zero tiles is copied once into block CSR, [`rows`]), so a sweep costs O(nnz(W)) and
 //! allocates nothing (tests/nsgs_alloc.rs counts the allocations).
+//!
+//! When the measured error decreases only slowly (a nearly null direction of W that two
+//! contacts trade impulse along), the iterate is extrapolated along the change between two
+//! measures and kept only if the verdict's measure halves ([`extrapolate`]).
 
+mod extrapolate;
 mod local;
 mod rows;
 mod schedule;
@@ -318,6 +323,7 @@ pub fn solve_nsgs(problem: &ContactProblem<'_>, s: &NsgsSettings) -> Result<Cont
     let mut u = vec![0.0; n];
     let mut measures = measure_into(problem, &r, &mut u);
     let mut schedule = CheckSchedule::new(s.tol, measures.scaled_error);
+    let mut extrapolation = extrapolate::Extrapolation::new(n);
     let mut sweeps = 0;
     // whether `measures` are those of the current r
     let mut current = true;
@@ -333,6 +339,9 @@ pub fn solve_nsgs(problem: &ContactProblem<'_>, s: &NsgsSettings) -> Result<Cont
         current = schedule.due(sweeps, change, s.max_iter);
         if current {
             measures = measure_into(problem, &r, &mut u);
+            if !measures.passes(s.tol) {
+                extrapolation.try_after_measure(problem, &mut r, &mut u, &mut measures, sweeps);
+            }
             if !measures.passes(s.tol) {
                 schedule.measured(sweeps, measures.scaled_error, change);
             }
