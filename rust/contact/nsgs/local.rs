@@ -149,22 +149,32 @@ fn inverse3(m: &[[f64; 3]; 3]) -> Option<[f64; 9]> {
     inv.iter().all(|v| v.is_finite()).then_some(inv)
 }
 
-/// The one-contact solution in 3D when it is separation or sticking, or `None` (sliding, or
-/// a block without a safe inverse): separation when `b_n >= 0` (r = 0 gives `u = b`, which
-/// satisfies Signorini's condition and is in the dual cone), sticking when `r = -A^-1 b` is
-/// inside the friction disk (ellipse), where `u = 0`.
-pub(super) fn local_3d_closed(blk: &LocalBlock, mu: f64, b: &[f64; 3]) -> Option<[f64; 3]> {
+/// The 3D one-contact cases decided in closed form.
+pub(super) enum Closed {
+    /// separation or sticking: the local solution.
+    Solved([f64; 3]),
+    /// neither: the contact slides (or the block has no safe inverse); the sticking solution
+    /// `-A^-1 b` when it was computed (outside the disk, or with `r_n <= 0`).
+    Open(Option<[f64; 3]>),
+}
+
+/// The one-contact solution in 3D when it is separation or sticking: separation when
+/// `b_n >= 0` (r = 0 gives `u = b`, which satisfies Signorini's condition and is in the dual
+/// cone), sticking when `r = -A^-1 b` is inside the friction disk (ellipse), where `u = 0`.
+pub(super) fn local_3d_closed(blk: &LocalBlock, mu: f64, b: &[f64; 3]) -> Closed {
     if b[0] >= 0.0 {
-        return Some([0.0; 3]);
+        return Closed::Solved([0.0; 3]);
     }
-    let m = blk.inverse?;
+    let Some(m) = blk.inverse else {
+        return Closed::Open(None);
+    };
     let r = [
         -(m[0] * b[0] + m[1] * b[1] + m[2] * b[2]),
         -(m[3] * b[0] + m[4] * b[1] + m[5] * b[2]),
         -(m[6] * b[0] + m[7] * b[1] + m[8] * b[2]),
     ];
     if r[0].is_nan() || r[0] <= 0.0 {
-        return None;
+        return Closed::Open(Some(r));
     }
     let inside = match blk.scale {
         None => r[1] * r[1] + r[2] * r[2] < (mu * r[0]) * (mu * r[0]),
@@ -175,7 +185,11 @@ pub(super) fn local_3d_closed(blk: &LocalBlock, mu: f64, b: &[f64; 3]) -> Option
         Some(_) => false,
     };
     // a non-finite square (huge impulses) compares false: the passes decide
-    inside.then_some(r)
+    if inside {
+        Closed::Solved(r)
+    } else {
+        Closed::Open(Some(r))
+    }
 }
 
 /// `S = Q diag(small, large) Q^T` with `Q = [(-sn, cs), (cs, sn)]` (columns: the eigenvectors
@@ -261,29 +275,35 @@ fn norm2(x: [f64; 2]) -> f64 {
 /// `ψ(λ) = 1 / sqrt(S(λ)) - 1 / radius`, which is exactly linear for `d_0 = d_1` (the disk),
 /// safeguarded by the bracket `[||g|| / radius - max d, ||g|| / radius - min d]` (bisection
 /// when a step leaves it), started from `hint` when it lies inside the bracket (the previous
-/// pass's multiplier: a step or two), else from the bracket's right end.
+/// pass's or sweep's multiplier: a step or two), else from the bracket's right end. Newton
+/// converges quadratically there, so a step below 1e-9 of λ ends it (the next would be below
+/// rounding). With `S' = -2 T`, `T = Σ_k g_k^2 / (d_k + λ)^3`, the step is
+/// `ψ / ψ' = ψ S^(3/2) / T`: two divisions, a square root and its inverse per step.
 fn secular_root(d: [f64; 2], g: [f64; 2], radius: f64, hint: f64) -> f64 {
     let gnorm = norm2(g);
+    let inv_radius = 1.0 / radius;
     let mut lo = (gnorm / radius - d[0].max(d[1])).max(0.0);
     let mut hi = (gnorm / radius - d[0].min(d[1])).max(lo);
     let mut lambda = if hint > lo && hint < hi { hint } else { hi };
     for _ in 0..100 {
         let mut s = 0.0;
-        let mut ds = 0.0;
+        let mut t = 0.0;
         for k in 0..2 {
             let den = d[k] + lambda;
             if den > 0.0 {
-                let p = g[k] / den;
-                s += p * p;
-                ds -= 2.0 * p * p / den;
+                let inv = 1.0 / den;
+                let p = g[k] * inv;
+                let pp = p * p;
+                s += pp;
+                t += pp * inv;
             }
         }
         if !(s > 0.0 && s.is_finite()) {
             break;
         }
-        let root = s.sqrt();
-        let psi = 1.0 / root - 1.0 / radius;
-        if psi.abs() <= f64::EPSILON / radius {
+        let inv_root = 1.0 / s.sqrt();
+        let psi = inv_root - inv_radius;
+        if psi.abs() <= f64::EPSILON * inv_radius {
             break;
         }
         if psi < 0.0 {
@@ -291,18 +311,20 @@ fn secular_root(d: [f64; 2], g: [f64; 2], radius: f64, hint: f64) -> f64 {
         } else {
             hi = lambda;
         }
-        let dpsi = -0.5 * ds / (s * root);
+        let dpsi = t * inv_root * inv_root * inv_root;
         let mut next = if dpsi > 0.0 {
             lambda - psi / dpsi
         } else {
             f64::NAN
         };
-        if !(next > lo && next < hi) {
+        let newton = next > lo && next < hi;
+        if !newton {
             next = 0.5 * (lo + hi);
         }
         let step = (next - lambda).abs();
         lambda = next;
-        if step <= 4.0 * f64::EPSILON * lambda.abs().max(f64::MIN_POSITIVE)
+        if (newton && step <= 1e-9 * lambda)
+            || step <= 4.0 * f64::EPSILON * lambda.abs().max(f64::MIN_POSITIVE)
             || hi - lo <= 4.0 * f64::EPSILON * hi.abs()
         {
             break;
@@ -344,10 +366,18 @@ pub(super) fn local_2d_exact(blk: &LocalBlock, mu: f64, bn: f64, bt: f64) -> Opt
 }
 
 /// Block descent inside one contact (see the module notes); `r` holds the current local
-/// impulse on entry and the update on exit.
-pub(super) fn local_descent(blk: &LocalBlock, mu: f64, b: &[f64; 3], dim: usize, r: &mut [f64; 3]) {
+/// impulse on entry and the update on exit, `lambda` the multiplier of the disk constraint
+/// of this contact's last tangential update (NaN: none), the start of the first pass's
+/// secular solve, and on exit that of this update's.
+pub(super) fn local_descent(
+    blk: &LocalBlock,
+    mu: f64,
+    b: &[f64; 3],
+    dim: usize,
+    r: &mut [f64; 3],
+    lambda: &mut f64,
+) {
     let passes = if blk.coupled { LOCAL_ITERS } else { 1 };
-    let mut lambda = f64::NAN;
     let mut first = f64::NAN;
     for _ in 0..passes {
         let old = *r;
@@ -376,11 +406,11 @@ pub(super) fn local_descent(blk: &LocalBlock, mu: f64, b: &[f64; 3], dim: usize,
             };
         } else if let Some(e) = blk.scale {
             // r_t = E s, ||s|| <= r_n: min 1/2 s^T (E S E) s + (E g) . s over the disk
-            let x = disk_qp_from(&blk.eig, [e[0] * g[0], e[1] * g[1]], rn, &mut lambda);
+            let x = disk_qp_from(&blk.eig, [e[0] * g[0], e[1] * g[1]], rn, lambda);
             r[1] = e[0] * x[0];
             r[2] = e[1] * x[1];
         } else {
-            let x = disk_qp_from(&blk.eig, g, radius, &mut lambda);
+            let x = disk_qp_from(&blk.eig, g, radius, lambda);
             r[1] = x[0];
             r[2] = x[1];
         }
@@ -402,8 +432,97 @@ pub(super) fn local_descent(blk: &LocalBlock, mu: f64, b: &[f64; 3], dim: usize,
     }
 }
 
+/// Blocks for the local solvers' tests.
+#[cfg(test)]
+pub(super) mod tests_support {
+    use crate::testing::SplitMix64;
+
+    /// De Saxce's natural map of one contact, `r - P_K(r - (u + mu ||u_t|| n))`, in norm.
+    pub(crate) fn local_residual(
+        wb: &[[f64; 3]; 3],
+        b: &[f64; 3],
+        mu: f64,
+        r: &[f64; 3],
+        dim: usize,
+    ) -> f64 {
+        let mut u = [0.0; 3];
+        for (i, ui) in u.iter_mut().enumerate().take(dim) {
+            *ui = b[i] + (0..dim).map(|j| wb[i][j] * r[j]).sum::<f64>();
+        }
+        let mut v = [0.0; 3];
+        let ut = u[1].hypot(u[2]);
+        v[0] = r[0] - (u[0] + mu * ut);
+        for k in 1..dim {
+            v[k] = r[k] - u[k];
+        }
+        crate::contact::projection::project_cone(&mut v[..dim], mu);
+        (0..dim).map(|k| (r[k] - v[k]).powi(2)).sum::<f64>().sqrt()
+    }
+
+    /// a contact block `J M^-1 J^T` of a rigid body (mass and inertia in [0.5, 2] and
+    /// [0.05, 0.3]) touched at lever arm rho along an orthonormal frame (n, t1, t2): rows
+    /// `(d, rho x d)`.
+    pub(crate) fn body_block(rng: &mut SplitMix64) -> [[f64; 3]; 3] {
+        let unit = |rng: &mut SplitMix64| {
+            let v = [rng.normal(), rng.normal(), rng.normal()];
+            let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+            [v[0] / l, v[1] / l, v[2] / l]
+        };
+        let cross = |a: [f64; 3], b: [f64; 3]| {
+            [
+                a[1] * b[2] - a[2] * b[1],
+                a[2] * b[0] - a[0] * b[2],
+                a[0] * b[1] - a[1] * b[0],
+            ]
+        };
+        let n = unit(rng);
+        let t1 = unit(rng);
+        let t1 = {
+            let d = t1[0] * n[0] + t1[1] * n[1] + t1[2] * n[2];
+            let v = [t1[0] - d * n[0], t1[1] - d * n[1], t1[2] - d * n[2]];
+            let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+            [v[0] / l, v[1] / l, v[2] / l]
+        };
+        let t2 = cross(n, t1);
+        let rho = [
+            rng.range(-0.5, 0.5),
+            rng.range(-0.5, 0.5),
+            rng.range(-0.5, 0.5),
+        ];
+        let m = rng.range(0.5, 2.0);
+        let inertia = [
+            rng.range(0.05, 0.3),
+            rng.range(0.05, 0.3),
+            rng.range(0.05, 0.3),
+        ];
+        let rows: Vec<[f64; 6]> = [n, t1, t2]
+            .iter()
+            .map(|&d| {
+                let w = cross(rho, d);
+                [d[0], d[1], d[2], w[0], w[1], w[2]]
+            })
+            .collect();
+        let minv = [
+            1.0 / m,
+            1.0 / m,
+            1.0 / m,
+            1.0 / inertia[0],
+            1.0 / inertia[1],
+            1.0 / inertia[2],
+        ];
+        let mut a = [[0.0; 3]; 3];
+        for i in 0..3 {
+            for j in 0..3 {
+                a[i][j] = (0..6).map(|k| rows[i][k] * minv[k] * rows[j][k]).sum();
+            }
+        }
+        a
+    }
+}
+
 #[cfg(test)]
 mod tests {
+    use super::tests_support::{body_block, local_residual};
     use super::*;
     use crate::testing::SplitMix64;
 
@@ -476,7 +595,8 @@ mod tests {
             let rn = rng.range(0.1, 4.0);
             let b = [-rn, 3.0 * rng.normal(), 3.0 * rng.normal()];
             let mut r = [0.0; 3];
-            local_descent(&blk, 0.0, &b, 3, &mut r);
+            let mut lambda = f64::NAN;
+            local_descent(&blk, 0.0, &b, 3, &mut r, &mut lambda);
             assert_eq!(r[0], rn);
             let p = project_ellipse([-b[1] / t, -b[2] / t], e[0], e[1], rn);
             let scale = 1.0 + (b[1].abs() + b[2].abs()) / t;
@@ -501,82 +621,6 @@ mod tests {
         let un = rn + 0.2 * rt - 1.0;
         let ut = 0.2 * rn + rt + 3.0;
         assert!(un.abs() < 1e-15 && ut > 0.0);
-    }
-
-    /// De Saxce's natural map of one contact, `r - P_K(r - (u + mu ||u_t|| n))`, in norm.
-    fn local_residual(wb: &[[f64; 3]; 3], b: &[f64; 3], mu: f64, r: &[f64; 3], dim: usize) -> f64 {
-        let mut u = [0.0; 3];
-        for (i, ui) in u.iter_mut().enumerate().take(dim) {
-            *ui = b[i] + (0..dim).map(|j| wb[i][j] * r[j]).sum::<f64>();
-        }
-        let mut v = [0.0; 3];
-        let ut = u[1].hypot(u[2]);
-        v[0] = r[0] - (u[0] + mu * ut);
-        for k in 1..dim {
-            v[k] = r[k] - u[k];
-        }
-        crate::contact::projection::project_cone(&mut v[..dim], mu);
-        (0..dim).map(|k| (r[k] - v[k]).powi(2)).sum::<f64>().sqrt()
-    }
-
-    /// a contact block `J M^-1 J^T` of a rigid body (mass and inertia in [0.5, 2] and
-    /// [0.05, 0.3]) touched at lever arm rho along an orthonormal frame (n, t1, t2): rows
-    /// `(d, rho x d)`.
-    fn body_block(rng: &mut SplitMix64) -> [[f64; 3]; 3] {
-        let unit = |rng: &mut SplitMix64| {
-            let v = [rng.normal(), rng.normal(), rng.normal()];
-            let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-            [v[0] / l, v[1] / l, v[2] / l]
-        };
-        let cross = |a: [f64; 3], b: [f64; 3]| {
-            [
-                a[1] * b[2] - a[2] * b[1],
-                a[2] * b[0] - a[0] * b[2],
-                a[0] * b[1] - a[1] * b[0],
-            ]
-        };
-        let n = unit(rng);
-        let t1 = unit(rng);
-        let t1 = {
-            let d = t1[0] * n[0] + t1[1] * n[1] + t1[2] * n[2];
-            let v = [t1[0] - d * n[0], t1[1] - d * n[1], t1[2] - d * n[2]];
-            let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-            [v[0] / l, v[1] / l, v[2] / l]
-        };
-        let t2 = cross(n, t1);
-        let rho = [
-            rng.range(-0.5, 0.5),
-            rng.range(-0.5, 0.5),
-            rng.range(-0.5, 0.5),
-        ];
-        let m = rng.range(0.5, 2.0);
-        let inertia = [
-            rng.range(0.05, 0.3),
-            rng.range(0.05, 0.3),
-            rng.range(0.05, 0.3),
-        ];
-        let rows: Vec<[f64; 6]> = [n, t1, t2]
-            .iter()
-            .map(|&d| {
-                let w = cross(rho, d);
-                [d[0], d[1], d[2], w[0], w[1], w[2]]
-            })
-            .collect();
-        let minv = [
-            1.0 / m,
-            1.0 / m,
-            1.0 / m,
-            1.0 / inertia[0],
-            1.0 / inertia[1],
-            1.0 / inertia[2],
-        ];
-        let mut a = [[0.0; 3]; 3];
-        for i in 0..3 {
-            for j in 0..3 {
-                a[i][j] = (0..6).map(|k| rows[i][k] * minv[k] * rows[j][k]).sum();
-            }
-        }
-        a
     }
 
     /// the block as stored decides the local solution: with an unsymmetric `W_ii` (relative
@@ -609,9 +653,10 @@ mod tests {
             if let Some((rn, rt)) = exact {
                 r = [rn, rt, 0.0];
             } else {
-                // the outer sweeps repeat the passes: so does this test
+                // the outer sweeps repeat the passes, carrying the multiplier: so does this test
+                let mut lambda = f64::NAN;
                 for _ in 0..200 {
-                    local_descent(&blk, mu, &b, dim, &mut r);
+                    local_descent(&blk, mu, &b, dim, &mut r, &mut lambda);
                 }
             }
             let scale = 1.0 + r.iter().map(|v| v.abs()).sum::<f64>();
@@ -636,8 +681,9 @@ mod tests {
                 {
                     rs = [rn, rt, 0.0];
                 } else {
+                    let mut lambda = f64::NAN;
                     for _ in 0..200 {
-                        local_descent(&sb, mu, &b, dim, &mut rs);
+                        local_descent(&sb, mu, &b, dim, &mut rs, &mut lambda);
                     }
                 }
                 let wrong = local_residual(&wb, &b, mu, &rs, dim);
