@@ -15,6 +15,8 @@ mod drift;
 mod event;
 #[path = "generalized.rs"]
 pub mod generalized;
+#[path = "joints.rs"]
+mod joints;
 #[path = "law.rs"]
 mod law;
 #[path = "narrow.rs"]
@@ -28,9 +30,12 @@ mod solve;
 
 use self::bodies::{bodies_of, norm3, BodyInfo, Frozen};
 use self::event::Located;
+pub use self::joints::{Joint, JointKind, JointSystemInfo};
 use self::narrow::{declared_candidates, frame, Candidate, Geometry};
 use self::persistence::{sphere_points, CandState};
-pub use self::record::{simulate, simulate_recorded, ContactRecord, StepRecord, Trajectory};
+pub use self::record::{
+    simulate, simulate_joints, simulate_recorded, ContactRecord, StepRecord, Trajectory,
+};
 use self::solve::SolveBuffers;
 use super::broad::BroadPhase;
 use super::poisson::routh;
@@ -154,6 +159,8 @@ pub struct Stepper {
     /// `(q_k, v_k)` while a located step follows its path (module `event`).
     saved_q: Vec<f64>,
     saved_v: Vec<f64>,
+    /// the joints, when the scene has any (module `joints`).
+    joints: Option<Box<joints::JointSystem>>,
 }
 
 impl Stepper {
@@ -211,6 +218,7 @@ impl Stepper {
             restitution: Vec::new(),
             solve: SolveBuffers::default(),
             candidates,
+            joints: None,
         })
     }
 
@@ -229,6 +237,18 @@ impl Stepper {
         }
         self.freeze();
         self.free_velocity();
+        if let Some(js) = self.joints.as_mut() {
+            let (h, tol) = (self.settings.h, self.settings.gap_tolerance);
+            js.free_velocity(
+                &self.bodies,
+                &self.frozen,
+                &self.q,
+                &self.v,
+                &mut self.v_free,
+                h,
+                tol,
+            );
+        }
         // a bound on each body's point speeds (v_k and v_free): a candidate farther than
         // 2 h times its bound cannot close within the step, whatever its normal
         for (bi, b) in self.bodies.iter().enumerate() {
@@ -307,6 +327,9 @@ impl Stepper {
             }
             self.apply_impulses(&mut v_next);
         }
+        if let Some(js) = self.joints.as_mut() {
+            js.after_solve(&self.bodies, &mut v_next, &mut self.gp);
+        }
         record.momentum_residual = self.momentum_residual(&v_next);
         if nc > 0 {
             self.remember(&v_next, contacts);
@@ -322,6 +345,9 @@ impl Stepper {
         self.v.copy_from_slice(&v_next);
         self.v_next = v_next;
         self.integrate_positions();
+        if let Some(js) = self.joints.as_mut() {
+            js.project_positions(&self.bodies, &mut self.q);
+        }
         if project {
             record.projection = self.project(e_start)?;
         }
