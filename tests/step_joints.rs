@@ -471,3 +471,69 @@ fn bad_joints_are_refused_before_any_step() {
         ));
     }
 }
+
+/// a chain of `n` links (m = 1, length 0.2) lying on the floor along x, each hinged to the
+/// next, both ends of every link touching the floor (mu = 0.4): 2 n contacts, past the size
+/// where W is assembled sparse.
+fn chain_on_floor(dim: usize, n: usize) -> (Scene, Vec<Joint>) {
+    let l = 0.2;
+    let j = l * l / 12.0;
+    let th = std::f64::consts::FRAC_PI_2;
+    let bodies = (0..n)
+        .map(|i| swinging_body(dim, 1.0, j, 0.5 * l, th, [i as f64 * l, 0.0, 0.0]))
+        .collect();
+    let mut sc = scene(dim, bodies);
+    let mut normal = vec![0.0; dim];
+    normal[dim - 1] = 1.0;
+    sc.half_spaces.push(HalfSpace {
+        point: vec![0.0; dim],
+        normal,
+    });
+    for i in 0..n {
+        let mut lo = vec![0.0; dim];
+        let mut hi = vec![0.0; dim];
+        lo[dim - 1] = 0.5 * l;
+        hi[dim - 1] = -0.5 * l;
+        sc.shapes.push(Shape {
+            body: i,
+            points: vec![lo, hi],
+            radius: 0.0,
+        });
+        sc.pairs.push(Pair::ShapeHalfSpace {
+            shape: i,
+            half_space: 0,
+            mu: 0.4,
+            e: 0.0,
+        });
+    }
+    let joints = (1..n)
+        .map(|i| hinge(dim, i, Some(i - 1), [i as f64 * l, 0.0, 0.0]))
+        .collect();
+    (sc, joints)
+}
+
+#[test]
+fn a_hinged_chain_lying_on_the_floor_rests_exactly_with_a_sparse_w() {
+    for dim in [2, 3] {
+        let n = 15;
+        let (sc, joints) = chain_on_floor(dim, n);
+        let mut st = Stepper::with_joints(&sc, &joints, &StepSettings::new(1e-3, 0)).unwrap();
+        let mut contacts = Vec::new();
+        for _ in 0..200 {
+            contacts.clear();
+            let rec = st.step(&mut contacts).unwrap();
+            assert_eq!(rec.active, 2 * n);
+            assert!(rec.momentum_residual < 1e-12, "{}", rec.momentum_residual);
+            assert!(rec.scaled_error < 1e-9, "dim {dim}: {}", rec.scaled_error);
+            // the floor carries the whole weight: Σ P_n = n m g h
+            let total: f64 = contacts.iter().map(|c| c.impulse[0]).sum();
+            assert!((total - n as f64 * G * 1e-3).abs() < 1e-9 * n as f64 * G * 1e-3);
+        }
+        let speed = st.v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        assert!(speed < 1e-10, "dim {dim}: speed {speed}");
+        let sink = (0..n)
+            .map(|i| st.q[i * if dim == 2 { 3 } else { 7 } + dim - 1].abs())
+            .fold(0.0f64, f64::max);
+        assert!(sink < 1e-10, "dim {dim}: {sink}");
+    }
+}

@@ -57,6 +57,7 @@ from .errors import (
     NonFiniteError,
     ShapeError,
 )
+from .joints import Joint
 from .settings import StepSettings, accepts
 from .trajectory import Trajectory
 
@@ -314,10 +315,15 @@ class Scene:
         self.half_spaces: list[HalfSpace] = []
         self.shapes: list[tuple[Body, Shape]] = []
         self.pairs: list[tuple[str, Any, Any, float, float]] = []
+        self.joints: list[Joint] = []
 
-    def add(self, item: Body | HalfSpace) -> Any:
-        """Adds a body or a half-space; returns it (use it as a handle)."""
-        if isinstance(item, Body):
+    def add(self, item: Body | HalfSpace | Joint) -> Any:
+        """Adds a body, a half-space or a joint (:mod:`coulomb.joints`); returns it (use it as
+        a handle)."""
+        if isinstance(item, Joint):
+            item._spec(self.dim, self.bodies)  # checked now, before any work
+            self.joints.append(item)
+        elif isinstance(item, Body):
             item._spec(self.dim)  # checked now, before any work
             self.bodies.append(item)
         elif isinstance(item, HalfSpace):
@@ -396,6 +402,7 @@ class Scene:
             ],
             "pairs": [{"kind": k, "a": a, "b": b, "mu": mu, "e": e}
                       for k, a, b, mu, e in self.pairs],
+            "joints": [j._spec(self.dim, self.bodies) for j in self.joints],
         }
 
     def layout(self) -> list[tuple[slice, slice]]:

@@ -9,10 +9,13 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString};
 
 use super::{guarded, settings, to_py};
+
+#[path = "step_joints.rs"]
+mod joints;
 use crate::contact::ContactOrder;
 use crate::error::CoulombError;
 use crate::step::{
-    simulate_recorded, Body, BodyKind, Drift, HalfSpace, Pair, Restitution, Scene, Shape,
+    simulate_joints, Body, BodyKind, Drift, HalfSpace, Pair, Restitution, Scene, Shape,
     StepSettings, StepSolver, Trajectory,
 };
 
@@ -358,6 +361,7 @@ pub(super) fn step_simulate<'py>(
     record_every: usize,
     locate_impacts: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let joints = joints::joints_from_dict(scene)?;
     let scene = scene_from_dict(scene)?;
     let settings = settings_from(
         py,
@@ -379,7 +383,7 @@ pub(super) fn step_simulate<'py>(
     )?;
     let (tr, seconds) = guarded(py, usize::MAX, || {
         let start = std::time::Instant::now();
-        let tr = simulate_recorded(&scene, &settings, record_every)?;
+        let tr = simulate_joints(&scene, &joints, &settings, record_every)?;
         Ok((tr, start.elapsed().as_secs_f64()))
     })?;
     trajectory_dict(py, tr, seconds)

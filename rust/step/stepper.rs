@@ -328,7 +328,7 @@ impl Stepper {
             self.apply_impulses(&mut v_next);
         }
         if let Some(js) = self.joints.as_mut() {
-            js.after_solve(&self.bodies, &mut v_next, &mut self.gp);
+            record.resumed |= js.after_solve(&self.bodies, &mut v_next, &mut self.gp);
         }
         record.momentum_residual = self.momentum_residual(&v_next);
         if nc > 0 {

@@ -585,13 +585,15 @@ impl JointSystem {
     }
 
     /// after the contact impulses: `v_next` projected on the rows again (`gp += J^T λ`), and
-    /// the limits' impact memory.
+    /// the limits' impact memory; true when a stop gave back a remembered rebound (the step's
+    /// energy is then judged across it and the step that struck, as a contact's).
     pub(in crate::step::stepper) fn after_solve(
         &mut self,
         bodies: &[BodyInfo],
         v_next: &mut [f64],
         gp: &mut [f64],
-    ) {
+    ) -> bool {
+        let mut resumed = false;
         let mut islands = std::mem::take(&mut self.islands);
         for isl in &mut islands {
             isl.project(v_next, bodies, Some(&mut *gp));
@@ -600,11 +602,13 @@ impl JointSystem {
             }
             for &l in &isl.limits {
                 let lim = &mut self.limits[l];
+                resumed |= lim.active && lim.mode == Mode::Pending;
                 lim.pending = (lim.active && lim.mode == Mode::Imminent && lim.lam > 0.0)
                     .then_some(lim.approach.min(0.0));
             }
         }
         self.islands = islands;
+        resumed
     }
 
     /// the position projection after the positions: Newton steps
