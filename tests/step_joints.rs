@@ -537,3 +537,95 @@ fn a_hinged_chain_lying_on_the_floor_rests_exactly_with_a_sparse_w() {
         assert!(sink < 1e-10, "dim {dim}: {sink}");
     }
 }
+
+/// a slider on a vertical prismatic joint (3D: along z; 2D: along y), dropped from rest
+/// 0.1 m above its lower stop: it strikes at sqrt(2 g 0.1) and leaves at -e times that.
+#[test]
+fn a_slider_dropped_on_its_stop_rebounds_at_minus_e_times_its_approach() {
+    for dim in [2, 3] {
+        for e in [0.0, 0.3, 1.0] {
+            let body = swinging_body(dim, 2.0, 0.1, 0.0, 0.0, [0.0; 3]);
+            let sc = scene(dim, vec![body]);
+            let mut axis = vec![0.0; dim];
+            axis[dim - 1] = 1.0;
+            let joints = [Joint {
+                kind: JointKind::Prismatic,
+                a: 0,
+                b: None,
+                anchor: vec![0.0; dim],
+                axis,
+                limits: Some((-0.1, 1.0)),
+                e,
+            }];
+            let h = 1e-4;
+            let mut st = Stepper::with_joints(&sc, &joints, &StepSettings::new(h, 0)).unwrap();
+            let mut contacts = Vec::new();
+            let mut result = None;
+            for _ in 0..100_000 {
+                let before = st.v[dim - 1];
+                st.step(&mut contacts).unwrap();
+                if st.q[dim - 1] <= -0.1 + 1e-12 {
+                    st.step(&mut contacts).unwrap();
+                    result = Some((before, st.v[dim - 1]));
+                    break;
+                }
+            }
+            let (before, after) = result.expect("the slider reached its stop");
+            let strike = (2.0 * G * 0.1f64).sqrt();
+            println!("dim {dim} e {e}: before {before:.6}, after {after:.6}");
+            // the approach within gravity's O(h) of free fall
+            assert!(
+                (before + strike).abs() < 2.0 * G * h,
+                "{before} vs {strike}"
+            );
+            // the rebound step's target is the rebound itself: -e v-
+            assert!(
+                (after + e * before).abs() < 1e-9 * strike,
+                "dim {dim} e {e}: {after} vs {}",
+                -e * before
+            );
+        }
+    }
+}
+
+/// a spherical pendulum on a conical orbit: the angular momentum about the vertical through
+/// the pivot is conserved (gravity and the joint's reaction have no moment about it).
+#[test]
+fn a_spherical_pendulum_keeps_its_vertical_angular_momentum() {
+    let (m, l) = (1.0, 1.0);
+    let i = 1e-3;
+    let th = 0.6;
+    let mut body = swinging_body(3, m, i, l, th, [0.0; 3]);
+    body.inertia = vec![i, 0.0, 0.0, 0.0, i, 0.0, 0.0, 0.0, i];
+    // the conical pendulum's rate: w^2 = g / (l cos th), velocity along +y at (l sin th, 0, .)
+    let w = (G / (l * th.cos())).sqrt();
+    body.v0 = vec![0.0, w * l * th.sin(), 0.0, 0.0, 0.0, w];
+    let sc = scene(3, vec![body]);
+    let joints = [Joint {
+        kind: JointKind::Spherical,
+        a: 0,
+        b: None,
+        anchor: vec![0.0; 3],
+        axis: vec![],
+        limits: None,
+        e: 0.0,
+    }];
+    let mut st = Stepper::with_joints(&sc, &joints, &StepSettings::new(1e-3, 0)).unwrap();
+    let lz = |st: &Stepper| m * (st.q[0] * st.v[1] - st.q[1] * st.v[0]) + i * st.v[5];
+    let l0 = lz(&st);
+    let mut contacts = Vec::new();
+    let mut worst = 0.0f64;
+    let mut height = (f64::INFINITY, f64::NEG_INFINITY);
+    for _ in 0..5000 {
+        st.step(&mut contacts).unwrap();
+        worst = worst.max((lz(&st) - l0).abs());
+        height = (height.0.min(st.q[2]), height.1.max(st.q[2]));
+    }
+    println!("spherical: L_z drift {worst:.3e} of {l0:.4}, height in {height:?}");
+    // exact in the velocity step (the joint's impulse acts at the pivot, and
+    // `r_{k+1} × v_{k+1} = r_k × v_{k+1}`); the position projection's O(h^3) displacements
+    // change it slightly (measured 2.6e-9 relative over 5000 steps)
+    assert!(worst < 1e-8 * l0.abs(), "{worst}");
+    // the orbit stays conical: the height stays at -l cos th to O(h)
+    assert!((height.0 + l * th.cos()).abs() < 1e-2 && (height.1 + l * th.cos()).abs() < 1e-2);
+}

@@ -339,7 +339,7 @@ impl JointSystem {
         gap_tol: f64,
     ) {
         let mut islands = std::mem::take(&mut self.islands);
-        // the joint rows' own step: v_free projected on J v = 0 (u)
+        // the joint rows at q_k and their factor
         for isl in &mut islands {
             self.equality_rows(isl, bodies, q);
             isl.raw.clear();
@@ -351,36 +351,15 @@ impl JointSystem {
             isl.eq_target.clear();
             isl.eq_target.resize(isl.n_eq, 0.0);
             isl.active.clear();
-            self.build_and_project(isl, bodies, frozen, v_free);
+            isl.factor_rows(|b| frozen[b].minv);
         }
         // each row's second-order remainder over the step on v_k: the targets
         // `-(C(q ⊕ h v_k) - C(q) - h J v_k) / h` (on v_k, not on the joint-only velocity:
         // a contact that holds a jointed body still gets no remainder)
         self.qs.clear();
         self.qs.extend_from_slice(q);
-        let mut dq = [0.0; 6];
-        for isl in &islands {
-            for &b in &isl.bodies {
-                let bi = &bodies[b];
-                for k in 0..bi.nv {
-                    dq[k] = h * v[bi.off_v + k];
-                }
-                displace_body(&mut self.qs[bi.off_q..], bi.kind, &dq[..bi.nv]);
-            }
-        }
         for isl in &mut islands {
-            let mut moved = std::mem::take(&mut isl.moved);
-            moved.clear();
-            for &j in &isl.joints {
-                let d = &self.data[j];
-                let (fa, fb) = self.frames(d, bodies, &self.qs);
-                d.rows(self.dim, &fa, &fb, &mut moved);
-            }
-            for (r, (row, mv)) in isl.rows[..isl.n_eq].iter().zip(&moved).enumerate() {
-                let rate = Island::rate(row, v, bodies);
-                isl.eq_target[r] = -(mv.c - row.c - h * rate) / h;
-            }
-            isl.moved = moved;
+            self.remainders(isl, bodies, q, v, h);
         }
         for isl in &mut islands {
             for &l in &isl.limits {
@@ -404,8 +383,48 @@ impl JointSystem {
                 self.limits[l] = lim;
             }
             self.active_set(isl, bodies, frozen, v_free);
+            if !isl.active.is_empty() {
+                // a stop changes the velocity by O(1) (a rebound): the remainder on the
+                // velocity the step will have
+                self.remainders(isl, bodies, q, v_free, h);
+                self.reproject(isl, bodies, v_free);
+            }
         }
         self.islands = islands;
+    }
+
+    /// island `isl`'s equality targets: each row's second-order remainder over the step on
+    /// the velocity `vel`, `-(C(q ⊕ h vel) - C(q) - h J vel) / h` (`qs` holds q).
+    fn remainders(
+        &mut self,
+        isl: &mut Island,
+        bodies: &[BodyInfo],
+        q: &[f64],
+        vel: &[f64],
+        h: f64,
+    ) {
+        let mut dq = [0.0; 6];
+        for &b in &isl.bodies {
+            let bi = &bodies[b];
+            let nq = bi.kind.nq(self.dim);
+            self.qs[bi.off_q..bi.off_q + nq].copy_from_slice(&q[bi.off_q..bi.off_q + nq]);
+            for k in 0..bi.nv {
+                dq[k] = h * vel[bi.off_v + k];
+            }
+            displace_body(&mut self.qs[bi.off_q..], bi.kind, &dq[..bi.nv]);
+        }
+        let mut moved = std::mem::take(&mut isl.moved);
+        moved.clear();
+        for &j in &isl.joints {
+            let d = &self.data[j];
+            let (fa, fb) = self.frames(d, bodies, &self.qs);
+            d.rows(self.dim, &fa, &fb, &mut moved);
+        }
+        for (r, (row, mv)) in isl.rows[..isl.n_eq].iter().zip(&moved).enumerate() {
+            let rate = Island::rate(row, vel, bodies);
+            isl.eq_target[r] = -(mv.c - row.c - h * rate) / h;
+        }
+        isl.moved = moved;
     }
 
     /// the island's rows (equality, then its active limits), their factor, and `v_free`
