@@ -104,6 +104,9 @@ def test_a_pendulum_striking_a_stop_rebounds_at_minus_e_times_its_approach(
     assert abs(after + e * before) < 1e-9 * w_bottom, (before, after)
     # the stop holds: the swing angle never passes it
     assert a.min() > -1e-12
+    # the rebound step is judged across the strike: no energy gained, every check passes
+    result = tr.check()
+    assert result.ok, result.violations
 
 
 @pytest.mark.parametrize("dim", [2, 3])
