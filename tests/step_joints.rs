@@ -668,3 +668,28 @@ fn a_hinged_rod_striking_the_floor_obeys_newtons_law_through_the_joint() {
         }
     }
 }
+
+/// a rod welded to the world with its end on the floor: the contact's W (through the
+/// constrained inverse mass) is zero, and the step still solves it (no impulse is needed).
+#[test]
+fn a_welded_body_on_the_floor_needs_no_impulse() {
+    for dim in [2, 3] {
+        let (sc, mut joints) = hinged_rod_on_floor(dim);
+        joints[0].kind = JointKind::Fixed;
+        joints[0].axis = vec![];
+        let mut st = Stepper::with_joints(&sc, &joints, &StepSettings::new(1e-3, 0)).unwrap();
+        let mut contacts = Vec::new();
+        for _ in 0..100 {
+            contacts.clear();
+            let rec = st.step(&mut contacts).unwrap();
+            assert!(
+                rec.status.is_none_or(|s| s.as_str() == "solved"),
+                "{:?}",
+                rec.status
+            );
+            assert!(contacts.iter().all(|c| c.impulse[0].abs() < 1e-12));
+        }
+        assert!(st.v.iter().all(|x| x.abs() < 1e-12), "{:?}", st.v);
+        assert!(st.q.iter().all(|x| x.is_finite()));
+    }
+}
