@@ -16,6 +16,9 @@ model
     impulse time stepper (Stewart 2000; Stewart and Trinkle 1996), run in Rust.
 trajectory
     The simulation result with its per-step checks (``Trajectory.check``) and plots.
+joints
+    Joints (revolute, prismatic, spherical, fixed) between bodies or a body and the world,
+    with limits and restitution, added to a scene with ``Scene.add``.
 io
     Readers for benchmark problem files (Siconos LCP and friction contact, FCLib HDF5).
 painleve
@@ -47,6 +50,7 @@ from . import (
     errors,
     extremes,
     io,
+    joints,
     lcp,
     model,
     painleve,
@@ -59,6 +63,7 @@ from ._core import __version__, memory_budget, set_memory_budget
 from ._result import Result
 from ._status import Status
 from .contact import ContactResult
+from .joints import Fixed, Prismatic, Revolute, Spherical, Weld
 from .lcp import LcpResult
 from .model import (
     Box,
@@ -101,6 +106,7 @@ __all__ = [
     "ConvexHull",
     "Cylinder",
     "Disk",
+    "Fixed",
     "GapContact",
     "HalfSpace",
     "Heightfield",
@@ -113,22 +119,27 @@ __all__ = [
     "Point",
     "Polygon",
     "PolyhedralSettings",
+    "Prismatic",
     "ProxSettings",
     "Result",
+    "Revolute",
     "RigidBody2D",
     "RigidBody3D",
     "Scene",
     "Segment",
     "Sphere",
+    "Spherical",
     "Status",
     "StepSettings",
     "Trajectory",
     "TriangleMesh",
+    "Weld",
     "__version__",
     "contact",
     "errors",
     "extremes",
     "io",
+    "joints",
     "lcp",
     "memory_budget",
     "model",

@@ -76,6 +76,7 @@ from .errors import (
     NonFiniteError,
     ShapeError,
 )
+from .joints import Joint
 from .settings import StepSettings, accepts
 from .trajectory import Trajectory
 
@@ -359,11 +360,16 @@ class Scene:
         self.statics: list[StaticSolid] = []
         self.shapes: list[tuple[Body, Shape]] = []
         self.pairs: list[tuple[str, Any, Any, float, float]] = []
+        self.joints: list[Joint] = []
 
-    def add(self, item: Body | HalfSpace | StaticSolid) -> Any:
-        """Adds a body, a half-space or a static solid (:class:`TriangleMesh`,
-        :class:`Heightfield`); returns it (use it as a handle)."""
-        if isinstance(item, Body):
+    def add(self, item: Body | HalfSpace | StaticSolid | Joint) -> Any:
+        """Adds a body, a half-space, a static solid (:class:`TriangleMesh`,
+        :class:`Heightfield`) or a joint (:mod:`coulomb.joints`); returns it (use it as a
+        handle)."""
+        if isinstance(item, Joint):
+            item._spec(self.dim, self.bodies)  # checked now, before any work
+            self.joints.append(item)
+        elif isinstance(item, Body):
             item._spec(self.dim)  # checked now, before any work
             self.bodies.append(item)
         elif isinstance(item, HalfSpace):
@@ -561,6 +567,7 @@ class Scene:
             ],
             "pairs": pairs,
             "solids": solids,
+            "joints": [j._spec(self.dim, self.bodies) for j in self.joints],
         }
 
     def layout(self) -> list[tuple[slice, slice]]:

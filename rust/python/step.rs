@@ -10,11 +10,14 @@ use pyo3::types::{PyDict, PyList, PyString};
 
 use super::settings::{self, Keyword};
 use super::{guarded, to_py};
+
+#[path = "step_joints.rs"]
+mod joints;
 use crate::contact::ContactOrder;
 use crate::error::CoulombError;
 use crate::geometry::{Shape2, Shape3};
 use crate::step::{
-    simulate_recorded, Body, BodyKind, HalfSpace, Pair, Scene, Shape, Solid, SolidShape,
+    simulate_joints, Body, BodyKind, HalfSpace, Pair, Scene, Shape, Solid, SolidShape,
     StepSettings, StepSolver, Trajectory,
 };
 
@@ -478,6 +481,7 @@ pub(super) fn step_simulate<'py>(
     record_every: usize,
     locate_impacts: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let joints = joints::joints_from_dict(scene)?;
     let scene = scene_from_dict(scene)?;
     let settings = settings_from(
         py,
@@ -499,7 +503,7 @@ pub(super) fn step_simulate<'py>(
     )?;
     let (tr, seconds) = guarded(py, usize::MAX, || {
         let start = std::time::Instant::now();
-        let tr = simulate_recorded(&scene, &settings, record_every)?;
+        let tr = simulate_joints(&scene, &joints, &settings, record_every)?;
         Ok((tr, start.elapsed().as_secs_f64()))
     })?;
     trajectory_dict(py, tr, seconds)

@@ -38,6 +38,11 @@ pub(super) trait Driver {
     /// `v_{k+1} = v_free + M^{-1} G P` into `v_next`, and `G P`.
     fn apply(&mut self, v_next: &mut [f64]);
     /// the step's momentum balance, relative.
+    /// the bilateral rows' velocity correction after the contact solve (scenes with joints);
+    /// returns whether the step resumed a stop's rebound.
+    fn constrain(&mut self, _v_next: &mut [f64]) -> bool {
+        false
+    }
     fn momentum(&self, v_next: &[f64]) -> f64;
     /// the contacts' memory, and their records appended to `contacts`.
     fn remember(&mut self, v_next: &[f64], contacts: &mut Vec<ContactRecord>);
@@ -72,6 +77,7 @@ pub(super) fn step<D: Driver>(d: &mut D, contacts: &mut Vec<ContactRecord>) -> R
         d.solve(&mut record)?;
         d.apply(&mut v_next);
     }
+    record.resumed |= d.constrain(&mut v_next);
     record.momentum_residual = d.momentum(&v_next);
     if nc > 0 {
         d.remember(&v_next, contacts);
@@ -118,6 +124,12 @@ impl Driver for Stepper {
     fn apply(&mut self, v_next: &mut [f64]) {
         self.apply_impulses(v_next);
     }
+    fn constrain(&mut self, v_next: &mut [f64]) -> bool {
+        match self.joints.as_mut() {
+            Some(js) => js.after_solve(&self.bodies, v_next, &mut self.gp),
+            None => false,
+        }
+    }
     fn momentum(&self, v_next: &[f64]) -> f64 {
         self.momentum_residual(v_next)
     }
@@ -132,6 +144,9 @@ impl Driver for Stepper {
         self.v.copy_from_slice(&v_next);
         self.v_next = v_next;
         self.integrate_positions();
+        if let Some(js) = self.joints.as_mut() {
+            js.project_positions(&self.bodies, &mut self.q);
+        }
         self.step_index += 1;
         self.t = self.step_index as f64 * self.settings.h;
     }

@@ -56,17 +56,27 @@ impl Stepper {
     /// contact its G columns and `M_b^{-1}` times them.
     fn assemble_w(&mut self) {
         let nc = self.active.len();
+        // joints: one more block per island, `-B^T A^+ B` (module `joints`)
+        if let Some(js) = self.joints.as_mut() {
+            js.contact_columns(&self.active);
+        }
+        let joints = self.joints.as_deref();
+        let nb = self.bodies.len();
         let active = &self.active;
         let w = &mut self.delassus;
-        w.begin(self.bodies.len());
+        w.begin(nb + joints.map_or(0, |js| js.island_count()));
         for (i, a) in active.iter().enumerate() {
             for (k, side) in a.sides[..a.nsides].iter().enumerate() {
                 w.side(i, k, side.body);
             }
         }
+        if let Some(js) = joints {
+            js.register(w, nb);
+        }
         let dim = self.dim;
-        w.assemble(dim, nc, nc >= SPARSE_FROM, |i, j| {
-            side_product(dim, active, i, j)
+        w.assemble(dim, nc, nc >= SPARSE_FROM, |i, j| match joints {
+            Some(js) if i.1 >= 2 => js.coupling(i.1 - 2, i.0, j.0),
+            _ => side_product(dim, active, i, j),
         });
     }
 

@@ -88,7 +88,10 @@ pub use solid::{Solid, SolidShape};
 pub use stepper::generalized::{
     simulate_generalized, GeneralizedStepper, GeneralizedSystem, GeneralizedTrajectory,
 };
-pub use stepper::{simulate, simulate_recorded, ContactRecord, StepRecord, Stepper, Trajectory};
+pub use stepper::{
+    simulate, simulate_joints, simulate_recorded, ContactRecord, Joint, JointKind, JointSystemInfo,
+    StepRecord, Stepper, Trajectory,
+};
 
 use crate::contact::{NsgsSettings, PolyhedralSettings};
 use crate::error::{check_finite, CoulombError, Result};

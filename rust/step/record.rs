@@ -7,7 +7,7 @@
 use super::{Stepper, TINY};
 use crate::contact::ContactStatus;
 use crate::error::Result;
-use crate::step::{Scene, StepSettings};
+use crate::step::{Joint, Scene, StepSettings};
 
 /// The checks of one step k -> k+1: momentum balance, gaps, cone, complementarity, energy.
 #[derive(Clone, Debug)]
@@ -120,7 +120,25 @@ pub fn simulate_recorded(
     settings: &StepSettings,
     record_every: usize,
 ) -> Result<Trajectory> {
-    let mut st = Stepper::new(scene, settings)?;
+    run_scene(Stepper::new(scene, settings)?, settings, record_every)
+}
+
+/// [`simulate_recorded`] on a scene with joints (see [`Stepper::with_joints`]).
+pub fn simulate_joints(
+    scene: &Scene,
+    joints: &[Joint],
+    settings: &StepSettings,
+    record_every: usize,
+) -> Result<Trajectory> {
+    run_scene(
+        Stepper::with_joints(scene, joints, settings)?,
+        settings,
+        record_every,
+    )
+}
+
+/// the recorded run of a constructed stepper (see [`simulate_recorded`]).
+fn run_scene(mut st: Stepper, settings: &StepSettings, record_every: usize) -> Result<Trajectory> {
     let steps = settings.steps;
     let every = record_every.max(1);
     let rows = steps.div_ceil(every) + 1;

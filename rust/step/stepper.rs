@@ -17,6 +17,8 @@ mod driver;
 mod event;
 #[path = "generalized.rs"]
 pub mod generalized;
+#[path = "joints.rs"]
+mod joints;
 #[path = "law.rs"]
 mod law;
 #[path = "narrow.rs"]
@@ -31,10 +33,13 @@ mod solid_pairs;
 mod solve;
 
 use self::bodies::{bodies_of, norm3, BodyInfo, Frozen};
+pub use self::joints::{Joint, JointKind, JointSystemInfo};
 use self::law::SolveWork;
 use self::narrow::{declared_candidates, frame, Candidate, Geometry};
 use self::persistence::{sphere_points, CandState};
-pub use self::record::{simulate, simulate_recorded, ContactRecord, StepRecord, Trajectory};
+pub use self::record::{
+    simulate, simulate_joints, simulate_recorded, ContactRecord, StepRecord, Trajectory,
+};
 use self::solve::SolveBuffers;
 use super::broad::BroadPhase;
 use super::poisson::routh;
@@ -156,6 +161,8 @@ pub struct Stepper {
     saved_v: Vec<f64>,
     /// the solids' pairs and their candidates' names (module `solid_pairs`).
     solid_pairs: solid_pairs::SolidPairs,
+    /// the joints, when the scene has any (module `joints`).
+    joints: Option<Box<joints::JointSystem>>,
 }
 
 impl Stepper {
@@ -212,6 +219,7 @@ impl Stepper {
             solve: SolveBuffers::default(),
             candidates,
             solid_pairs,
+            joints: None,
         })
     }
 
@@ -230,6 +238,18 @@ impl Stepper {
         }
         self.freeze();
         self.free_velocity();
+        if let Some(js) = self.joints.as_mut() {
+            let (h, tol) = (self.settings.h, self.settings.gap_tolerance);
+            js.free_velocity(
+                &self.bodies,
+                &self.frozen,
+                &self.q,
+                &self.v,
+                &mut self.v_free,
+                h,
+                tol,
+            );
+        }
         // a bound on each body's point speeds (v_k and v_free): a candidate farther than
         // 2 h times its bound cannot close within the step, whatever its normal
         for (bi, b) in self.bodies.iter().enumerate() {
