@@ -100,21 +100,23 @@ fn capsules_and_cylinders_on_a_plane_rest() {
     }
 }
 
-/// A tower of boxes on the floor stands: every box's drift below 1e-9 m over 2 s, with NSGS
-/// and with Lemke, in 2D and 3D.
+/// A tower of ten boxes on the floor stands for 10 s: every coordinate of every box within
+/// 1e-9 (m, and rad) of its start, with NSGS and with Lemke, in 2D and 3D, at h = 5 ms.
+///
+/// NSGS runs at its default tolerance 1e-12 with the step's default Lemke fallback. A face's
+/// four contact rows outnumber the motions they stop (W singular), and on this tower NSGS
+/// alone misses its tolerance on many steps: measured in 3D with the fallback off, a scaled
+/// error up to 3.3e-4 after its iteration limit and a drift of 1e-3 m; with the fallback, 701
+/// of the 2000 steps go to Lemke and the drift is 1.2e-10. Relaxing NSGS to 1e-10 (the
+/// tolerance the guide gives for faces) is not enough at this h: its residual velocities
+/// integrate to a drift of 1.8e-9 over 10 s (at h = 1 ms, 2.8e-10).
 #[test]
-fn a_box_tower_stands_with_exact_sticking_under_nsgs_and_lemke() {
+fn a_ten_box_tower_stands_ten_seconds_with_exact_sticking_under_nsgs_and_lemke() {
     for dim in [2, 3] {
         for lemke in [false, true] {
-            let n = 6;
+            let n = 10;
             let scene = tower(dim, n, 0.1, 0.5);
-            let mut settings = StepSettings::new(1e-3, 2000);
-            // a face's contact rows outnumber the relative velocities they constrain (in 2D
-            // two tangential rows for one sliding direction: the split of the friction
-            // between the two corners is not unique), where NSGS's error can stall at 1.5e-12
-            if let StepSolver::Nsgs(s) = &mut settings.solver {
-                s.tol = 1e-10;
-            }
+            let mut settings = StepSettings::new(5e-3, 2000);
             if lemke {
                 settings.solver = StepSolver::Lemke(PolyhedralSettings::for_dim(dim));
             }
