@@ -7,6 +7,8 @@ of any coordinate and the floor's impulse against ``n m g h``."""
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 from coulomb import Box, HalfSpace, RigidBody3D, Scene
 
@@ -23,7 +25,7 @@ def tower(n: int = 10, half: float = 0.1, mu: float = 0.5) -> Scene:
                                      position=(0.0, 0.0, half * (2 * k + 1))))
         boxes.append(scene.attach(body, Box(half_extents=(half, half, half))))
     scene.contact(boxes[0], floor, mu=mu)
-    for a, b in zip(boxes, boxes[1:]):
+    for a, b in itertools.pairwise(boxes):
         scene.contact(b, a, mu=mu)
     return scene
 

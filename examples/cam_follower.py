@@ -8,7 +8,12 @@ The push would have to turn negative (pull) at the top of the stroke once ``w > 
 sqrt(g / e)``; a contact cannot pull, so above that rate the follower leaves the cam. The cam
 turns on a hinge with a huge inertia, so its rate stays w. Prints, for rates around w_jump,
 the follower's largest lift off the cam, and the jump rate found by bisection against
-sqrt(g / e)."""
+sqrt(g / e).
+
+Measured (h = 0.1 ms): below w_jump the face stays within 4e-7 m of the disk's top (the
+step's O(h) on a contact sliding around a curve), above it the follower flies (7e-5 m at
+1.02 w_jump, 1.4e-3 m at 1.1); the bisection on a lift of 1e-6 m finds 31.165 rad/s against
+31.321, 0.5 % low."""
 
 from __future__ import annotations
 
