@@ -119,18 +119,22 @@ impl Norm2 {
     /// adds `x^2`.
     #[inline]
     pub(crate) fn add(&mut self, x: f64) {
+        // the finite nonzero entries take two comparisons: infinity is above any finite scale,
+        // NaN fails both comparisons
         let a = x.abs();
-        if a.is_nan() {
-            self.nan = true;
-        } else if a == f64::INFINITY {
-            self.inf = true;
-        } else if a > self.scale {
-            let t = self.scale / a;
-            self.ssq = 1.0 + self.ssq * t * t;
-            self.scale = a;
+        if a > self.scale {
+            if a == f64::INFINITY {
+                self.inf = true;
+            } else {
+                let t = self.scale / a;
+                self.ssq = 1.0 + self.ssq * t * t;
+                self.scale = a;
+            }
         } else if a > 0.0 {
             let t = a / self.scale;
             self.ssq += t * t;
+        } else if a.is_nan() {
+            self.nan = true;
         }
     }
 
@@ -331,6 +335,9 @@ pub(crate) fn measure_into(
     let mut min_n = if problem.nc == 0 { 0.0 } else { f64::INFINITY };
     let mut comp: f64 = 0.0;
     let mut cone: f64 = 0.0;
+    // ||u|| and max |u_k|, accumulated in u's order as u is formed
+    let mut unorm = Norm2::default();
+    let mut vscale: f64 = 0.0;
     for i in 0..problem.nc {
         let o = i * dim;
         let mu = problem.mu[i];
@@ -339,7 +346,10 @@ pub(crate) fn measure_into(
         // u_i and the magnitudes of its terms, (|W| |r| + |q|)_i
         let (wr, mut terms) = problem.block_row_terms(i, r);
         for k in 0..dim {
-            u[o + k] = wr[k] + qi[k];
+            let v = wr[k] + qi[k];
+            u[o + k] = v;
+            unorm.add(v);
+            vscale = vscale.max(v.abs());
             terms[k] += qi[k].abs();
         }
         let ui = &u[o..o + dim];
@@ -370,13 +380,13 @@ pub(crate) fn measure_into(
         comp = comp.max((ri[0] * ui[0]).abs());
         cone = cone.max(viol);
     }
-    let unorm = norm2(u);
-    let vscale = u.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let unorm = unorm.value();
     let mut diss: f64 = 0.0;
     for (ri, ui) in r.chunks_exact(dim).zip(u.chunks_exact(dim)) {
-        if tangent_norm(&ui[1..]) > 1e-12 * vscale {
-            let dot: f64 = (1..dim).map(|k| ri[k] * ui[k]).sum();
-            diss = diss.max(dot);
+        let dot: f64 = (1..dim).map(|k| ri[k] * ui[k]).sum();
+        // only a dot above the running max can change it: the slip's norm is taken for those
+        if dot > diss && tangent_norm(&ui[1..]) > 1e-12 * vscale {
+            diss = dot;
         }
     }
     let res = res.value();
@@ -465,6 +475,12 @@ fn de_saxce_residual(r: &[f64], u: &[f64], mu: f64, slip_floor: f64) -> [f64; 3]
     }
     e
 }
+
+#[cfg(test)]
+mod reference;
+
+#[cfg(test)]
+mod fast_tests;
 
 #[cfg(test)]
 mod tests {
