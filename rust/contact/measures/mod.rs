@@ -361,7 +361,7 @@ pub(crate) fn measure_into(
         let ri = &r[o..o + dim];
         let qi = &problem.q[o..o + dim];
         // u_i and the magnitudes of its terms, (|W| |r| + |q|)_i
-        let (wr, mut terms) = problem.block_row_terms(i, r);
+        let (wr, mut terms) = rows::row_terms(problem, i, r);
         for k in 0..dim {
             let v = wr[k] + qi[k];
             u[o + k] = v;
@@ -541,6 +541,8 @@ fn de_saxce_residual(r: &[f64], u: &[f64], mu: f64, slip_floor: f64) -> [f64; 3]
     }
     e
 }
+
+mod rows;
 
 #[cfg(test)]
 mod reference;
