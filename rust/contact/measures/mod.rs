@@ -119,18 +119,22 @@ impl Norm2 {
     /// adds `x^2`.
     #[inline]
     pub(crate) fn add(&mut self, x: f64) {
+        // the finite nonzero entries take two comparisons: infinity is above any finite scale,
+        // NaN fails both comparisons
         let a = x.abs();
-        if a.is_nan() {
-            self.nan = true;
-        } else if a == f64::INFINITY {
-            self.inf = true;
-        } else if a > self.scale {
-            let t = self.scale / a;
-            self.ssq = 1.0 + self.ssq * t * t;
-            self.scale = a;
+        if a > self.scale {
+            if a == f64::INFINITY {
+                self.inf = true;
+            } else {
+                let t = self.scale / a;
+                self.ssq = 1.0 + self.ssq * t * t;
+                self.scale = a;
+            }
         } else if a > 0.0 {
             let t = a / self.scale;
             self.ssq += t * t;
+        } else if a.is_nan() {
+            self.nan = true;
         }
     }
 
@@ -270,8 +274,25 @@ fn scaled_residuals(
             for k in 1..dim {
                 x[k - 1] = r[k] - su[k];
             }
-            let s = x[0].hypot(x[1]);
-            let f = if s > radius { radius / s } else { 1.0 };
+            // inside the disk by the bound the norm is not needed (f = 1 either way)
+            let f = if dim == 2 {
+                // hypot(x, 0) = |x|
+                let s = x[0].abs();
+                if s > radius {
+                    radius / s
+                } else {
+                    1.0
+                }
+            } else if hypot_bound(x[0], x[1]) <= radius {
+                1.0
+            } else {
+                let s = x[0].hypot(x[1]);
+                if s > radius {
+                    radius / s
+                } else {
+                    1.0
+                }
+            };
             for k in 1..dim {
                 a[k] = r[k] - f * x[k - 1];
             }
@@ -331,24 +352,37 @@ pub(crate) fn measure_into(
     let mut min_n = if problem.nc == 0 { 0.0 } else { f64::INFINITY };
     let mut comp: f64 = 0.0;
     let mut cone: f64 = 0.0;
+    // ||u|| and max |u_k|, accumulated in u's order as u is formed
+    let mut unorm = Norm2::default();
+    let mut vscale: f64 = 0.0;
     for i in 0..problem.nc {
         let o = i * dim;
         let mu = problem.mu[i];
         let ri = &r[o..o + dim];
         let qi = &problem.q[o..o + dim];
         // u_i and the magnitudes of its terms, (|W| |r| + |q|)_i
-        let (wr, mut terms) = problem.block_row_terms(i, r);
+        let (wr, mut terms) = rows::row_terms(problem, i, r);
         for k in 0..dim {
-            u[o + k] = wr[k] + qi[k];
+            let v = wr[k] + qi[k];
+            u[o + k] = v;
+            unorm.add(v);
+            vscale = vscale.max(v.abs());
             terms[k] += qi[k].abs();
         }
         let ui = &u[o..o + dim];
         // the literature's map (velocities added to impulses as they are)
         let (e1, viol) = match problem.anisotropy(i) {
-            None => (
-                de_saxce_residual(ri, ui, mu, 0.0),
-                tangent_norm(&ri[1..]) - mu * ri[0],
-            ),
+            None => {
+                let c = mu * ri[0];
+                // ||r_t|| - c only where it may raise the running max (the bound is below it
+                // otherwise: cone.max(-inf) = cone)
+                let viol = if dim == 3 && hypot_bound(ri[1], ri[2]) - c < cone {
+                    f64::NEG_INFINITY
+                } else {
+                    tangent_norm(&ri[1..]) - c
+                };
+                (de_saxce_residual(ri, ui, mu, 0.0), viol)
+            }
             Some(pair) => anisotropic_residual(pair, ri, ui, 0.0),
         };
         res.add_all(&e1[..dim]);
@@ -370,13 +404,13 @@ pub(crate) fn measure_into(
         comp = comp.max((ri[0] * ui[0]).abs());
         cone = cone.max(viol);
     }
-    let unorm = norm2(u);
-    let vscale = u.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let unorm = unorm.value();
     let mut diss: f64 = 0.0;
     for (ri, ui) in r.chunks_exact(dim).zip(u.chunks_exact(dim)) {
-        if tangent_norm(&ui[1..]) > 1e-12 * vscale {
-            let dot: f64 = (1..dim).map(|k| ri[k] * ui[k]).sum();
-            diss = diss.max(dot);
+        let dot: f64 = (1..dim).map(|k| ri[k] * ui[k]).sum();
+        // only a dot above the running max can change it: the slip's norm is taken for those
+        if dot > diss && slip_above(&ui[1..], 1e-12 * vscale) {
+            diss = dot;
         }
     }
     let res = res.value();
@@ -446,6 +480,43 @@ pub(crate) fn anisotropic_residual(
     (e, (rh[1].hypot(rh[2]) - m * r[0]).max(flat))
 }
 
+/// An upper bound of `hypot(a, b)` as the platform's `hypot` returns it (within one unit in
+/// the last place, as glibc's and musl's are): `|a| + |b| >= sqrt(a^2 + b^2)`, widened by
+/// 8 eps for the rounding of the sum, of the product and of `hypot`. NaN for NaN entries (every
+/// comparison with it fails, and the caller then takes the norm itself).
+#[inline]
+fn hypot_bound(a: f64, b: f64) -> f64 {
+    (a.abs() + b.abs()) * (1.0 + 8.0 * f64::EPSILON)
+}
+
+/// whether `||t|| > threshold` for t without NaN (the caller's dot is NaN otherwise), without
+/// the norm when the largest component already is
+/// (`||t|| >= max_k |t_k|`, which `hypot` keeps: the max is representable).
+#[inline]
+fn slip_above(t: &[f64], threshold: f64) -> bool {
+    t.iter().any(|v| v.abs() > threshold) || tangent_norm(t) > threshold
+}
+
+/// [`project_cone`], returning at once when the bound of the tangent's norm
+/// ([`hypot_bound`]) already puts `r` inside the cone: `project_cone` leaves r unchanged there,
+/// its test being monotone in the norm (`s <= mu n, n >= 0` for `mu <= 1`, `s / mu <= n`
+/// otherwise).
+#[inline]
+fn project_cone_bounded(r: &mut [f64], mu: f64) {
+    if r.len() == 3 {
+        let (n, ub) = (r[0], hypot_bound(r[1], r[2]));
+        let inside = if mu <= 1.0 {
+            ub <= mu * n && n >= 0.0
+        } else {
+            (1.0 / mu) * ub <= n
+        };
+        if inside {
+            return;
+        }
+    }
+    project_cone(r, mu);
+}
+
 /// De Saxcé's natural-map residual of one isotropic contact,
 /// `e = r - P_K(r - (u + mu ||u_t|| n))` (De Saxcé and Feng 1991), zero-padded to 3, with the
 /// slip `||u_t||` counted by [`counted_slip`] above `slip_floor` (0 for the literature's map;
@@ -453,18 +524,31 @@ pub(crate) fn anisotropic_residual(
 fn de_saxce_residual(r: &[f64], u: &[f64], mu: f64, slip_floor: f64) -> [f64; 3] {
     let dim = r.len();
     let mut v = [0.0; 3];
-    let slip = counted_slip(tangent_norm(&u[1..dim]), slip_floor);
+    // below the floor by the bound the slip counts 0 without its norm
+    let slip = if dim == 3 && hypot_bound(u[1], u[2]) <= slip_floor {
+        0.0
+    } else {
+        counted_slip(tangent_norm(&u[1..dim]), slip_floor)
+    };
     v[0] = r[0] - (u[0] + mu * slip);
     for k in 1..dim {
         v[k] = r[k] - u[k];
     }
-    project_cone(&mut v[..dim], mu);
+    project_cone_bounded(&mut v[..dim], mu);
     let mut e = [0.0; 3];
     for k in 0..dim {
         e[k] = r[k] - v[k];
     }
     e
 }
+
+mod rows;
+
+#[cfg(test)]
+mod reference;
+
+#[cfg(test)]
+mod fast_tests;
 
 #[cfg(test)]
 mod tests {
