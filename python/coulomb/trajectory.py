@@ -18,6 +18,7 @@ and falls back in flight), which is the integrator's and not a gain of the conta
 
 from __future__ import annotations
 
+import os
 from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -29,7 +30,7 @@ from ._extras import require
 from ._readable import readable
 from ._result import Result
 from ._status import Status
-from .errors import CoulombError, InternalError
+from .errors import CoulombError, InternalError, ProblemFormatError
 
 if TYPE_CHECKING:
     from .model import Scene
@@ -298,6 +299,33 @@ class Trajectory:
             tr.message = f"{n} steps, every contact solve solved"
         tr.success = tr.status == Status.COMPLETED
         return tr
+
+    @classmethod
+    def load(cls, path: str | os.PathLike[str], scene: Scene | None = None) -> Trajectory:
+        """Reads a trajectory written by :meth:`Scene.stream <coulomb.model.Scene.stream>`
+        (h5py, the optional extra ``coulomb[hdf5]``) into memory; ``scene`` (the one streamed)
+        gives :meth:`body` and the load power (zero without it)."""
+        require("h5py", extra="hdf5", what="Trajectory.load")
+        import h5py
+
+        from . import _stream
+
+        with h5py.File(Path(path), "r") as f:
+            if f.attrs.get("format") != _stream.FORMAT:
+                raise ProblemFormatError(f"{str(path)!r} is not a coulomb trajectory file")
+            a = f.attrs
+            raw: dict[str, Any] = {name: f[name][()] for name in _stream.ARRAYS}
+            raw["status"] = [s.decode() if isinstance(s, bytes) else str(s)
+                             for s in raw["status"]]
+            raw["dim"] = int(a["dim"])
+            stopped = str(a.get("stopped", ""))
+            if not bool(a.get("complete", False)):
+                stopped = stopped or "the run did not finish writing the file (interrupted)"
+            raw["stopped"] = stopped or None
+            raw["solve_time"] = float(a.get("solve_time", 0.0))
+            return cls._from_core(raw, scene=scene, h=float(a["h"]), solver=str(a["solver"]),
+                                  gap_tolerance=float(a["gap_tolerance"]), tol=float(a["tol"]),
+                                  record_every=int(a["record_every"]))
 
     # -- access ----------------------------------------------------------------------------
 
