@@ -8,10 +8,13 @@ the same names (``t``, ``q``, ``v``, ``kinetic_energy``, ``potential_energy``, `
 ``iterations``, ``momentum_residual``, ``min_normal_impulse``, ``cone_violation``,
 ``complementarity``, ``resumed``, ``fallback``, ``projection``, and the contact records
 ``contact_step``, ``contact_id``, ``contact_impulse``, ``contact_velocity``,
-``contact_approach``, ``contact_gap``, ``contact_closed``), and attributes ``format``
-(``"coulomb-trajectory"``), ``version``, ``dim``, ``h``, ``solver``, ``tol``,
-``gap_tolerance``, ``record_every``, ``stopped`` (empty when every step ran), ``solve_time``
-and ``complete`` (false until the run ended, so a file of a run cut short says so).
+``contact_approach``, ``contact_gap``, ``contact_closed``; ``status`` an HDF5 enum of the
+status names, :data:`STATUS_CODES`), and attributes ``format`` (``"coulomb-trajectory"``),
+``version``, ``dim``, ``h``, ``solver``, ``tol``, ``gap_tolerance``, ``record_every``,
+``stopped`` (empty when every step ran), ``solve_time`` and ``complete`` (false until the run
+ended, so a file of a run cut short says so). The datasets are stored in chunks of about
+64 KiB, which keeps HDF5's own memory flat too (a variable-length string per status made it
+grow with the run).
 :meth:`Trajectory.load <coulomb.trajectory.Trajectory.load>` reads it back.
 """
 
@@ -34,6 +37,9 @@ if TYPE_CHECKING:
 
 FORMAT = "coulomb-trajectory"
 VERSION = 1
+
+#: the stored codes of the step statuses (an HDF5 enum, ``status`` in the file).
+STATUS_CODES = {"no_contact": 0, "solved": 1, "iteration_limit": 2, "numerical_failure": 3}
 
 #: the per-state, per-step and per-contact arrays, in the core's names.
 ARRAYS = (
@@ -72,19 +78,21 @@ class Writer:
 
         offset = self.steps
         for name in ARRAYS:
-            data = chunk[name]
             if name == "status":
-                data = np.asarray(data, dtype=object)
+                data = np.array([STATUS_CODES[s] for s in chunk[name]], dtype=np.uint8)
             else:
-                data = np.asarray(data)
+                data = np.asarray(chunk[name])
             if name == "contact_step":
                 data = data + offset
             if name not in self.f:
                 kw: dict[str, Any] = {}
                 if name == "status":
-                    kw["dtype"] = h5py.string_dtype()
+                    kw["dtype"] = h5py.enum_dtype(STATUS_CODES, basetype="u1")
+                # storage chunks of about 64 KiB: few enough that HDF5's index stays small
+                row = max(1, data.itemsize * int(np.prod(data.shape[1:])))
+                rows = max(1, 65536 // row)
                 self.f.create_dataset(name, data=data, maxshape=(None, *data.shape[1:]),
-                                      chunks=True, **kw)
+                                      chunks=(rows, *data.shape[1:]), **kw)
                 continue
             ds = self.f[name]
             n = ds.shape[0]

@@ -315,8 +315,8 @@ class Trajectory:
                 raise ProblemFormatError(f"{str(path)!r} is not a coulomb trajectory file")
             a = f.attrs
             raw: dict[str, Any] = {name: f[name][()] for name in _stream.ARRAYS}
-            raw["status"] = [s.decode() if isinstance(s, bytes) else str(s)
-                             for s in raw["status"]]
+            names = {code: name for name, code in _stream.STATUS_CODES.items()}
+            raw["status"] = [names[int(c)] for c in raw["status"]]
             raw["dim"] = int(a["dim"])
             stopped = str(a.get("stopped", ""))
             if not bool(a.get("complete", False)):
