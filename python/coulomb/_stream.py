@@ -11,8 +11,9 @@ the same names (``t``, ``q``, ``v``, ``kinetic_energy``, ``potential_energy``, `
 ``contact_approach``, ``contact_gap``, ``contact_closed``; ``status`` an HDF5 enum of the
 status names, :data:`STATUS_CODES`), and attributes ``format`` (``"coulomb-trajectory"``),
 ``version``, ``dim``, ``h``, ``solver``, ``tol``, ``gap_tolerance``, ``record_every``,
-``stopped`` (empty when every step ran), ``solve_time`` and ``complete`` (false until the run
-ended, so a file of a run cut short says so). The datasets are stored in chunks of about
+``stopped`` (empty when every step ran), ``solve_time``, ``complete`` (false until the run
+ended, so a file of a run cut short says so) and ``states``, ``steps``, ``contacts`` (the rows
+of the whole chunks written). The datasets are stored in chunks of about
 64 KiB, which keeps HDF5's own memory flat too (a variable-length string per status made it
 grow with the run).
 :meth:`Trajectory.load <coulomb.trajectory.Trajectory.load>` reads it back.
@@ -49,6 +50,13 @@ ARRAYS = (
     "contact_id", "contact_impulse", "contact_velocity", "contact_approach", "contact_gap",
     "contact_closed",
 )
+
+#: which row count of the file (its attributes ``states``, ``steps``, ``contacts``) each array
+#: has.
+ROWS = {name: ("states" if name in ("t", "q", "v", "kinetic_energy", "potential_energy",
+                                    "min_gap", "negative_gaps")
+               else "contacts" if name.startswith("contact_") else "steps")
+        for name in ARRAYS}
 
 
 def open_file(path: str | os.PathLike[str]) -> Any:
@@ -100,6 +108,10 @@ class Writer:
             ds[n:] = data
         self.steps += len(chunk["active"])
         self.failed += sum(s not in ("solved", "no_contact") for s in chunk["status"])
+        # the rows of whole chunks: a run stopped while a chunk was being appended is read
+        # back up to the last whole one
+        self.f.attrs.update(states=self.f["t"].shape[0], steps=self.steps,
+                            contacts=self.f["contact_step"].shape[0])
         self.f.flush()
 
 

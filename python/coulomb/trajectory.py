@@ -314,7 +314,13 @@ class Trajectory:
             if f.attrs.get("format") != _stream.FORMAT:
                 raise ProblemFormatError(f"{str(path)!r} is not a coulomb trajectory file")
             a = f.attrs
-            raw: dict[str, Any] = {name: f[name][()] for name in _stream.ARRAYS}
+            rows = {"states": int(a.get("states", 0)), "steps": int(a.get("steps", 0)),
+                    "contacts": int(a.get("contacts", 0))}
+            if rows["states"] == 0:
+                raise ProblemFormatError(f"{str(path)!r} holds no states (its run stopped "
+                                         "before the first chunk was written)")
+            raw: dict[str, Any] = {name: f[name][:rows[_stream.ROWS[name]]]
+                                   for name in _stream.ARRAYS}
             names = {code: name for name, code in _stream.STATUS_CODES.items()}
             raw["status"] = [names[int(c)] for c in raw["status"]]
             raw["dim"] = int(a["dim"])

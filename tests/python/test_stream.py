@@ -156,3 +156,22 @@ def test_a_file_that_is_not_a_trajectory_is_refused(tmp_path):
         f["x"] = np.zeros(3)
     with pytest.raises(coulomb.errors.ProblemFormatError, match="not a coulomb trajectory"):
         coulomb.Trajectory.load(path)
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="needs POSIX signals")
+def test_ctrl_c_leaves_the_chunks_written_and_the_file_marked_incomplete(tmp_path):
+    sys.path.insert(0, str(Path(__file__).parent))
+    from test_interrupt import interrupt
+
+    path = tmp_path / "run.h5"
+    got = interrupt(f"pile(10).stream({str(path)!r}, 10000.0, 1e-3, record_every=100, "
+                    "chunk=16)", delay=1.5)
+    assert got["outcome"] == "KeyboardInterrupt", got
+    with h5py.File(path) as f:
+        assert not f.attrs["complete"]
+        rows = f["t"].shape[0]
+    assert rows > 1 and (rows - 1) % 16 == 0  # whole chunks only
+    back = coulomb.Trajectory.load(path)
+    assert back.status == coulomb.Status.STOPPED and not back.success
+    assert "interrupted" in back.stopped
+    np.testing.assert_array_equal(np.diff(back.t) > 0, True)
