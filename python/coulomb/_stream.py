@@ -121,7 +121,16 @@ class Streamed:
     went and how the run ended, without its arrays (:meth:`load` reads them back).
 
     ``success`` is true exactly when every step ran and every contact solve met its
-    tolerance (as :attr:`Trajectory.success <coulomb.trajectory.Trajectory.success>`)."""
+    tolerance (as :attr:`Trajectory.success <coulomb.trajectory.Trajectory.success>`).
+
+    The file holds one dataset per array of a trajectory, by the same names (``t``, ``q``,
+    ``v``, the energies, ``min_gap``, ``negative_gaps``, the step checks, ``status`` as an HDF5
+    enum of the status names, and the ``contact_*`` records, ``contact_step`` being the row in
+    the file's step arrays), in storage chunks of about 64 KiB, and the attributes
+    ``format = "coulomb-trajectory"``, ``version``, ``dim``, ``h``, ``solver``, ``tol``,
+    ``gap_tolerance``, ``record_every``, ``stopped`` (empty when every step ran),
+    ``solve_time``, ``complete`` (false until the run ended: a run cut short by Ctrl-C says
+    so) and ``states``, ``steps``, ``contacts`` (the rows of the whole chunks written)."""
 
     path: Path
     states: int

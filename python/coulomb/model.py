@@ -84,7 +84,7 @@ from .settings import StepSettings, accepts
 from .trajectory import Trajectory
 
 if TYPE_CHECKING:
-    from ._stream import Streamed
+    from .trajectory import Streamed
 
 __all__ = [
     "Body",
@@ -745,9 +745,10 @@ class Scene:
         record_every`` steps), each is appended to the file and dropped. The stepper's state
         (warm starts, impacts it stopped, persistent contacts) carries over between chunks:
         the file holds exactly the arrays :meth:`simulate` returns with the same options
-        (layout in :mod:`coulomb._stream`); ``Trajectory.load(path)`` reads it back.
+        (its layout under :class:`~coulomb.trajectory.Streamed`); ``Trajectory.load(path)``
+        reads it back.
 
-        Returns a :class:`~coulomb._stream.Streamed`: the path, the counts of states and
+        Returns a :class:`~coulomb.trajectory.Streamed`: the path, the counts of states and
         steps, ``status`` and ``success`` (as a trajectory's), ``stopped`` and the solve time.
 
         Raises

@@ -30,12 +30,13 @@ from ._extras import require
 from ._readable import readable
 from ._result import Result
 from ._status import Status
+from ._stream import Streamed
 from .errors import CoulombError, InternalError, ProblemFormatError
 
 if TYPE_CHECKING:
     from .model import Scene
 
-__all__ = ["Trajectory", "TrajectoryCheckError"]
+__all__ = ["Streamed", "Trajectory", "TrajectoryCheckError"]
 
 
 def _load_power(scene: Scene | None, v: np.ndarray) -> np.ndarray:
