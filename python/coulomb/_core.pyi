@@ -27,6 +27,7 @@ __all__ = [
     "simd_level",
     "solid_check",
     "step_simulate",
+    "step_stream",
 ]
 
 __version__: str
@@ -142,6 +143,13 @@ class _StepSimulateDict(TypedDict):
     stopped: str | None
     solve_time: float
 
+class _StepStreamDict(TypedDict):
+    """``step_stream``: how the streamed run ended."""
+
+    stopped: str | None
+    solve_time: float
+    chunks: int
+
 class _ModelSimulateDict(_StepSimulateDict):
     """``model_simulate``: a scene's trajectory dict and ``f . v`` per recorded state."""
 
@@ -216,6 +224,26 @@ def step_simulate(
     record_every: int = 1,
     locate_impacts: bool = False,
 ) -> _StepSimulateDict: ...
+def step_stream(
+    scene: dict[str, Any],
+    h: float,
+    steps: int,
+    write: Callable[[_StepSimulateDict], object],
+    chunk: int = 1024,
+    solver: str = "nsgs",
+    tol: float = 1e-12,
+    max_iter: int | None = None,
+    relaxation: float = 1.0,
+    facets: int | None = None,
+    gap_tolerance: float = 1e-9,
+    warm_start: bool = True,
+    fallback: bool = True,
+    drift: str = "none",
+    drift_bias: float = 0.2,
+    restitution: str = "newton",
+    record_every: int = 1,
+    locate_impacts: bool = False,
+) -> _StepStreamDict: ...
 def model_simulate(
     dim: int,
     laws: list[tuple[float, float]],

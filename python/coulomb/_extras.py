@@ -4,7 +4,8 @@ a check that says so before any work is done.
 ======== ======================== =====================================================
 extra    installs                 needed by
 ======== ======================== =====================================================
-hdf5     h5py, scipy              ``coulomb.io.read_fclib`` (FCLib HDF5 files)
+hdf5     h5py, scipy              ``coulomb.io.read_fclib`` (FCLib HDF5 files),
+                                  ``Scene.stream``, ``Trajectory.load``
 plot     matplotlib               ``Trajectory.plot``, ``Trajectory.animate``, ``Study.plot``,
                                   ``coulomb study --plot``
 ode      scipy                    ``coulomb.regularized.simulate_ramp``, the

@@ -49,14 +49,17 @@ stepper, which calls those functions back at each state.
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
 from . import _core, _validate
 from ._arguments import Solver, _dim, _positive, _solver_options, _steps, _vector
+from ._extras import require
 from ._generalized import GapContact, Model
 from ._solids import (
     Capsule,
@@ -79,6 +82,9 @@ from .errors import (
 from .joints import Joint
 from .settings import StepSettings, accepts
 from .trajectory import Trajectory
+
+if TYPE_CHECKING:
+    from .trajectory import Streamed
 
 __all__ = [
     "Body",
@@ -677,6 +683,20 @@ class Scene:
         10^9 steps; options of the other solver are refused (``relaxation`` is NSGS's,
         ``facets`` Lemke's). Ctrl-C stops the run (``KeyboardInterrupt``).
         """
+        args = self._run_args(t_end, h, solver, tol, max_iter, relaxation, facets,
+                              gap_tolerance, warm_start, fallback, drift, drift_bias,
+                              restitution, record_every, locate_impacts)
+        raw = _core.step_simulate(self._spec(), **args)
+        return Trajectory._from_core(raw, scene=self, h=args["h"], solver=args["solver"],
+                                     gap_tolerance=args["gap_tolerance"], tol=args["tol"],
+                                     record_every=args["record_every"])
+
+    def _run_args(self, t_end: float, h: float, solver: Solver, tol: float | None,
+                  max_iter: int | None, relaxation: float, facets: int | None,
+                  gap_tolerance: float, warm_start: bool, fallback: bool, drift: str,
+                  drift_bias: float, restitution: str, record_every: int,
+                  locate_impacts: bool) -> dict[str, Any]:
+        """The checked options of :meth:`simulate` and :meth:`stream`, as the core's keywords."""
         t_end = _positive("t_end", t_end)
         h = _positive("h", h)
         steps = _steps(t_end, h)
@@ -690,14 +710,77 @@ class Scene:
         locate_impacts = _validate.boolean("locate_impacts", locate_impacts)
         if not self.bodies:
             raise InvalidParameterError("the scene has no bodies")
+        return dict(h=h, steps=steps, solver=solver, tol=tol, max_iter=max_iter,
+                    relaxation=relaxation, facets=facets, gap_tolerance=gap_tolerance,
+                    warm_start=warm_start, fallback=fallback, drift=drift,
+                    drift_bias=drift_bias, restitution=restitution, record_every=record_every,
+                    locate_impacts=locate_impacts)
+
+    @accepts(None, (StepSettings,))
+    def stream(
+        self,
+        path: str | os.PathLike[str],
+        t_end: float,
+        h: float,
+        solver: Solver = "nsgs",
+        *,
+        chunk: int = 1024,
+        tol: float | None = None,
+        max_iter: int | None = None,
+        relaxation: float = 1.0,
+        facets: int | None = None,
+        gap_tolerance: float = 1e-9,
+        warm_start: bool = True,
+        fallback: bool = True,
+        drift: Literal["none", "bias", "projection"] = "none",
+        drift_bias: float = 0.2,
+        restitution: Literal["newton", "poisson"] = "newton",
+        record_every: int = 1,
+        locate_impacts: bool = False,
+        settings: StepSettings | None = None,
+    ) -> Streamed:
+        """:meth:`simulate`, writing the trajectory to the HDF5 file ``path`` as it goes
+        (h5py, the optional extra ``coulomb[hdf5]``), so memory stays flat however long the
+        run: the stepper hands its records out every ``chunk`` kept states (``chunk *
+        record_every`` steps), each is appended to the file and dropped. The stepper's state
+        (warm starts, impacts it stopped, persistent contacts) carries over between chunks:
+        the file holds exactly the arrays :meth:`simulate` returns with the same options
+        (its layout under :class:`~coulomb.trajectory.Streamed`); ``Trajectory.load(path)``
+        reads it back.
+
+        Returns a :class:`~coulomb.trajectory.Streamed`: the path, the counts of states and
+        steps, ``status`` and ``success`` (as a trajectory's), ``stopped`` and the solve time.
+
+        Raises
+        ------
+        MissingExtraError
+            When h5py is not installed (before any work).
+        InvalidParameterError
+            When ``path`` cannot be written (before any step), or an option is invalid.
+
+        Notes
+        -----
+        Ctrl-C stops the run (``KeyboardInterrupt``); the file then holds the chunks written
+        so far and its ``complete`` attribute stays false.
+        """
+        require("h5py", extra="hdf5", what="Scene.stream")
+        from . import _stream
+
+        args = self._run_args(t_end, h, solver, tol, max_iter, relaxation, facets,
+                              gap_tolerance, warm_start, fallback, drift, drift_bias,
+                              restitution, record_every, locate_impacts)
+        chunk = _validate.count("chunk", chunk)
         spec = self._spec()
-        raw = _core.step_simulate(
-            spec, h, steps, solver=solver, tol=tol, max_iter=max_iter, relaxation=relaxation,
-            facets=facets, gap_tolerance=gap_tolerance, warm_start=warm_start,
-            fallback=fallback, drift=drift, drift_bias=drift_bias,
-            restitution=restitution, record_every=record_every,
-            locate_impacts=locate_impacts,
-        )
-        return Trajectory._from_core(raw, scene=self, h=h, solver=solver,
-                                     gap_tolerance=gap_tolerance, tol=tol,
-                                     record_every=record_every)
+        with _stream.open_file(path) as f:
+            f.attrs.update(format=_stream.FORMAT, version=_stream.VERSION, dim=self.dim,
+                           h=args["h"], solver=args["solver"], tol=args["tol"],
+                           gap_tolerance=args["gap_tolerance"],
+                           record_every=args["record_every"], complete=False)
+            writer = _stream.Writer(f)
+            raw = _core.step_stream(spec, write=writer, chunk=chunk, **args)
+            stopped = raw["stopped"]
+            f.attrs.update(stopped=stopped or "", solve_time=raw["solve_time"], complete=True)
+            states = int(f["t"].shape[0]) if "t" in f else 0
+        return _stream.Streamed(path=Path(path), states=states, steps=writer.steps,
+                                failed_steps=writer.failed, stopped=stopped,
+                                solve_time=float(raw["solve_time"]), chunks=int(raw["chunks"]))

@@ -18,6 +18,7 @@ and falls back in flight), which is the integrator's and not a gain of the conta
 
 from __future__ import annotations
 
+import os
 from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -29,12 +30,13 @@ from ._extras import require
 from ._readable import readable
 from ._result import Result
 from ._status import Status
-from .errors import CoulombError, InternalError
+from ._stream import Streamed
+from .errors import CoulombError, InternalError, ProblemFormatError
 
 if TYPE_CHECKING:
     from .model import Scene
 
-__all__ = ["Trajectory", "TrajectoryCheckError"]
+__all__ = ["Streamed", "Trajectory", "TrajectoryCheckError"]
 
 
 def _load_power(scene: Scene | None, v: np.ndarray) -> np.ndarray:
@@ -298,6 +300,39 @@ class Trajectory:
             tr.message = f"{n} steps, every contact solve solved"
         tr.success = tr.status == Status.COMPLETED
         return tr
+
+    @classmethod
+    def load(cls, path: str | os.PathLike[str], scene: Scene | None = None) -> Trajectory:
+        """Reads a trajectory written by :meth:`Scene.stream <coulomb.model.Scene.stream>`
+        (h5py, the optional extra ``coulomb[hdf5]``) into memory; ``scene`` (the one streamed)
+        gives :meth:`body` and the load power (zero without it)."""
+        require("h5py", extra="hdf5", what="Trajectory.load")
+        import h5py
+
+        from . import _stream
+
+        with h5py.File(Path(path), "r") as f:
+            if f.attrs.get("format") != _stream.FORMAT:
+                raise ProblemFormatError(f"{str(path)!r} is not a coulomb trajectory file")
+            a = f.attrs
+            rows = {"states": int(a.get("states", 0)), "steps": int(a.get("steps", 0)),
+                    "contacts": int(a.get("contacts", 0))}
+            if rows["states"] == 0:
+                raise ProblemFormatError(f"{str(path)!r} holds no states (its run stopped "
+                                         "before the first chunk was written)")
+            raw: dict[str, Any] = {name: f[name][:rows[_stream.ROWS[name]]]
+                                   for name in _stream.ARRAYS}
+            names = {code: name for name, code in _stream.STATUS_CODES.items()}
+            raw["status"] = [names[int(c)] for c in raw["status"]]
+            raw["dim"] = int(a["dim"])
+            stopped = str(a.get("stopped", ""))
+            if not bool(a.get("complete", False)):
+                stopped = stopped or "the run did not finish writing the file (interrupted)"
+            raw["stopped"] = stopped or None
+            raw["solve_time"] = float(a.get("solve_time", 0.0))
+            return cls._from_core(raw, scene=scene, h=float(a["h"]), solver=str(a["solver"]),
+                                  gap_tolerance=float(a["gap_tolerance"]), tol=float(a["tol"]),
+                                  record_every=int(a["record_every"]))
 
     # -- access ----------------------------------------------------------------------------
 

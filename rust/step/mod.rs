@@ -89,8 +89,8 @@ pub use stepper::generalized::{
     simulate_generalized, GeneralizedStepper, GeneralizedSystem, GeneralizedTrajectory,
 };
 pub use stepper::{
-    simulate, simulate_joints, simulate_recorded, ContactRecord, Joint, JointKind, JointSystemInfo,
-    StepRecord, Stepper, Trajectory,
+    simulate, simulate_joints, simulate_recorded, ChunkedRun, ContactRecord, Joint, JointKind,
+    JointSystemInfo, StepRecord, Stepper, Trajectory,
 };
 
 use crate::contact::{NsgsSettings, PolyhedralSettings};

@@ -159,6 +159,67 @@ fn run_scene(mut st: Stepper, settings: &StepSettings, record_every: usize) -> R
     Ok(out)
 }
 
+/// A recorded run handed out in chunks, so a long run's records need not be held at once
+/// (the Python binding writes each chunk to a file and drops it). The stepper's state (the
+/// warm starts, the approach velocities of impacts it stopped, the persistent contacts) lives
+/// on between chunks, and a chunk is a whole number of `record_every` steps, so the chunks
+/// joined are the [`simulate_recorded`] trajectory of the same run, bit for bit: the initial
+/// state heads the first chunk, each chunk's `contacts[i].step` is the row in its own `steps`.
+pub struct ChunkedRun {
+    st: Stepper,
+    every: usize,
+    left: usize,
+    started: bool,
+}
+
+impl ChunkedRun {
+    /// a run of `settings.steps` steps of `scene` (with `joints`) keeping every
+    /// `record_every`-th state.
+    pub fn new(
+        scene: &Scene,
+        joints: &[Joint],
+        settings: &StepSettings,
+        record_every: usize,
+    ) -> Result<Self> {
+        Ok(ChunkedRun {
+            st: Stepper::with_joints(scene, joints, settings)?,
+            every: record_every.max(1),
+            left: settings.steps,
+            started: false,
+        })
+    }
+
+    /// the next at most `rows` kept states (`rows * record_every` steps, the initial state
+    /// first in the first chunk); `None` once the run is over (all steps done or a non-finite
+    /// state stopped it, which the chunk with `stopped` set says). The chunk's size is checked
+    /// against the memory budget.
+    pub fn next_chunk(&mut self, rows: usize) -> Result<Option<Trajectory>> {
+        if self.started && self.left == 0 {
+            return Ok(None);
+        }
+        let steps = rows.max(1).saturating_mul(self.every).min(self.left);
+        let row_bytes = 8 * (self.st.nq + self.st.nv + 5) + std::mem::size_of::<StepRecord>();
+        let kept = steps.div_ceil(self.every) + 1;
+        crate::limits::check_bytes(
+            &format!("a chunk of {kept} states of {} coordinates", self.st.nq),
+            kept,
+            row_bytes,
+            "stream smaller chunks",
+        )?;
+        let mut out = Trajectory::reserved(self.st.dim, self.st.nq, self.st.nv, kept);
+        if !self.started {
+            self.started = true;
+            self.st.push_state(&mut out);
+        }
+        run_steps(&mut self.st, steps, self.every, &mut out)?;
+        self.left -= steps;
+        if out.stopped.is_some() || crate::interrupt::stopped() {
+            self.left = 0;
+        }
+        Ok(Some(out))
+    }
+}
+
 impl Trajectory {
     /// an empty trajectory of `dim`, `nq` coordinates and `nv` velocities, with room for
     /// `reserve` states.
@@ -207,6 +268,17 @@ pub(super) fn run_recorded<D: Recorded>(
     out: &mut Trajectory,
 ) -> Result<()> {
     d.record_state(out)?;
+    run_steps(d, steps, every, out)
+}
+
+/// [`run_recorded`] without recording the current state first: the steps of a run after its
+/// first chunk ([`ChunkedRun`]).
+fn run_steps<D: Recorded>(
+    d: &mut D,
+    steps: usize,
+    every: usize,
+    out: &mut Trajectory,
+) -> Result<()> {
     let mut pending: Option<StepRecord> = None;
     for k in 0..steps {
         if crate::interrupt::poll(d.step_cost()) {

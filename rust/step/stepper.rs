@@ -38,7 +38,7 @@ use self::law::SolveWork;
 use self::narrow::{declared_candidates, frame, Candidate, Geometry};
 use self::persistence::{sphere_points, CandState};
 pub use self::record::{
-    simulate, simulate_joints, simulate_recorded, ContactRecord, StepRecord, Trajectory,
+    simulate, simulate_joints, simulate_recorded, ChunkedRun, ContactRecord, StepRecord, Trajectory,
 };
 use self::solve::SolveBuffers;
 use super::broad::BroadPhase;

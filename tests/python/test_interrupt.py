@@ -72,6 +72,8 @@ CASES = {
     "prox n=900": "W, q = redundant(300); coulomb.contact.solve(W, q, 0.5, dim=3, "
                   "method='prox', tol=1e-300, max_iter=10**9)",
     "simulate 40-sphere pile": "pile(10).simulate(10000.0, 1e-3, record_every=100)",
+    "stream 40-sphere pile": ("import os, tempfile; pile(10).stream(os.path.join("
+                              "tempfile.mkdtemp(), 'run.h5'), 10000.0, 1e-3, record_every=100)"),
 }
 
 CHILD = textwrap.dedent(
