@@ -29,6 +29,7 @@
 //! contacts trade impulse along), the iterate is extrapolated along the change between two
 //! measures and kept only if the verdict's measure halves ([`extrapolate`]).
 
+mod closed;
 mod extrapolate;
 mod local;
 mod rows;
@@ -37,7 +38,8 @@ mod slide;
 
 pub use local::LOCAL_ITERS;
 
-use local::{local_2d_exact, local_3d_closed, local_descent, Closed, LocalBlock};
+use closed::{local_2d_exact, local_3d_closed, Closed};
+use local::{local_descent, LocalBlock};
 use rows::OffDiagonal;
 use schedule::CheckSchedule;
 
