@@ -27,7 +27,10 @@
 //!
 //! When the measured error decreases only slowly (a nearly null direction of W that two
 //! contacts trade impulse along), the iterate is extrapolated along the change between two
-//! measures and kept only if the verdict's measure halves ([`extrapolate`]).
+//! measures and kept only if the verdict's measure halves; when the error stalls while the
+//! impulses change by the same step every sweep (a drift along a null direction of W on the
+//! contacts' current faces), the iterate moves along that step to the first contact that
+//! changes case, where the sweeps would have taken it ([`extrapolate`]).
 
 mod closed;
 mod extrapolate;
