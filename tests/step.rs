@@ -509,16 +509,15 @@ fn imminent_frictionless_contact_that_does_not_close_gets_nothing() {
 }
 
 /// After the jam the rod falls flat on both ends (mu = 2, W singular): NSGS can stall there,
-/// and the Lemke fallback must leave every step solved, with no energy gain.
+/// and the Lemke fallback must then leave every step solved, with no energy gain. Since the
+/// sweeps move along a drift in W's null direction to its first change of case, NSGS solves
+/// every step of this scene itself at both step sizes (the fallback is exercised by
+/// tests/python/test_step_model.py).
 #[test]
 fn painleve_rod_falls_flat_with_every_step_solved() {
     for h in [1e-2, 1e-4] {
         let tr = run(&painleve_rod(), h, 3.0);
         every_step_solved(&tr);
-        assert!(
-            tr.steps.iter().any(|s| s.fallback),
-            "{h}: NSGS no longer stalls?"
-        );
         let q = q_at(&tr, tr.t.len() - 1);
         assert!(q[1].abs() < 1e-7 && q[2].abs() < 1e-7, "lies flat: {q:?}");
         for k in 0..tr.steps.len() {

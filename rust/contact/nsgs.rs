@@ -27,8 +27,12 @@
 //!
 //! When the measured error decreases only slowly (a nearly null direction of W that two
 //! contacts trade impulse along), the iterate is extrapolated along the change between two
-//! measures and kept only if the verdict's measure halves ([`extrapolate`]).
+//! measures and kept only if the verdict's measure halves; when the error stalls while the
+//! impulses change by the same step every sweep (a drift along a null direction of W on the
+//! contacts' current faces), the iterate moves along that step to the first contact that
+//! changes case, where the sweeps would have taken it ([`extrapolate`]).
 
+mod closed;
 mod extrapolate;
 mod local;
 mod rows;
@@ -37,7 +41,8 @@ mod slide;
 
 pub use local::LOCAL_ITERS;
 
-use local::{local_2d_exact, local_3d_closed, local_descent, Closed, LocalBlock};
+use closed::{local_2d_exact, local_3d_closed, Closed};
+use local::{local_descent, LocalBlock};
 use rows::OffDiagonal;
 use schedule::CheckSchedule;
 

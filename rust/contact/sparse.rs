@@ -11,6 +11,11 @@
 //! of each block row found with a marker array, sorted, and the scalars summed into their tiles
 //! (duplicate scalar entries add up, as in scipy.sparse). Any sparsity pattern is accepted: the
 //! tiles are only a grouping of the entries.
+//!
+//! The assembly of a stepper rebuilds its W in place from whole tiles every step
+//! (`sparse/rebuild.rs`).
+
+mod rebuild;
 
 use crate::error::{CoulombError, Result};
 
@@ -27,13 +32,7 @@ pub struct BlockCsr {
     diag: Vec<usize>,
 }
 
-/// The scratch of [`BlockCsr::rebuild_from_tiles`], kept between rebuilds.
-#[derive(Clone, Debug, Default)]
-pub(crate) struct TileScratch {
-    start: Vec<usize>,
-    order: Vec<usize>,
-    mark: Vec<usize>,
-}
+pub(crate) use rebuild::TileScratch;
 
 /// An entry source for [`BlockCsr::from_entries`]: yields `(row, col, value)` and can be
 /// replayed.
@@ -290,103 +289,6 @@ impl BlockCsr {
             .sum()
     }
 
-    /// Rebuilds this W in place from whole `dim x dim` tiles `(i, j, tile)` (block row,
-    /// block column, row-major tile in the first `dim` rows and columns), in any order; tiles
-    /// at the same place add up in the order given, every diagonal tile is stored (zero when
-    /// none is given). The same storage as [`Self::from_coo`] of the tiles' scalars, summed in
-    /// the same order, built without scalar triplets; this W's buffers and `scratch` are
-    /// reused, so a rebuild of a size seen before allocates nothing. Refuses non-finite
-    /// entries.
-    pub(crate) fn rebuild_from_tiles(
-        &mut self,
-        dim: usize,
-        nc: usize,
-        tiles: &[(usize, usize, [[f64; 3]; 3])],
-        scratch: &mut TileScratch,
-    ) -> Result<()> {
-        check_dims(dim, dim * nc)?;
-        for (_, _, t) in tiles {
-            for row in &t[..dim] {
-                check_data(&row[..dim])?;
-            }
-        }
-        let TileScratch { start, order, mark } = scratch;
-        // 1. the tiles by block row, in their given order (a counting sort)
-        start.clear();
-        start.resize(nc + 1, 0);
-        for &(i, _, _) in tiles {
-            start[i + 1] += 1;
-        }
-        for i in 0..nc {
-            start[i + 1] += start[i];
-        }
-        order.clear();
-        order.resize(tiles.len(), 0);
-        mark.clear();
-        mark.extend_from_slice(&start[..nc]);
-        for (k, &(i, _, _)) in tiles.iter().enumerate() {
-            order[mark[i]] = k;
-            mark[i] += 1;
-        }
-        // 2. the distinct block columns of each row, sorted, the diagonal always present
-        mark.clear();
-        mark.resize(nc, usize::MAX);
-        self.dim = dim;
-        self.nc = nc;
-        self.row_ptr.clear();
-        self.row_ptr.push(0);
-        self.cols.clear();
-        self.diag.clear();
-        for i in 0..nc {
-            let first = self.cols.len();
-            mark[i] = i;
-            self.cols.push(i);
-            for &k in &order[start[i]..start[i + 1]] {
-                let j = tiles[k].1;
-                if mark[j] != i {
-                    mark[j] = i;
-                    self.cols.push(j);
-                }
-            }
-            self.cols[first..].sort_unstable();
-            self.row_ptr.push(self.cols.len());
-        }
-        // 3. the tiles summed into place (mark: block column -> tile index, per row)
-        let bs = dim * dim;
-        self.values.clear();
-        self.values.resize(self.cols.len() * bs, 0.0);
-        for i in 0..nc {
-            for t in self.row_ptr[i]..self.row_ptr[i + 1] {
-                mark[self.cols[t]] = t;
-                if self.cols[t] == i {
-                    self.diag.push(t);
-                }
-            }
-            for &k in &order[start[i]..start[i + 1]] {
-                let (_, j, tile) = &tiles[k];
-                let out = &mut self.values[mark[*j] * bs..(mark[*j] + 1) * bs];
-                for a in 0..dim {
-                    for b in 0..dim {
-                        out[a * dim + b] += tile[a][b];
-                    }
-                }
-            }
-        }
-        Ok(())
-    }
-
-    /// an empty W (no contacts), a buffer for [`Self::rebuild_from_tiles`].
-    pub(crate) fn empty() -> Self {
-        Self {
-            dim: 1,
-            nc: 0,
-            row_ptr: vec![0],
-            cols: Vec::new(),
-            values: Vec::new(),
-            diag: Vec::new(),
-        }
-    }
-
     /// the bucketing described in the module notes; indices are already checked.
     fn from_entries(dim: usize, nc: usize, nnz: usize, entries: &dyn Entries) -> Result<Self> {
         // 1. bucket the entries by block row (counting sort)
@@ -602,180 +504,4 @@ impl BlockCsr {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::testing::SplitMix64;
-
-    fn random_sparse(n: usize, density: f64, seed: u64) -> Vec<f64> {
-        let mut rng = SplitMix64::new(seed);
-        (0..n * n)
-            .map(|_| {
-                if rng.uniform() < density {
-                    rng.normal()
-                } else {
-                    0.0
-                }
-            })
-            .collect()
-    }
-
-    fn csr_of(n: usize, w: &[f64]) -> (Vec<i64>, Vec<i64>, Vec<f64>) {
-        let mut ptr = vec![0i64];
-        let (mut idx, mut val) = (Vec::new(), Vec::new());
-        for r in 0..n {
-            // reversed column order: unsorted input
-            for c in (0..n).rev() {
-                if w[r * n + c] != 0.0 {
-                    idx.push(c as i64);
-                    val.push(w[r * n + c]);
-                }
-            }
-            ptr.push(idx.len() as i64);
-        }
-        (ptr, idx, val)
-    }
-
-    #[test]
-    fn csr_csc_coo_and_dense_agree_and_round_trip() {
-        for (dim, nc, seed) in [(3, 7, 1), (2, 9, 2), (3, 1, 3), (2, 4, 4)] {
-            let n = dim * nc;
-            let w = random_sparse(n, 0.15, seed);
-            let (ptr, idx, val) = csr_of(n, &w);
-            let a = BlockCsr::from_csr(dim, n, &ptr, &idx, &val).unwrap();
-            assert_eq!(a.to_dense(), w);
-            // CSC of W is CSR of W^T
-            let wt: Vec<f64> = (0..n * n).map(|k| w[(k % n) * n + k / n]).collect();
-            let (cptr, cidx, cval) = csr_of(n, &wt);
-            let b = BlockCsr::from_csc(dim, n, &cptr, &cidx, &cval).unwrap();
-            assert_eq!(b.to_dense(), w);
-            // COO with duplicates: every entry split in two halves, shuffled order
-            let (mut rows, mut cols, mut data) = (Vec::new(), Vec::new(), Vec::new());
-            for k in (0..n * n).rev() {
-                if w[k] != 0.0 {
-                    for _ in 0..2 {
-                        rows.push((k / n) as i32);
-                        cols.push((k % n) as i32);
-                        data.push(0.5 * w[k]);
-                    }
-                }
-            }
-            let c = BlockCsr::from_coo(dim, n, &rows, &cols, &data).unwrap();
-            assert_eq!(c.to_dense(), w);
-            let d = BlockCsr::from_dense(dim, n, &w).unwrap();
-            assert_eq!(a, d);
-            let tiles = BlockCsr::dense_tile_count(dim, nc, &w);
-            assert_eq!(BlockCsr::from_dense_counted(dim, nc, &w, tiles), d);
-            assert_eq!(a, c);
-            // every diagonal tile is stored, sorted columns
-            for i in 0..nc {
-                assert!(a.row_cols(i).contains(&i));
-                assert!(a.row_cols(i).windows(2).all(|p| p[0] < p[1]));
-            }
-            // products
-            let mut rng = SplitMix64::new(seed + 100);
-            let x: Vec<f64> = (0..n).map(|_| rng.normal()).collect();
-            let mut y = vec![0.0; n];
-            a.mul(&x, &mut y);
-            for r in 0..n {
-                let e: f64 = (0..n).map(|c| w[r * n + c] * x[c]).sum();
-                assert!((y[r] - e).abs() <= 1e-13 * (1.0 + e.abs()));
-            }
-        }
-    }
-
-    #[test]
-    fn a_rebuild_from_tiles_is_the_coo_of_their_scalars_summed_in_order() {
-        let mut rng = SplitMix64::new(7);
-        let mut csr = BlockCsr::empty();
-        let mut scratch = TileScratch::default();
-        for (dim, nc, count) in [(3, 5, 12), (2, 7, 20), (2, 4, 9), (3, 6, 0)] {
-            // repeated places (sums), any order, some rows without a tile
-            let tiles: Vec<(usize, usize, [[f64; 3]; 3])> = (0..count)
-                .map(|_| {
-                    let i = (rng.uniform() * nc as f64) as usize % nc;
-                    let j = (rng.uniform() * nc as f64) as usize % nc;
-                    (
-                        i,
-                        j,
-                        std::array::from_fn(|_| std::array::from_fn(|_| rng.normal())),
-                    )
-                })
-                .collect();
-            let (mut rows, mut cols, mut data) = (vec![], vec![], vec![]);
-            for &(i, j, t) in &tiles {
-                for (a, row) in t.iter().enumerate().take(dim) {
-                    for (b, &x) in row.iter().enumerate().take(dim) {
-                        rows.push(i * dim + a);
-                        cols.push(j * dim + b);
-                        data.push(x);
-                    }
-                }
-            }
-            let want = BlockCsr::from_coo(dim, dim * nc, &rows, &cols, &data).unwrap();
-            csr.rebuild_from_tiles(dim, nc, &tiles, &mut scratch)
-                .unwrap();
-            assert_eq!(csr, want, "dim {dim}, nc {nc}");
-        }
-        let bad = [(0, 0, [[f64::NAN; 3]; 3])];
-        assert!(csr.rebuild_from_tiles(2, 1, &bad, &mut scratch).is_err());
-    }
-
-    #[test]
-    fn an_empty_matrix_keeps_zero_diagonal_tiles() {
-        let a = BlockCsr::from_csr::<i32>(3, 6, &[0; 7], &[], &[]).unwrap();
-        assert_eq!(a.nnz_blocks(), 2);
-        assert_eq!(a.diag_values(1), &[0.0; 9]);
-        assert!(a.block(0, 1).is_none());
-        assert_eq!(a.to_dense(), vec![0.0; 36]);
-    }
-
-    #[test]
-    fn bad_arrays_are_refused() {
-        let ptr = [0i64, 1, 2, 2, 3];
-        let idx = [0i64, 1, 3];
-        let val = [1.0, 2.0, 3.0];
-        assert!(BlockCsr::from_csr(2, 4, &ptr, &idx, &val).is_ok());
-        let shape = |r: Result<BlockCsr>| matches!(r, Err(CoulombError::Shape(_)));
-        // n not a multiple of dim
-        assert!(shape(BlockCsr::from_csr(3, 4, &ptr, &idx, &val)));
-        // index out of range, negative index
-        assert!(shape(BlockCsr::from_csr(2, 4, &ptr, &[0, 1, 4], &val)));
-        assert!(shape(BlockCsr::from_csr(2, 4, &ptr, &[0, -1, 3], &val)));
-        // indptr: wrong length, decreasing, wrong end, not starting at 0
-        assert!(shape(BlockCsr::from_csr(2, 4, &ptr[..4], &idx, &val)));
-        assert!(shape(BlockCsr::from_csr(
-            2,
-            4,
-            &[0, 2, 1, 2, 3],
-            &idx,
-            &val
-        )));
-        assert!(shape(BlockCsr::from_csr(
-            2,
-            4,
-            &[0, 1, 2, 2, 2],
-            &idx,
-            &val
-        )));
-        assert!(shape(BlockCsr::from_csr(
-            2,
-            4,
-            &[1, 1, 2, 2, 3],
-            &idx,
-            &val
-        )));
-        // lengths
-        assert!(shape(BlockCsr::from_csr(2, 4, &ptr, &idx[..2], &val)));
-        assert!(shape(BlockCsr::from_coo(2, 4, &idx, &idx[..2], &val)));
-        assert!(shape(BlockCsr::from_coo(2, 4, &[0, 1, 9], &idx, &val)));
-        assert!(matches!(
-            BlockCsr::from_csr(2, 4, &ptr, &idx, &[1.0, f64::NAN, 0.0]),
-            Err(CoulombError::NonFinite(_))
-        ));
-        assert!(matches!(
-            BlockCsr::from_csr(4, 4, &ptr, &idx, &val),
-            Err(CoulombError::InvalidParameter(_))
-        ));
-        assert!(shape(BlockCsr::from_dense(2, 4, &[0.0; 15])));
-    }
-}
+mod tests;

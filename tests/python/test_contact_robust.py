@@ -195,8 +195,8 @@ def test_a_redundant_pile_rounded_to_6_digits_is_reported_unsolved():
 # not run here: RockPile_tob1 (hard, see test_fclib.py) and fc2d_granularflowonwall_02020_00213
 # (nc = 2020, read dense here: its FCLib copy, the same W and q, is solved block-sparse by the
 # 2D LCP finish in test_fclib.py)
-# RockPile: not solved; the 2D flow: its own test; Capsules-i122-1617: solved by error_q but
-# not contact by contact (tests/python/test_fclib.py says why)
+# RockPile: not solved; the 2D flow: its own test; Capsules-i122-1617: its own test in
+# tests/python/test_fclib.py
 SKIPPED = ("RockPile_tob1", "fc2d_granularflowonwall_02020_00213", "Capsules-i122-1617")
 
 

@@ -1,0 +1,158 @@
+//! The in-place rebuild of a block CSR W from whole `dim x dim` tiles, as a stepper's
+//! assembly produces them every step (`W_ij` summed over the bodies contacts i and j share):
+//! a counting sort of the tiles by block row, the distinct block columns of each row found with
+//! a marker array and sorted, the tiles summed into place. The buffers of the W and of a
+//! [`TileScratch`] are reused, so a rebuild of a size seen before allocates nothing.
+
+use super::{check_data, check_dims, BlockCsr};
+use crate::error::Result;
+
+/// The scratch of [`BlockCsr::rebuild_from_tiles`], kept between rebuilds.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct TileScratch {
+    start: Vec<usize>,
+    order: Vec<usize>,
+    mark: Vec<usize>,
+}
+
+impl BlockCsr {
+    /// Rebuilds this W in place from whole `dim x dim` tiles `(i, j, tile)` (block row,
+    /// block column, row-major tile in the first `dim` rows and columns), in any order; tiles
+    /// at the same place add up in the order given, every diagonal tile is stored (zero when
+    /// none is given). The same storage as [`Self::from_coo`] of the tiles' scalars, summed in
+    /// the same order, built without scalar triplets; this W's buffers and `scratch` are
+    /// reused, so a rebuild of a size seen before allocates nothing. Refuses non-finite
+    /// entries.
+    pub(crate) fn rebuild_from_tiles(
+        &mut self,
+        dim: usize,
+        nc: usize,
+        tiles: &[(usize, usize, [[f64; 3]; 3])],
+        scratch: &mut TileScratch,
+    ) -> Result<()> {
+        check_dims(dim, dim * nc)?;
+        for (_, _, t) in tiles {
+            for row in &t[..dim] {
+                check_data(&row[..dim])?;
+            }
+        }
+        let TileScratch { start, order, mark } = scratch;
+        // 1. the tiles by block row, in their given order (a counting sort)
+        start.clear();
+        start.resize(nc + 1, 0);
+        for &(i, _, _) in tiles {
+            start[i + 1] += 1;
+        }
+        for i in 0..nc {
+            start[i + 1] += start[i];
+        }
+        order.clear();
+        order.resize(tiles.len(), 0);
+        mark.clear();
+        mark.extend_from_slice(&start[..nc]);
+        for (k, &(i, _, _)) in tiles.iter().enumerate() {
+            order[mark[i]] = k;
+            mark[i] += 1;
+        }
+        // 2. the distinct block columns of each row, sorted, the diagonal always present
+        mark.clear();
+        mark.resize(nc, usize::MAX);
+        self.dim = dim;
+        self.nc = nc;
+        self.row_ptr.clear();
+        self.row_ptr.push(0);
+        self.cols.clear();
+        self.diag.clear();
+        for i in 0..nc {
+            let first = self.cols.len();
+            mark[i] = i;
+            self.cols.push(i);
+            for &k in &order[start[i]..start[i + 1]] {
+                let j = tiles[k].1;
+                if mark[j] != i {
+                    mark[j] = i;
+                    self.cols.push(j);
+                }
+            }
+            self.cols[first..].sort_unstable();
+            self.row_ptr.push(self.cols.len());
+        }
+        // 3. the tiles summed into place (mark: block column -> tile index, per row)
+        let bs = dim * dim;
+        self.values.clear();
+        self.values.resize(self.cols.len() * bs, 0.0);
+        for i in 0..nc {
+            for t in self.row_ptr[i]..self.row_ptr[i + 1] {
+                mark[self.cols[t]] = t;
+                if self.cols[t] == i {
+                    self.diag.push(t);
+                }
+            }
+            for &k in &order[start[i]..start[i + 1]] {
+                let (_, j, tile) = &tiles[k];
+                let out = &mut self.values[mark[*j] * bs..(mark[*j] + 1) * bs];
+                for a in 0..dim {
+                    for b in 0..dim {
+                        out[a * dim + b] += tile[a][b];
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// an empty W (no contacts), a buffer for [`Self::rebuild_from_tiles`].
+    pub(crate) fn empty() -> Self {
+        Self {
+            dim: 1,
+            nc: 0,
+            row_ptr: vec![0],
+            cols: Vec::new(),
+            values: Vec::new(),
+            diag: Vec::new(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testing::SplitMix64;
+
+    #[test]
+    fn a_rebuild_from_tiles_is_the_coo_of_their_scalars_summed_in_order() {
+        let mut rng = SplitMix64::new(7);
+        let mut csr = BlockCsr::empty();
+        let mut scratch = TileScratch::default();
+        for (dim, nc, count) in [(3, 5, 12), (2, 7, 20), (2, 4, 9), (3, 6, 0)] {
+            // repeated places (sums), any order, some rows without a tile
+            let tiles: Vec<(usize, usize, [[f64; 3]; 3])> = (0..count)
+                .map(|_| {
+                    let i = (rng.uniform() * nc as f64) as usize % nc;
+                    let j = (rng.uniform() * nc as f64) as usize % nc;
+                    (
+                        i,
+                        j,
+                        std::array::from_fn(|_| std::array::from_fn(|_| rng.normal())),
+                    )
+                })
+                .collect();
+            let (mut rows, mut cols, mut data) = (vec![], vec![], vec![]);
+            for &(i, j, t) in &tiles {
+                for (a, row) in t.iter().enumerate().take(dim) {
+                    for (b, &x) in row.iter().enumerate().take(dim) {
+                        rows.push(i * dim + a);
+                        cols.push(j * dim + b);
+                        data.push(x);
+                    }
+                }
+            }
+            let want = BlockCsr::from_coo(dim, dim * nc, &rows, &cols, &data).unwrap();
+            csr.rebuild_from_tiles(dim, nc, &tiles, &mut scratch)
+                .unwrap();
+            assert_eq!(csr, want, "dim {dim}, nc {nc}");
+        }
+        let bad = [(0, 0, [[f64::NAN; 3]; 3])];
+        assert!(csr.rebuild_from_tiles(2, 1, &bad, &mut scratch).is_err());
+    }
+}
