@@ -268,7 +268,10 @@ def box_pile(count: int, h: float = 1e-3, t_end: float = 1.0, half: float = 0.05
         h,
         n,
         sec,
-        {"floor penetration at the end (m)": max(0.0, -lowest), "largest speed at the end (m/s)": speed},
+        {
+            "floor penetration at the end (m)": max(0.0, -lowest),
+            "largest speed at the end (m/s)": speed,
+        },
     )
 
 
@@ -305,7 +308,7 @@ def chain(links: int = 20, h: float = 1e-3, t_end: float = 2.0, length: float = 
     import mujoco
 
     model = mujoco.MjModel.from_xml_string(xml)
-    t, qpos, qvel, n, sec = _rollout(xml, None, t_end, h)
+    _t, qpos, qvel, n, sec = _rollout(xml, None, t_end, h)
     data = mujoco.MjData(model)
 
     def energy(qp: np.ndarray, qv: np.ndarray) -> float:

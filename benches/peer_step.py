@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import datetime
+import itertools
 import math
 import os
 import platform
@@ -203,7 +204,7 @@ def coulomb_tower(h: float, solver: str, count: int = 10, t_end: float = 10.0,
             )
             boxes.append(scene.attach(body, Box((half, half, half))))
         scene.contact(boxes[0], floor, mu=mu)
-        for a, b in zip(boxes[:-1], boxes[1:]):
+        for a, b in itertools.pairwise(boxes):
             scene.contact(b, a, mu=mu)
         return scene
 
