@@ -193,8 +193,9 @@ fn face_normal3(shape: &dyn Parry3, fid: u32) -> Option<Vector3<f64>> {
 }
 
 /// The unit normal of triangle `part` of a triangle mesh or heightfield (its winding's, which
-/// the mesh's validation makes the outward one), in the shape's frame.
-fn part_normal3(shape: &dyn Parry3, part: u32) -> Option<Vector3<f64>> {
+/// the mesh's validation makes the outward one), in the shape's frame (`_toward` unused: a
+/// mesh is one-sided).
+fn part_normal3(shape: &dyn Parry3, part: u32, _toward: Vector3<f64>) -> Option<Vector3<f64>> {
     let tri = if let Some(mesh) = shape.as_trimesh() {
         (part < mesh.num_triangles() as u32).then(|| mesh.triangle(part))?
     } else {
@@ -203,9 +204,14 @@ fn part_normal3(shape: &dyn Parry3, part: u32) -> Option<Vector3<f64>> {
     tri.normal().map(|n| n.into_inner())
 }
 
-/// 2D shapes have no parts with faces of their own.
-fn part_normal2(_shape: &dyn Parry2, _part: u32) -> Option<Vector2<f64>> {
-    None
+/// The unit normal of segment `part` of a polyline, in its frame, on the side of `toward` (a
+/// polyline is two-sided: the normal is the segment's left one or its opposite).
+fn part_normal2(shape: &dyn Parry2, part: u32, toward: Vector2<f64>) -> Option<Vector2<f64>> {
+    let line = shape.as_polyline()?;
+    let seg = (part < line.num_segments() as u32).then(|| line.segment(part))?;
+    let d = seg.b - seg.a;
+    let n = Vector2::new(-d.y, d.x).try_normalize(0.0)?;
+    Some(if n.dot(&toward) < 0.0 { -n } else { n })
 }
 
 /// The face of one shape that a manifold's points lie on: the one face feature among the
@@ -296,14 +302,16 @@ macro_rules! contacts_impl {
                 // triangle (whose parts are in the shape's own frame)
                 let face_b = match shared_face(m.points.iter().map(|p| fid(p, true))) {
                     Some(f) if m.subshape_pos2.is_none() => {
-                        $face(b, f).or_else(|| $part_face(b, m.subshape2))
+                        let toward = pose_b.rotation.inverse() * -normal;
+                        $face(b, f).or_else(|| $part_face(b, m.subshape2, toward))
                     }
                     _ => None,
                 }
                 .map(|n| -(pose_b.rotation * n));
                 let face_a = match shared_face(m.points.iter().map(|p| fid(p, false))) {
                     Some(f) if m.subshape_pos1.is_none() => {
-                        $face(a, f).or_else(|| $part_face(a, m.subshape1))
+                        let toward = pose_a.rotation.inverse() * normal;
+                        $face(a, f).or_else(|| $part_face(a, m.subshape1, toward))
                     }
                     _ => None,
                 }
