@@ -231,31 +231,28 @@ def _solved(tr) -> str:
 def coulomb_box_pile(count: int, h: float, solver: str, t_end: float = 1.0,
                      half: float = 0.05, mu: float = 0.5) -> dict:
     """`count` cubes dropped into a box (floor and four walls; the layout of
-    mujoco_scenes.box_pile): contact_all for the box pairs, each box declared against the
-    five half-spaces."""
+    mujoco_scenes.box_pile), every pair by contact_all."""
     _side, wall, centres = mj.box_pile_layout(count, half)
     turn = math.radians(10.0)
     inertia = _box_inertia(0.1, (half,) * 3)
 
     def run():
         scene = Scene(dim=3, gravity=(0.0, 0.0, -G0))
-        walls = [scene.add(_floor())] + [
+        scene.add(_floor())
+        for p, n in (
+            ((-wall, 0.0, 0.0), (1.0, 0.0, 0.0)),
+            ((wall, 0.0, 0.0), (-1.0, 0.0, 0.0)),
+            ((0.0, -wall, 0.0), (0.0, 1.0, 0.0)),
+            ((0.0, wall, 0.0), (0.0, -1.0, 0.0)),
+        ):
             scene.add(HalfSpace(p, n))
-            for p, n in (
-                ((-wall, 0.0, 0.0), (1.0, 0.0, 0.0)),
-                ((wall, 0.0, 0.0), (-1.0, 0.0, 0.0)),
-                ((0.0, -wall, 0.0), (0.0, 1.0, 0.0)),
-                ((0.0, wall, 0.0), (0.0, -1.0, 0.0)),
-            )
-        ]
         for k, c in enumerate(centres):
             a = turn * (k % 3)
             body = scene.add(RigidBody3D(
                 mass=0.1, inertia=inertia, position=c,
                 orientation=(math.cos(a / 2), 0.0, 0.0, math.sin(a / 2))))
-            box = scene.attach(body, Box((half, half, half)))
-            for w in walls:
-                scene.contact(box, w, mu=mu)
+            scene.attach(body, Box((half, half, half)))
+        # every box pair found by the broad phase, and every box against the five half-spaces
         scene.contact_all(mu=mu)
         return scene
 
@@ -318,6 +315,29 @@ def _rotate(quat: np.ndarray, p: np.ndarray) -> np.ndarray:
     u = quat[..., 1:]
     t = 2.0 * np.cross(u, p)
     return p + w * t + np.cross(u, t)
+
+
+#: the box scenes' profile (callgrind instruction counts, not measured by this script).
+PROFILE_NOTE = """### Where the box scenes' steps go (callgrind)
+
+`valgrind --tool=callgrind target/release/examples/step_profile tower 10 300` and
+`... box-pile 125 130` (the same scenes in Rust, `benches/profile/step_profile.rs`), instructions
+before and after the narrow phase kept its manifold, GJK simplex and EPA per pair
+(`rust/geometry/convex.rs`; before: parry's dispatcher, which makes a new EPA and, against a
+half-space, a new point buffer per query):
+
+| scene | narrow phase before | after | whole run before | after |
+|---|---:|---:|---:|---:|
+| tower of 10 boxes, 300 steps | 120,550,138 | 103,017,804 | 8,010,469,091 | 8,000,045,563 |
+| 125 boxes falling in a box, 130 steps | 24,771,843 | 21,069,940 | 1,780,023,488 | 1,776,195,705 |
+
+A settled step of a box on a box and a capsule on the floor allocates nothing (12 allocations
+before; `tests/step_solids_alloc.rs`, `tests/geometry_alloc.rs`). The narrow phase is about 1 %
+of the box scenes' instructions: on the tower 78 % go to the robust mode's fallback (faer's
+sparse LU alone 46 %) and 20 % to NSGS, which misses its tolerance (1e-12) on 826 of the first
+2000 steps (`step_profile tower 10 2000`); after the 125 boxes land, each step is solved by the
+fallback too. The box scenes' speed is the contact solver's on these redundant face contacts
+(four points per face), not the geometry's."""
 
 
 def _fmt_fig(figs: dict) -> str:
@@ -412,6 +432,13 @@ def main() -> int:
         "(creep 0); the ball rebounds at e = 0.6 of its speed; the resting box neither drifts "
         "nor sinks."
     )
+    lines.append(
+        "The tower's boxes must not move at all (exact sticking: drift below 1e-9 m); MuJoCo's "
+        "soft contacts let the top box sink. The chain's joint gap is the largest distance "
+        "between two hinged ends (MuJoCo's chain is in joint coordinates: no gap by "
+        "construction)."
+    )
+    lines += ["", PROFILE_NOTE]
     table = "\n".join(lines)
     print(table)
     if not args.no_write:

@@ -85,6 +85,7 @@ from .model import (
     Scene,
     Segment,
     Sphere,
+    Polyline,
     TriangleMesh,
 )
 from .settings import (
@@ -132,6 +133,7 @@ __all__ = [
     "Status",
     "StepSettings",
     "Trajectory",
+    "Polyline",
     "TriangleMesh",
     "Weld",
     "__version__",

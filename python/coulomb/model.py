@@ -70,6 +70,7 @@ from ._solids import (
     Heightfield,
     Shape,
     StaticSolid,
+    Polyline,
     TriangleMesh,
     _check_solid,
     _pose,
@@ -108,6 +109,7 @@ __all__ = [
     "Segment",
     "Shape",
     "Sphere",
+    "Polyline",
     "TriangleMesh",
 ]
 
