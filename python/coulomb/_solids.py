@@ -199,7 +199,7 @@ class Compound(Shape):
             if dim == 2:
                 rot2 = _rotation2(outer[2])
                 c = (rot2 @ np.asarray(spec["pose"][:2]) + np.asarray(outer[:2])).tolist()
-                spec["pose"] = c + [outer[2] + spec["pose"][2]]
+                spec["pose"] = [*c, outer[2] + spec["pose"][2]]
             else:
                 inner = _rotation(spec["pose"][3:])
                 rot = _rotation(outer[3:])
