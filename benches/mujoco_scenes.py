@@ -231,7 +231,7 @@ def box_pile_layout(count: int, half: float = 0.05):
 
 
 def box_pile(count: int, h: float = 1e-3, t_end: float = 1.0, half: float = 0.05,
-             mu: float = 0.5) -> PeerRun:
+             mu: float = 0.5, repeats: int | None = None) -> PeerRun:
     """`count` cubes of side `2 half` (0.1 kg, mu 0.5) dropped on a grid into a box (floor and
     four walls). Figures: the deepest penetration at the end (floor), the largest speed."""
     _side, wall, centres = box_pile_layout(count, half)
@@ -259,7 +259,7 @@ def box_pile(count: int, h: float = 1e-3, t_end: float = 1.0, half: float = 0.05
     {"".join(bodies)}
   </worldbody>
 </mujoco>"""
-    _t, qpos, qvel, n, sec = _rollout(xml, None, t_end, h)
+    _t, qpos, qvel, n, sec = _rollout(xml, None, t_end, h, repeats)
     pos = qpos.reshape(len(qpos), count, 7)
     lowest = float(np.min(_lowest_corner(pos[-1], half)))
     speed = float(np.max(np.linalg.norm(qvel[-1].reshape(count, 6)[:, :3], axis=1)))
@@ -283,7 +283,7 @@ def _lowest_corner(q: np.ndarray, half: float) -> np.ndarray:
     return q[:, 2] - half * np.sum(np.abs(r), axis=1)
 
 
-def chain(links: int = 20, h: float = 1e-3, t_end: float = 2.0, length: float = 0.05,
+def chain(links: int = 20, h: float = 1e-3, t_end: float = 1.0, length: float = 0.05,
           radius: float = 0.005) -> PeerRun:
     """`links` capsules of length `length` (10 g each) hinged end to end about y, the first
     hinged to the world at the origin, released horizontal along +x (MuJoCo's joint chain:
