@@ -182,6 +182,158 @@ def sphere_pile(count: int, h: float = 1e-3, t_end: float = 1.0, radius: float =
     return PeerRun(f"pile of {count} spheres", h, n, sec, {})
 
 
+def box_tower(count: int = 10, h: float = 1e-3, t_end: float = 10.0, half: float = 0.1,
+              mu: float = 0.5) -> PeerRun:
+    """`count` cubes of side `2 half` (1 kg, mu 0.5) stacked exactly on the floor, standing
+    for `t_end`. Figures: the largest horizontal drift of any box, and how far the top box
+    sank (its soft contacts' penetration summed down the tower)."""
+    bodies = "".join(
+        f'<body pos="0 0 {half * (2 * k + 1):.6f}"><freejoint/>'
+        f'<geom type="box" size="{half} {half} {half}" mass="1" friction="{mu} 0.005 0.0001"/>'
+        f"</body>"
+        for k in range(count)
+    )
+    xml = f"""
+<mujoco>
+  <worldbody>
+    <geom type="plane" size="5 5 0.1" friction="{mu} 0.005 0.0001"/>
+    {bodies}
+  </worldbody>
+</mujoco>"""
+    _t, qpos, _qvel, n, sec = _rollout(xml, None, t_end, h)
+    pos = qpos.reshape(len(qpos), count, 7)[:, :, :3]
+    drift = float(np.max(np.abs(pos[:, :, :2])))
+    sink = float(half * (2 * count - 1) - pos[-1, -1, 2])
+    return PeerRun(
+        f"tower of {count} boxes",
+        h,
+        n,
+        sec,
+        {"largest drift (m)": drift, "top box sank (m)": sink},
+    )
+
+
+def box_pile_layout(count: int, half: float = 0.05):
+    """The box pile's grid (as benches/peer_step.py builds it): `side` boxes per row, the
+    walls' half width, and each box's centre, each layer turned by 10 deg about z."""
+    side = math.ceil(count ** (1 / 3))
+    spacing = 2.6 * half
+    wall = side * spacing / 2 + 2 * half
+    centres = []
+    for k in range(count):
+        i, j, l = k % side, (k // side) % side, k // (side * side)
+        centres.append((
+            -side * spacing / 2 + spacing * (i + 0.5),
+            -side * spacing / 2 + spacing * (j + 0.5),
+            1.5 * half + spacing * l,
+        ))
+    return side, wall, centres
+
+
+def box_pile(count: int, h: float = 1e-3, t_end: float = 1.0, half: float = 0.05,
+             mu: float = 0.5, repeats: int | None = None) -> PeerRun:
+    """`count` cubes of side `2 half` (0.1 kg, mu 0.5) dropped on a grid into a box (floor and
+    four walls). Figures: the deepest penetration at the end (floor), the largest speed."""
+    _side, wall, centres = box_pile_layout(count, half)
+    turn = math.radians(10.0)
+    bodies = []
+    for k, (x, y, z) in enumerate(centres):
+        a = turn * (k % 3)
+        bodies.append(
+            f'<body pos="{x:.6f} {y:.6f} {z:.6f}" euler="0 0 {a:.6f}"><freejoint/>'
+            f'<geom type="box" size="{half} {half} {half}" mass="0.1" '
+            f'friction="{mu} 0.005 0.0001"/></body>'
+        )
+    walls = "".join(
+        f'<geom type="plane" size="{wall} 1 0.1" pos="{px} {py} 1" zaxis="{nx} {ny} 0" '
+        f'friction="{mu} 0.005 0.0001"/>'
+        for px, py, nx, ny in ((-wall, 0, 1, 0), (wall, 0, -1, 0), (0, -wall, 0, 1),
+                               (0, wall, 0, -1))
+    )
+    xml = f"""
+<mujoco>
+  <size memory="200M"/>
+  <worldbody>
+    <geom type="plane" size="{wall} {wall} 0.1" friction="{mu} 0.005 0.0001"/>
+    {walls}
+    {"".join(bodies)}
+  </worldbody>
+</mujoco>"""
+    _t, qpos, qvel, n, sec = _rollout(xml, None, t_end, h, repeats)
+    pos = qpos.reshape(len(qpos), count, 7)
+    lowest = float(np.min(_lowest_corner(pos[-1], half)))
+    speed = float(np.max(np.linalg.norm(qvel[-1].reshape(count, 6)[:, :3], axis=1)))
+    return PeerRun(
+        f"pile of {count} boxes",
+        h,
+        n,
+        sec,
+        {
+            "floor penetration at the end (m)": max(0.0, -lowest),
+            "largest speed at the end (m/s)": speed,
+        },
+    )
+
+
+def _lowest_corner(q: np.ndarray, half: float) -> np.ndarray:
+    """each box's lowest corner height, from its pose rows (x, y, z, qw, qx, qy, qz)."""
+    w, x, y, z = q[:, 3], q[:, 4], q[:, 5], q[:, 6]
+    # the third row of the rotation matrix: the body axes' z components
+    r = np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], axis=1)
+    return q[:, 2] - half * np.sum(np.abs(r), axis=1)
+
+
+def chain(links: int = 20, h: float = 1e-3, t_end: float = 1.0, length: float = 0.05,
+          radius: float = 0.005) -> PeerRun:
+    """`links` capsules of length `length` (10 g each) hinged end to end about y, the first
+    hinged to the world at the origin, released horizontal along +x (MuJoCo's joint chain:
+    each link a child body with a hinge). Figures: the energy change and the tip's height at
+    the end."""
+    m = 0.01
+
+    def link(k: int) -> str:
+        pos = "0 0 0" if k == 0 else f"{length} 0 0"
+        inner = link(k + 1) if k + 1 < links else ""
+        return (
+            f'<body pos="{pos}"><joint type="hinge" axis="0 1 0"/>'
+            f'<geom type="capsule" fromto="0 0 0 {length} 0 0" size="{radius}" mass="{m}" '
+            f'contype="0" conaffinity="0"/>{inner}</body>'
+        )
+
+    xml = f"""
+<mujoco>
+  <option gravity="0 0 {-G0}"/>
+  <worldbody>{link(0)}</worldbody>
+</mujoco>"""
+    import mujoco
+
+    model = mujoco.MjModel.from_xml_string(xml)
+    _t, qpos, qvel, n, sec = _rollout(xml, None, t_end, h)
+    data = mujoco.MjData(model)
+
+    def energy(qp: np.ndarray, qv: np.ndarray) -> float:
+        data.qpos[:] = qp
+        data.qvel[:] = qv
+        mujoco.mj_forward(model, data)
+        mujoco.mj_energyPos(model, data)
+        mujoco.mj_energyVel(model, data)
+        return float(data.energy[0] + data.energy[1])
+
+    model.opt.enableflags |= mujoco.mjtEnableBit.mjENBL_ENERGY
+    e0 = energy(np.zeros(model.nq), np.zeros(model.nv))
+    e1 = energy(qpos[-1], qvel[-1])
+    data.qpos[:] = qpos[-1]
+    mujoco.mj_kinematics(model, data)
+    tip = data.xpos[-1] + data.xmat[-1].reshape(3, 3) @ np.array([length, 0.0, 0.0])
+    return PeerRun(
+        f"chain of {links} links",
+        h,
+        n,
+        sec,
+        {"energy change (J)": e1 - e0, "tip height at the end (m)": float(tip[2])},
+    )
+
+
 if __name__ == "__main__":
     for run in (ramp(), floor_impact(), resting_box(), sphere_pile(100)):
         print(f"{run.scene:24s} h={run.h:g}  {run.steps_per_second:10.0f} steps/s  {run.figures}")

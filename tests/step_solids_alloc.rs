@@ -1,9 +1,9 @@
 //! Allocations of the solids' steps: the stepper's own buffers for solids (names, states,
-//! caches, the broad phase's grid) are kept from step to step, so what a settled step still
-//! allocates is parry's narrow phase inside touching pairs (its manifold code copies the old
-//! points and clips into temporary vectors; a touching pair of polyhedra is queried twice, the
-//! second time pulled apart). Measured: a box resting on a box and a capsule resting on the
-//! floor, 12 allocations in a settled step, exactly those of the two pairs' queries alone.
+//! caches, the broad phase's grid) are kept from step to step, so what a settled step could
+//! still allocate is parry's narrow phase inside touching pairs. Convex pairs with polygonal
+//! features and such a shape against a half-space keep their manifold, GJK simplex and EPA
+//! buffers in the pair's cache (tests/geometry_alloc.rs): a box resting on a box and a capsule
+//! resting on the floor, 0 allocations in a settled step (12 before the cache kept them).
 
 use coulomb::geometry::Shape3;
 use coulomb::step::{Pair, Scene, SolidShape, StepSettings, Stepper};

@@ -6,11 +6,20 @@
 //! valgrind --tool=callgrind target/release/examples/step_profile resting 2000
 //! cargo run --release --example step_profile -- pile 100 1000
 //! cargo run --release --example step_profile -- pile-declared 100 1000
+//! cargo run --release --example step_profile -- tower 10 2000
+//! valgrind --tool=callgrind target/release/examples/step_profile box-pile 125 100
 //! ```
+//!
+//! `tower N` stacks N cubes of 0.2 m on the floor (box pairs declared), `box-pile N` drops N
+//! cubes of 0.1 m into a box of five half-spaces (box pairs by the broad phase), as in
+//! benches/peer_step.py.
 //!
 //! NSGS's sweep order, relaxation and sweep limit can be changed for experiments through the
 //! environment: `ORDER=symmetric|backward|forward`, `RELAX=1.3`, `MAXIT=100`.
-use coulomb::step::{simulate, Body, BodyKind, HalfSpace, Pair, Scene, Shape, StepSettings};
+use coulomb::geometry::Shape3;
+use coulomb::step::{
+    simulate, Body, BodyKind, HalfSpace, Pair, Scene, Shape, Solid, SolidShape, StepSettings,
+};
 
 const G: f64 = 9.81;
 
@@ -157,6 +166,113 @@ fn pile(count: usize, declared: bool) -> Scene {
     scene
 }
 
+/// a cube of half side `half` and mass `m` at `q0` (position, quaternion), with its corners
+/// (against half-spaces) and its solid (against other boxes).
+fn cube(
+    scene: &mut Scene,
+    half: f64,
+    m: f64,
+    q0: [f64; 7],
+) -> Result<(), Box<dyn std::error::Error>> {
+    let (mut body, mut shape) = box_body([half; 3], [0.0; 3], [0.0; 3]);
+    for x in body.inertia.iter_mut() {
+        *x *= m;
+    }
+    body.mass = m;
+    body.q0 = q0.to_vec();
+    shape.body = scene.bodies.len();
+    scene.solids.push(Solid {
+        body: Some(scene.bodies.len()),
+        pose: vec![0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0],
+        shape: SolidShape::Spatial(Shape3::cuboid([half; 3])?),
+    });
+    scene.bodies.push(body);
+    scene.shapes.push(shape);
+    Ok(())
+}
+
+fn empty_scene() -> Scene {
+    Scene {
+        dim: 3,
+        gravity: vec![0.0, 0.0, -G],
+        bodies: vec![],
+        shapes: vec![],
+        half_spaces: vec![],
+        pairs: vec![],
+        solids: Vec::new(),
+    }
+}
+
+/// `count` cubes of side 0.2 m and 1 kg stacked exactly on the floor, mu 0.5.
+fn tower(count: usize) -> Result<Scene, Box<dyn std::error::Error>> {
+    let half = 0.1;
+    let mut scene = empty_scene();
+    scene.half_spaces.push(HalfSpace {
+        point: vec![0.0; 3],
+        normal: vec![0.0, 0.0, 1.0],
+    });
+    for k in 0..count {
+        let z = half * (2 * k + 1) as f64;
+        cube(&mut scene, half, 1.0, [0.0, 0.0, z, 1.0, 0.0, 0.0, 0.0])?;
+    }
+    scene.pairs.push(Pair::ShapeHalfSpace {
+        shape: 0,
+        half_space: 0,
+        mu: 0.5,
+        e: 0.0,
+    });
+    for k in 1..count {
+        scene.pairs.push(Pair::SolidSolid {
+            a: k,
+            b: k - 1,
+            mu: 0.5,
+            e: 0.0,
+        });
+    }
+    Ok(scene)
+}
+
+/// `count` cubes of side 0.1 m and 0.1 kg on a grid above a floor inside four walls, turned
+/// by 0, 10 and 20 deg about z in turn (benches/mujoco_scenes.py's `box_pile_layout`).
+fn box_pile(count: usize) -> Result<Scene, Box<dyn std::error::Error>> {
+    let half = 0.05;
+    let side = (count as f64).cbrt().ceil() as usize;
+    let spacing = 2.6 * half;
+    let wall = side as f64 * spacing / 2.0 + 2.0 * half;
+    let mut scene = empty_scene();
+    for (p, n) in [
+        ([0.0, 0.0, 0.0], [0.0, 0.0, 1.0]),
+        ([-wall, 0.0, 0.0], [1.0, 0.0, 0.0]),
+        ([wall, 0.0, 0.0], [-1.0, 0.0, 0.0]),
+        ([0.0, -wall, 0.0], [0.0, 1.0, 0.0]),
+        ([0.0, wall, 0.0], [0.0, -1.0, 0.0]),
+    ] {
+        scene.half_spaces.push(HalfSpace {
+            point: p.to_vec(),
+            normal: n.to_vec(),
+        });
+    }
+    for k in 0..count {
+        let (i, j, l) = (k % side, (k / side) % side, k / (side * side));
+        let x = -(side as f64) * spacing / 2.0 + spacing * (i as f64 + 0.5);
+        let y = -(side as f64) * spacing / 2.0 + spacing * (j as f64 + 0.5);
+        let z = 1.5 * half + spacing * l as f64;
+        let a = 10f64.to_radians() * (k % 3) as f64;
+        let q0 = [x, y, z, (a / 2.0).cos(), 0.0, 0.0, (a / 2.0).sin()];
+        cube(&mut scene, half, 0.1, q0)?;
+        for w in 0..5 {
+            scene.pairs.push(Pair::ShapeHalfSpace {
+                shape: k,
+                half_space: w,
+                mu: 0.5,
+                e: 0.0,
+            });
+        }
+    }
+    scene.pairs.push(Pair::Solids { mu: 0.5, e: 0.0 });
+    Ok(scene)
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
     let which = args.get(1).map_or("ramp", |s| s.as_str());
@@ -178,10 +294,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ),
         "pile" => (pile(arg(2, 100), false), arg(3, 1000)),
         "pile-declared" => (pile(arg(2, 100), true), arg(3, 1000)),
+        "tower" => (tower(arg(2, 10))?, arg(3, 2000)),
+        "box-pile" => (box_pile(arg(2, 125))?, arg(3, 1000)),
         other => {
-            return Err(
-                format!("unknown scene {other:?}: ramp, resting, pile or pile-declared").into(),
+            return Err(format!(
+                "unknown scene {other:?}: ramp, resting, pile, pile-declared, tower or box-pile"
             )
+            .into())
         }
     };
     let mut settings = StepSettings::new(1e-3, steps);

@@ -163,48 +163,56 @@ class ConvexHull(Shape):
 @dataclass(eq=False)
 class Compound(Shape):
     """The union of convex ``parts``, each ``(shape, center, orientation)`` in the body frame
-    (``center``, ``orientation`` may be None); the parts are spheres, boxes, capsules,
-    cylinders, cones and convex hulls. Spatial scenes."""
+    (``center``, ``orientation`` may be None; 3D: a quaternion ``(w, x, y, z)``, 2D: an angle
+    in rad); the parts are spheres (disks), boxes, capsules, segments, convex polygons or
+    hulls, and in 3D cylinders and cones."""
 
-    parts: Sequence[tuple[Shape, Sequence[float] | None, Sequence[float] | None]] = ()
+    parts: Sequence[tuple[Shape, Sequence[float] | None, Any]] = ()
 
     _point_form = False
 
     def _points(self, dim: int) -> tuple[list[list[float]], float]:
-        if dim != 3:
-            raise InvalidParameterError("a Compound needs a spatial scene (dim=3)")
         if len(self.parts) == 0:
             raise ShapeError("a compound needs at least one part")
         out: list[list[float]] = []
-        for shape, center, orientation in self.parts:
-            pose = _pose(3, center, orientation)
-            pts, _ = shape._points(3)
-            rot = _rotation(pose[3:])
-            out += (np.asarray(pts) @ rot.T + np.asarray(pose[:3])).tolist()
-        return out, 0.0
-
-    def _solid(self, dim: int) -> dict[str, Any]:
-        self._points(dim)
-        parts = []
         for k, part in enumerate(self.parts):
             if not (isinstance(part, tuple) and len(part) == 3):
                 raise ShapeError(f"compound part {k} must be (shape, center, orientation)")
             shape, center, orientation = part
             if not isinstance(shape, Shape):
                 raise InvalidParameterError(f"compound part {k} is not a shape")
-            spec = shape._solid(3)
+            pose = _pose(dim, center, orientation)
+            pts, _ = shape._points(dim)
+            rot = _rotation(pose[3:]) if dim == 3 else _rotation2(pose[2])
+            out += (np.asarray(pts) @ rot.T + np.asarray(pose[:dim])).tolist()
+        return out, 0.0
+
+    def _solid(self, dim: int) -> dict[str, Any]:
+        self._points(dim)
+        parts = []
+        for k, (shape, center, orientation) in enumerate(self.parts):
+            spec = shape._solid(dim)
             if spec is None or spec["kind"] == "compound":
                 raise InvalidParameterError(
                     f"compound part {k} ({type(shape).__name__}) is not a convex solid")
-            inner = _rotation(spec["pose"][3:])
-            outer = _pose(3, center, orientation)
-            rot = _rotation(outer[3:])
-            # the part's own pose composed into the compound's frame
-            c = (rot @ np.asarray(spec["pose"][:3]) + np.asarray(outer[:3])).tolist()
-            q = _quaternion(rot @ inner)
-            spec["pose"] = c + q
+            outer = _pose(dim, center, orientation)
+            if dim == 2:
+                rot2 = _rotation2(outer[2])
+                c = (rot2 @ np.asarray(spec["pose"][:2]) + np.asarray(outer[:2])).tolist()
+                spec["pose"] = [*c, outer[2] + spec["pose"][2]]
+            else:
+                inner = _rotation(spec["pose"][3:])
+                rot = _rotation(outer[3:])
+                # the part's own pose composed into the compound's frame
+                c = (rot @ np.asarray(spec["pose"][:3]) + np.asarray(outer[:3])).tolist()
+                spec["pose"] = c + _quaternion(rot @ inner)
             parts.append(spec)
-        return {"kind": "compound", "parts": parts, "pose": _pose(3, None, None)}
+        return {"kind": "compound", "parts": parts, "pose": _pose(dim, None, None)}
+
+
+def _rotation2(angle: float) -> np.ndarray:
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([[c, -s], [s, c]])
 
 
 def _quaternion(r: np.ndarray) -> list[float]:
@@ -229,7 +237,7 @@ def _quaternion(r: np.ndarray) -> list[float]:
 @dataclass(eq=False)
 class StaticSolid:
     """Base class of the static solids (added to a scene with ``scene.add``, fixed in the
-    world): :class:`TriangleMesh`, :class:`Heightfield`."""
+    world): :class:`TriangleMesh`, :class:`Heightfield` (3D), :class:`Polyline` (2D)."""
 
     position: Sequence[float] = field(default=(0.0, 0.0, 0.0), kw_only=True)
 
@@ -261,6 +269,28 @@ class TriangleMesh(StaticSolid):
         return {"kind": "triangle_mesh", "vertices": v.tolist(),
                 "triangles": t.astype(np.int64).tolist(),
                 "pose": [*_vector("position", self.position, 3), 1.0, 0.0, 0.0, 0.0]}
+
+
+@dataclass(eq=False)
+class Polyline(StaticSolid):
+    """A static polyline (planar scenes: a terrain, a bin's profile): world-frame ``vertices``
+    (``n x 2``, n >= 2, shifted by ``position``), no segment of zero length. Bodies touch it
+    from either side; a contact on a segment takes the segment's normal. A shape of no
+    thickness (a :class:`Segment` without radius) resting on it has no defined normal (both
+    sides touch): give it a radius."""
+
+    vertices: Sequence[Sequence[float]] = ()
+    position: Sequence[float] = field(default=(0.0, 0.0), kw_only=True)
+
+    def _solid(self, dim: int) -> dict[str, Any]:
+        if dim != 2:
+            raise InvalidParameterError(
+                "a Polyline needs a planar scene (dim=2); in 3D use a TriangleMesh")
+        v = np.asarray(self.vertices, dtype=np.float64)
+        if v.ndim != 2 or v.shape[1] != 2 or v.shape[0] < 2:
+            raise ShapeError(f"vertices must be n x 2 (n >= 2), got shape {v.shape}")
+        return {"kind": "polyline", "vertices": v.tolist(),
+                "pose": [*_vector("position", self.position, 2), 0.0]}
 
 
 @dataclass(eq=False)

@@ -79,6 +79,7 @@ from ._solids import (
     ConvexHull,
     Cylinder,
     Heightfield,
+    Polyline,
     Shape,
     StaticSolid,
     TriangleMesh,
@@ -110,6 +111,7 @@ __all__ = [
     "Particle",
     "Point",
     "Polygon",
+    "Polyline",
     "RigidBody2D",
     "RigidBody3D",
     "Scene",
@@ -273,11 +275,13 @@ class Scene:
         friction coefficient ``mu >= 0`` and Newton restitution ``e`` in [0, 1], without
         declaring the pairs: the stepper finds the pairs whose bounding boxes (grown by what
         a step can close) meet, every step (a broad phase, a uniform grid, O(N) per step), and
-        asks the narrow phase for their contact points. Half-spaces are not included: declare
-        each shape's contact with a floor by :meth:`contact`. A pair declared by
+        asks the narrow phase for their contact points. Every attached shape also touches
+        every half-space (each pair as :meth:`contact` would declare it, after the declared
+        pairs: a point shape by its points, a solid by the narrow phase). A pair declared by
         :meth:`contact` keeps that declaration's ``mu`` and ``e`` (per-pair overrides).
         Shapes of no volume (:class:`Point`, a sphere of radius 0, a :class:`Polygon` of
-        collinear points) are left out.
+        collinear points) are left out of the shape pairs; against half-spaces they touch by
+        their points.
 
         A contact found this way is named by its pair of shapes and its touching features,
         so warm starts and impact memory follow the same contact point from step to step;
@@ -340,6 +344,7 @@ class Scene:
                 # phase leaves it to the declaration
                 k, ia, ib = "solid", solid_index[id(a)], solid_index[id(b)]
             pairs.append({"kind": k, "a": ia, "b": ib, "mu": mu, "e": e})
+        pairs += self._all_half_space_pairs(shape_index, solid_index, hs_index)
         return {
             "dim": self.dim,
             "gravity": self.gravity,
@@ -354,6 +359,29 @@ class Scene:
             "solids": solids,
             "joints": [j._spec(self.dim, self.bodies) for j in self.joints],
         }
+
+    def _all_half_space_pairs(self, shape_index: dict[int, int], solid_index: dict[int, int],
+                              hs_index: dict[int, int]) -> list[dict[str, Any]]:
+        """Under :meth:`contact_all`, every attached shape against every half-space not
+        declared by :meth:`contact`, in the order of the shapes, then of the half-spaces (the
+        order the same pairs declared by hand would have), with contact_all's mu and e."""
+        auto = [p for p in self.pairs if p[0] == "solids"]
+        if not auto:
+            return []
+        _, _, _, mu, e = auto[0]
+        declared = {(id(a), id(b)) for k, a, b, _, _ in self.pairs
+                    if k in ("half_space", "solid_half_space")}
+        out = []
+        for _, shape in self.shapes:
+            for h in self.half_spaces:
+                if (id(shape), id(h)) in declared:
+                    continue
+                if shape._point_form:
+                    kind, ia = "half_space", shape_index[id(shape)]
+                else:
+                    kind, ia = "solid_half_space", solid_index[id(shape)]
+                out.append({"kind": kind, "a": ia, "b": hs_index[id(h)], "mu": mu, "e": e})
+        return out
 
     def layout(self) -> list[tuple[slice, slice]]:
         """The slices of each body's coordinates and velocities in ``q`` and ``v``."""

@@ -33,10 +33,12 @@
 //! shared edge). A face contact's normal is the face's own (polygons and polyhedra): parry
 //! takes GJK's direction, accurate near touch only to about 1e-7.
 //!
-//! Allocation: a warm query between separated shapes allocates nothing; a touching one still
-//! allocates inside parry (its half-space manifold replaces the point buffer, its polygon
-//! clipping and its mesh and heightfield traversals use temporary vectors), a few
-//! allocations per query to a few tens for meshes and heightfields.
+//! Allocation: a warm query between separated shapes allocates nothing, nor does a touching
+//! or overlapping one between convex shapes with polygonal features or of one against a
+//! half-space (module `convex`: the manifold, GJK's simplex and EPA's buffers kept in the
+//! cache); balls, compounds, meshes and heightfields go through parry's dispatcher, which
+//! still allocates inside touching queries (a few allocations per query, a few tens for
+//! meshes and heightfields).
 
 use nalgebra::{Isometry2, Isometry3, Point2, Point3, Vector2, Vector3};
 use parry2d_f64::query::{
@@ -53,6 +55,7 @@ use parry3d_f64::query::{
 use parry2d_f64::shape::Shape as Parry2;
 use parry3d_f64::shape::Shape as Parry3;
 
+use super::convex::{convex2, convex3, Convex2, Convex3};
 use super::shape2::{check_pose2, Shape2};
 use super::shape3::{check_pose3, Shape3};
 use crate::error::{CoulombError, Result};
@@ -102,6 +105,7 @@ pub struct ContactPoint2 {
 pub struct ContactCache3 {
     manifolds: Vec<Manifold3<(), ()>>,
     workspace: Option<Workspace3>,
+    convex: Convex3,
     retry: Vec<ContactPoint3>,
     scaled: Option<Scaled<dyn Parry3>>,
 }
@@ -111,6 +115,7 @@ pub struct ContactCache3 {
 pub struct ContactCache2 {
     manifolds: Vec<Manifold2<(), ()>>,
     workspace: Option<Workspace2>,
+    convex: Convex2,
     retry: Vec<ContactPoint2>,
     scaled: Option<Scaled<dyn Parry2>>,
 }
@@ -188,8 +193,9 @@ fn face_normal3(shape: &dyn Parry3, fid: u32) -> Option<Vector3<f64>> {
 }
 
 /// The unit normal of triangle `part` of a triangle mesh or heightfield (its winding's, which
-/// the mesh's validation makes the outward one), in the shape's frame.
-fn part_normal3(shape: &dyn Parry3, part: u32) -> Option<Vector3<f64>> {
+/// the mesh's validation makes the outward one), in the shape's frame (`_toward` unused: a
+/// mesh is one-sided).
+fn part_normal3(shape: &dyn Parry3, part: u32, _toward: Vector3<f64>) -> Option<Vector3<f64>> {
     let tri = if let Some(mesh) = shape.as_trimesh() {
         (part < mesh.num_triangles() as u32).then(|| mesh.triangle(part))?
     } else {
@@ -198,9 +204,14 @@ fn part_normal3(shape: &dyn Parry3, part: u32) -> Option<Vector3<f64>> {
     tri.normal().map(|n| n.into_inner())
 }
 
-/// 2D shapes have no parts with faces of their own.
-fn part_normal2(_shape: &dyn Parry2, _part: u32) -> Option<Vector2<f64>> {
-    None
+/// The unit normal of segment `part` of a polyline, in its frame, on the side of `toward` (a
+/// polyline is two-sided: the normal is the segment's left one or its opposite).
+fn part_normal2(shape: &dyn Parry2, part: u32, toward: Vector2<f64>) -> Option<Vector2<f64>> {
+    let line = shape.as_polyline()?;
+    let seg = (part < line.num_segments() as u32).then(|| line.segment(part))?;
+    let d = seg.b - seg.a;
+    let n = Vector2::new(-d.y, d.x).try_normalize(0.0)?;
+    Some(if n.dot(&toward) < 0.0 { -n } else { n })
 }
 
 /// The face of one shape that a manifold's points lie on: the one face feature among the
@@ -236,7 +247,8 @@ const NEAR: f64 = 1e-3;
 macro_rules! contacts_impl {
     ($(#[$doc:meta])* $name:ident, $raw:ident, $shape:ty, $iso:ident, $vec:ident, $point:ident,
      $cache:ident, $dispatcher:ident, $check_pose:ident, $manifold:ty, $workspace:ty,
-     $dynshape:ty, $tracked:ident, $face:ident, $part_face:ident) => {
+     $dynshape:ty, $tracked:ident, $face:ident, $part_face:ident, $convex:ident,
+     $convex_ws:ty) => {
         /// parry's manifolds of `a` at `pose_a` and `b` at `pose_b` translated by `shift`,
         /// converted; gaps taken back to the unshifted poses (`g - n · shift`, exact while the
         /// same features touch), kept when `<= prediction`.
@@ -249,7 +261,7 @@ macro_rules! contacts_impl {
             shift: $vec<f64>,
             prediction: f64,
             manifolds: &mut Vec<$manifold>,
-            workspace: &mut Option<$workspace>,
+            (workspace, convex): (&mut Option<$workspace>, &mut $convex_ws),
             out: &mut Vec<$point>,
         ) -> Result<()> {
             out.clear();
@@ -269,9 +281,13 @@ macro_rules! contacts_impl {
             );
             let pos12 = at.inv_mul(&bt);
             let query = (prediction + shift.norm()) * inv;
-            $dispatcher
-                .contact_manifolds(&pos12, a, b, query, manifolds, workspace)
-                .map_err(|_| unsupported(format!("{:?} and {:?}", a.shape_type(), b.shape_type())))?;
+            if !$convex(&pos12, a, b, query, manifolds, convex) {
+                $dispatcher
+                    .contact_manifolds(&pos12, a, b, query, manifolds, workspace)
+                    .map_err(|_| {
+                        unsupported(format!("{:?} and {:?}", a.shape_type(), b.shape_type()))
+                    })?;
+            }
             for m in manifolds.iter() {
                 let part_a = m.subshape_pos1.unwrap_or_else($iso::identity);
                 let part_b = m.subshape_pos2.unwrap_or_else($iso::identity);
@@ -286,14 +302,16 @@ macro_rules! contacts_impl {
                 // triangle (whose parts are in the shape's own frame)
                 let face_b = match shared_face(m.points.iter().map(|p| fid(p, true))) {
                     Some(f) if m.subshape_pos2.is_none() => {
-                        $face(b, f).or_else(|| $part_face(b, m.subshape2))
+                        let toward = pose_b.rotation.inverse() * -normal;
+                        $face(b, f).or_else(|| $part_face(b, m.subshape2, toward))
                     }
                     _ => None,
                 }
                 .map(|n| -(pose_b.rotation * n));
                 let face_a = match shared_face(m.points.iter().map(|p| fid(p, false))) {
                     Some(f) if m.subshape_pos1.is_none() => {
-                        $face(a, f).or_else(|| $part_face(a, m.subshape1))
+                        let toward = pose_a.rotation.inverse() * normal;
+                        $face(a, f).or_else(|| $part_face(a, m.subshape1, toward))
                     }
                     _ => None,
                 }
@@ -374,7 +392,7 @@ macro_rules! contacts_impl {
             if a.is_static() && b.is_static() {
                 return Err(both_static());
             }
-            let $cache { manifolds, workspace, retry, scaled } = cache;
+            let $cache { manifolds, workspace, convex, retry, scaled } = cache;
             let size = match (a.size(), b.size()) {
                 (Some(x), Some(y)) => x.min(y),
                 (Some(x), None) | (None, Some(x)) => x,
@@ -395,7 +413,8 @@ macro_rules! contacts_impl {
                 _ => ((a.parry(), b.parry()), 1.0),
             };
             let zero = $vec::zeros();
-            $raw(shapes, unit, pose_a, pose_b, zero, prediction, manifolds, workspace, out)?;
+            let ws = (&mut *workspace, &mut *convex);
+            $raw(shapes, unit, pose_a, pose_b, zero, prediction, manifolds, ws, out)?;
             let first = deepest_gap(out, |p| p.gap);
             // a half-space's points are its support feature's vertices: no GJK to go wrong
             if first > TOUCH * size || a.is_half_space() || b.is_half_space() {
@@ -413,7 +432,8 @@ macro_rules! contacts_impl {
                 }
             };
             let shift = along * (PULL * size);
-            $raw(shapes, unit, pose_a, pose_b, shift, prediction, manifolds, workspace, retry)?;
+            let ws = (&mut *workspace, &mut *convex);
+            $raw(shapes, unit, pose_a, pose_b, shift, prediction, manifolds, ws, retry)?;
             let second = deepest_gap(retry, |p| p.gap);
             if first <= second + PREFER * size {
                 std::mem::swap(out, retry);
@@ -438,11 +458,13 @@ contacts_impl!(
     /// `n · shift`), and the answer with the larger deepest gap is kept (the second one unless
     /// the first beats it by more than `1e-12 L`).
     contacts3, raw3, Shape3, Isometry3, Vector3, ContactPoint3, ContactCache3, Dispatcher3,
-    check_pose3, Manifold3<(), ()>, Workspace3, dyn Parry3, Tracked3, face_normal3, part_normal3
+    check_pose3, Manifold3<(), ()>, Workspace3, dyn Parry3, Tracked3, face_normal3, part_normal3,
+    convex3, Convex3
 );
 
 contacts_impl!(
     /// [`contacts3`] in 2D.
     contacts2, raw2, Shape2, Isometry2, Vector2, ContactPoint2, ContactCache2, Dispatcher2,
-    check_pose2, Manifold2<(), ()>, Workspace2, dyn Parry2, Tracked2, face_normal2, part_normal2
+    check_pose2, Manifold2<(), ()>, Workspace2, dyn Parry2, Tracked2, face_normal2, part_normal2,
+    convex2, Convex2
 );

@@ -39,6 +39,7 @@
 
 pub mod broad;
 pub mod contact;
+mod convex;
 pub mod shape2;
 pub mod shape3;
 mod validate;

@@ -1,10 +1,15 @@
 //! Shapes in 2D, each built by a validating constructor.
 //!
 //! Body frames: a disk is centred at the origin; a capsule is the set of points within
-//! `radius` of its segment; a half-space is `{x : n · x <= 0}` with its outward unit normal.
+//! `radius` of its segment; a half-space is `{x : n · x <= 0}` with its outward unit normal; a
+//! compound's parts are at their poses in its frame; a polyline (static) is its vertices in the
+//! world frame.
 
 use nalgebra::{Isometry2, Point2, Unit, Vector2};
-use parry2d_f64::shape::{Ball, Capsule, ConvexPolygon, HalfSpace, Segment, Shape as ParryShape};
+use parry2d_f64::shape::{
+    Ball, Capsule, Compound, ConvexPolygon, HalfSpace, Polyline, Segment, Shape as ParryShape,
+    SharedShape,
+};
 
 use super::validate::{extent, finite_points, positive, spans_2d};
 use crate::error::{CoulombError, Result};
@@ -16,6 +21,8 @@ pub enum ShapeKind2 {
     ConvexPolygon,
     Segment,
     Capsule,
+    Compound,
+    Polyline,
     HalfSpace,
 }
 
@@ -25,6 +32,8 @@ enum Repr2 {
     ConvexPolygon(ConvexPolygon),
     Segment(Segment),
     Capsule(Capsule),
+    Compound(Compound),
+    Polyline(Polyline),
     HalfSpace(HalfSpace),
 }
 
@@ -109,6 +118,54 @@ impl Shape2 {
         ))))
     }
 
+    /// The union of convex `parts` (disks, convex polygons, segments, capsules; at least
+    /// one), each at its pose in the compound's frame.
+    pub fn compound(parts: &[(Isometry2<f64>, Shape2)]) -> Result<Self> {
+        if parts.is_empty() {
+            return Err(CoulombError::Shape(
+                "a compound needs at least one part".into(),
+            ));
+        }
+        let mut shared = Vec::with_capacity(parts.len());
+        for (k, (pose, part)) in parts.iter().enumerate() {
+            check_pose2(&format!("compound part {k}"), pose)?;
+            if part.is_static() || part.kind() == ShapeKind2::Compound {
+                return Err(CoulombError::InvalidParameter(format!(
+                    "compound part {k} is a {:?}: parts must be convex",
+                    part.kind()
+                )));
+            }
+            shared.push((*pose, SharedShape(part.parry().clone_dyn().into())));
+        }
+        Ok(Self::new(Repr2::Compound(Compound::new(shared))))
+    }
+
+    /// A static polyline through `vertices` (finite, at least two, no segment shorter than
+    /// `1e-9` of the polyline's extent). Bodies touch it from either side; a contact on a
+    /// segment's interior takes the segment's normal (the left of the direction of travel,
+    /// or its opposite: the side the body is on).
+    pub fn polyline(vertices: &[[f64; 2]]) -> Result<Self> {
+        finite_points("polyline vertices", vertices)?;
+        if vertices.len() < 2 {
+            return Err(CoulombError::Shape(format!(
+                "a polyline needs at least two vertices, got {}",
+                vertices.len()
+            )));
+        }
+        let scale = extent(vertices);
+        for (k, w) in vertices.windows(2).enumerate() {
+            let len = extent(w);
+            if len <= super::validate::FLAT * scale || len == 0.0 {
+                return Err(CoulombError::InvalidParameter(format!(
+                    "polyline segment {k} from {:?} to {:?} has zero length",
+                    w[0], w[1]
+                )));
+            }
+        }
+        let pts: Vec<Point2<f64>> = vertices.iter().map(|&p| p.into()).collect();
+        Ok(Self::new(Repr2::Polyline(Polyline::new(pts, None))))
+    }
+
     /// The half-plane `{x : n · x <= 0}` of outward `normal` (finite, nonzero; normalised).
     pub fn half_space(normal: [f64; 2]) -> Result<Self> {
         finite_points("half-space normal", &[normal])?;
@@ -141,13 +198,16 @@ impl Shape2 {
             Repr2::ConvexPolygon(_) => ShapeKind2::ConvexPolygon,
             Repr2::Segment(_) => ShapeKind2::Segment,
             Repr2::Capsule(_) => ShapeKind2::Capsule,
+            Repr2::Compound(_) => ShapeKind2::Compound,
+            Repr2::Polyline(_) => ShapeKind2::Polyline,
             Repr2::HalfSpace(_) => ShapeKind2::HalfSpace,
         }
     }
 
-    /// Whether the shape is static only (the half-space): two static shapes never touch.
+    /// Whether the shape is static only (a polyline, a half-space): two static shapes never
+    /// touch.
     pub fn is_static(&self) -> bool {
-        self.kind() == ShapeKind2::HalfSpace
+        matches!(self.kind(), ShapeKind2::Polyline | ShapeKind2::HalfSpace)
     }
 
     /// Whether the shape is a half-space (whose contacts parry computes in closed form).
@@ -162,6 +222,8 @@ impl Shape2 {
             Repr2::ConvexPolygon(s) => s,
             Repr2::Segment(s) => s,
             Repr2::Capsule(s) => s,
+            Repr2::Compound(s) => s,
+            Repr2::Polyline(s) => s,
             Repr2::HalfSpace(s) => s,
         }
     }
@@ -195,5 +257,13 @@ mod tests {
         assert!(Shape2::capsule([0.0, 0.0], [1.0, 0.0], 0.0).is_err());
         assert!(Shape2::half_space([0.0, 0.0]).is_err());
         assert!(Shape2::half_space([f64::NAN, 1.0]).is_err());
+        assert!(Shape2::compound(&[]).is_err());
+        let floor = Shape2::half_space([0.0, 1.0]);
+        if let Ok(floor) = floor {
+            assert!(Shape2::compound(&[(Isometry2::identity(), floor)]).is_err());
+        }
+        assert!(Shape2::polyline(&[[0.0, 0.0]]).is_err());
+        assert!(Shape2::polyline(&[[0.0, 0.0], [1.0, 0.0], [1.0, 0.0]]).is_err());
+        assert!(Shape2::polyline(&[[0.0, 0.0], [f64::INFINITY, 0.0]]).is_err());
     }
 }

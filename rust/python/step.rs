@@ -168,28 +168,66 @@ fn solid_shape(s: &Bound<'_, PyDict>, dim: usize) -> Result<SolidShape, CoulombE
         v.extract::<T>()
             .map_err(|_| CoulombError::Shape(format!("solid entry {key:?} has the wrong type")))
     }
-    let f = |key: &str| -> Result<f64, CoulombError> { ex(get(key)?, key) };
     let kind: String = ex(get("kind")?, "kind")?;
     if dim == 2 {
-        let p2 = |key: &str| -> Result<[f64; 2], CoulombError> { ex(get(key)?, key) };
-        let shape = match kind.as_str() {
-            "disk" | "sphere" => Shape2::disk(f("radius")?)?,
-            "box" => Shape2::rectangle(p2("half_extents")?)?,
-            "polygon" | "convex_hull" => {
-                let pts: Vec<[f64; 2]> = ex(get("points")?, "points")?;
-                Shape2::convex_polygon(&pts)?
-            }
-            "segment" => Shape2::segment(p2("a")?, p2("b")?)?,
-            "capsule" => Shape2::capsule(p2("a")?, p2("b")?, f("radius")?)?,
-            other => {
-                return Err(CoulombError::InvalidParameter(format!(
-                    "no 2D solid of kind {other:?}"
-                )))
-            }
-        };
-        return Ok(SolidShape::Planar(shape));
+        return Ok(SolidShape::Planar(shape2(s, &kind)?));
     }
     Ok(SolidShape::Spatial(shape3(s, &kind)?))
+}
+
+/// a 2D shape from a solid's dict (a compound's parts recursively).
+fn shape2(s: &Bound<'_, PyDict>, kind: &str) -> Result<Shape2, CoulombError> {
+    fn ex<'py, T: FromPyObjectOwned<'py>>(
+        s: &Bound<'py, PyDict>,
+        key: &str,
+    ) -> Result<T, CoulombError> {
+        s.get_item(key)
+            .ok()
+            .flatten()
+            .ok_or_else(|| CoulombError::Shape(format!("solid entry {key:?} is missing")))?
+            .extract::<T>()
+            .map_err(|_| CoulombError::Shape(format!("solid entry {key:?} has the wrong type")))
+    }
+    let f = |key: &str| -> Result<f64, CoulombError> { ex(s, key) };
+    let p2 = |key: &str| -> Result<[f64; 2], CoulombError> { ex(s, key) };
+    Ok(match kind {
+        "disk" | "sphere" => Shape2::disk(f("radius")?)?,
+        "box" => Shape2::rectangle(p2("half_extents")?)?,
+        "polygon" | "convex_hull" => {
+            let pts: Vec<[f64; 2]> = ex(s, "points")?;
+            Shape2::convex_polygon(&pts)?
+        }
+        "segment" => Shape2::segment(p2("a")?, p2("b")?)?,
+        "capsule" => Shape2::capsule(p2("a")?, p2("b")?, f("radius")?)?,
+        "polyline" => {
+            let v: Vec<[f64; 2]> = ex(s, "vertices")?;
+            Shape2::polyline(&v)?
+        }
+        "compound" => {
+            let parts: Vec<Bound<'_, PyDict>> = ex(s, "parts")?;
+            let mut out = Vec::with_capacity(parts.len());
+            for p in &parts {
+                let k: String = ex(p, "kind")?;
+                let pose: Vec<f64> = ex(p, "pose")?;
+                if pose.len() != 3 {
+                    return Err(CoulombError::Shape(format!(
+                        "a 2D compound part's pose has {} entries, expected 3",
+                        pose.len()
+                    )));
+                }
+                crate::error::check_finite("compound part pose", &pose)?;
+                let iso =
+                    nalgebra::Isometry2::new(nalgebra::Vector2::new(pose[0], pose[1]), pose[2]);
+                out.push((iso, shape2(p, &k)?));
+            }
+            Shape2::compound(&out)?
+        }
+        other => {
+            return Err(CoulombError::InvalidParameter(format!(
+                "no 2D solid of kind {other:?}"
+            )))
+        }
+    })
 }
 
 /// a 3D shape from a solid's dict (a compound's parts recursively).

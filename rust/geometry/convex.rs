@@ -1,0 +1,182 @@
+//! The manifold of two convex shapes with polygonal features (convex polygons and polyhedra,
+//! segments, capsules, cylinders, cones), or of one of them against a half-space, written into
+//! a manifold kept by the pair, with GJK's simplex and EPA's buffers kept by the pair too: a
+//! query allocates nothing once the buffers have grown (parry's dispatcher makes a new EPA, and
+//! a new point buffer against a half-space, at every query).
+//!
+//! The contact is that of parry's own convex-convex and half-space manifolds, built from its
+//! public primitives (Gilbert-Johnson-Keerthi distance, the expanding polytope when the shapes
+//! overlap, and the clipping of the two support features):
+//!
+//! - two convex shapes `A`, `B` (`B` at `pos12` in `A`'s frame), each the Minkowski sum of a
+//!   polytope and a ball of radius `r`: GJK (EPA when the polytopes overlap) gives the
+//!   closest points `p_1`, `p_2` and the unit direction `n_1` from `A` to `B` of the polytopes;
+//!   the support features of `A` along `n_1` and of `B` along `-n_1` are clipped against each
+//!   other, each point's distance `(p_2 - p_1) · n_1 - r_A - r_B`; in 3D GJK's own pair is
+//!   added (the caller drops it where it is redundant), in 2D only when the clip gave none;
+//! - a shape against the half-space `{x : m · x <= 0}`: the support feature of the shape along
+//!   `-m`, each vertex `v` kept when `m · v - r <= prediction`, its partner `v - (m · v) m` on
+//!   the plane.
+//!
+//! Both are the separating-axis construction of a manifold (Acary-Brogliato 2008, ch. 3;
+//! Stewart 2000, §2: the gap function along the normal). Other pairs (balls, compounds,
+//! meshes, heightfields) go through parry's dispatcher.
+
+use nalgebra::Unit;
+use parry2d_f64::query::ContactManifold as Manifold2;
+use parry3d_f64::query::ContactManifold as Manifold3;
+
+macro_rules! convex_impl {
+    ($ws:ident, $query:ident, $parry:ident, $manifold:ty, $dim3:expr) => {
+        /// GJK's simplex and EPA's buffers of one pair, kept from query to query.
+        pub(super) struct $ws {
+            simplex: $parry::query::gjk::VoronoiSimplex,
+            epa: $parry::query::epa::EPA,
+        }
+
+        impl Default for $ws {
+            fn default() -> Self {
+                Self {
+                    simplex: $parry::query::gjk::VoronoiSimplex::new(),
+                    epa: $parry::query::epa::EPA::new(),
+                }
+            }
+        }
+
+        /// The manifold of `a` and `b` (at `pos12` in `a`'s frame) into `manifolds` (one
+        /// manifold, its points replaced), when the pair is one this module handles (module
+        /// docs); `false`, with `manifolds` untouched, for any other pair.
+        pub(super) fn $query(
+            pos12: &$parry::math::Isometry<f64>,
+            a: &dyn $parry::shape::Shape,
+            b: &dyn $parry::shape::Shape,
+            prediction: f64,
+            manifolds: &mut Vec<$manifold>,
+            ws: &mut $ws,
+        ) -> bool {
+            use $parry::shape::ShapeType as T;
+            let (ta, tb) = (a.shape_type(), b.shape_type());
+            // parry's dispatcher has closed forms for these (and composites go through their
+            // parts): left to it
+            let special = |t| matches!(t, T::Ball | T::Cuboid | T::Triangle | T::HalfSpace);
+            let both_capsules = ta == T::Capsule && tb == T::Capsule;
+            if special(ta) || both_capsules {
+                return false;
+            }
+            let Some((pfm_a, ra)) = a.as_polygonal_feature_map() else {
+                return false;
+            };
+            let half_space = if tb == T::HalfSpace {
+                b.as_halfspace()
+            } else {
+                None
+            };
+            let other = if half_space.is_none() {
+                if special(tb) {
+                    return false;
+                }
+                match b.as_polygonal_feature_map() {
+                    Some(x) => Some(x),
+                    None => return false,
+                }
+            } else {
+                None
+            };
+            if manifolds.len() != 1 {
+                manifolds.clear();
+                manifolds.push(<$manifold>::new());
+            }
+            let m = &mut manifolds[0];
+            m.points.clear();
+            if let Some(hs) = half_space {
+                // the half-space is b: its frame is a's moved by pos12
+                let n = hs.normal;
+                let n_a = pos12 * n;
+                let mut feature = $parry::shape::PolygonalFeature::default();
+                pfm_a.local_support_feature(&-n_a, &mut feature);
+                let pos21 = pos12.inverse();
+                for i in 0..feature.num_vertices {
+                    let v = feature.vertices[i];
+                    let v_b = pos21 * v;
+                    let d = v_b.coords.dot(&n);
+                    if d - ra <= prediction {
+                        m.points.push($parry::query::TrackedContact::new(
+                            v - *n_a * ra,
+                            v_b - *n * d,
+                            feature.vids[i],
+                            $parry::shape::PackedFeatureId::face(0),
+                            d - ra,
+                        ));
+                    }
+                }
+                m.local_n1 = -*n_a;
+                m.local_n2 = *n;
+                return true;
+            }
+            let Some((pfm_b, rb)) = other else {
+                return false;
+            };
+            use $parry::query::gjk::{self, CSOPoint, GJKResult};
+            let dir = Unit::try_new(pos12.translation.vector, $parry::math::DEFAULT_EPSILON)
+                .unwrap_or_else($parry::math::Vector::x_axis);
+            ws.simplex
+                .reset(CSOPoint::from_shapes(pos12, pfm_a, pfm_b, &dir));
+            let total = prediction + ra + rb;
+            let result =
+                match gjk::closest_points(pos12, pfm_a, pfm_b, total, true, &mut ws.simplex) {
+                    GJKResult::Intersection => ws
+                        .epa
+                        .closest_points(pos12, pfm_a, pfm_b, &ws.simplex)
+                        .map_or(
+                            GJKResult::NoIntersection($parry::math::Vector::x_axis()),
+                            |(p, q, n)| GJKResult::ClosestPoints(p, q, n),
+                        ),
+                    r => r,
+                };
+            match result {
+                GJKResult::ClosestPoints(p1, p2_1, n1) => {
+                    let n2 = pos12.inverse_transform_unit_vector(&-n1);
+                    let mut f1 = $parry::shape::PolygonalFeature::default();
+                    let mut f2 = $parry::shape::PolygonalFeature::default();
+                    pfm_a.local_support_feature(&n1, &mut f1);
+                    pfm_b.local_support_feature(&n2, &mut f2);
+                    $parry::shape::PolygonalFeature::contacts(
+                        pos12,
+                        &pos12.inverse(),
+                        &n1,
+                        &n2,
+                        &f1,
+                        &f2,
+                        m,
+                        false,
+                    );
+                    if $dim3 || m.points.is_empty() {
+                        let unknown = $parry::shape::PackedFeatureId::UNKNOWN;
+                        m.points.push($parry::query::TrackedContact::new(
+                            p1,
+                            pos12.inverse_transform_point(&p2_1),
+                            unknown,
+                            unknown,
+                            (p2_1 - p1).dot(&n1),
+                        ));
+                    }
+                    if ra != 0.0 || rb != 0.0 {
+                        for p in &mut m.points {
+                            p.local_p1 += *n1 * ra;
+                            p.local_p2 += *n2 * rb;
+                            p.dist -= ra + rb;
+                        }
+                    }
+                    m.local_n1 = *n1;
+                    m.local_n2 = *n2;
+                }
+                GJKResult::NoIntersection(d) => m.local_n1 = *d,
+                _ => m.local_n1.fill(0.0),
+            }
+            true
+        }
+    };
+}
+
+convex_impl!(Convex3, convex3, parry3d_f64, Manifold3<(), ()>, true);
+convex_impl!(Convex2, convex2, parry2d_f64, Manifold2<(), ()>, false);
