@@ -327,22 +327,43 @@ impl Recorded for Stepper {
     }
 }
 
+/// A diagonal block of M for [`momentum_residual`]: entry `(a, c)` is `m[a stride + c]`,
+/// acting on the velocities `off..off + n` (a body of a scene, or a model's whole M); rows
+/// and columns `0..lead` carry only their diagonal entry and the rows `lead..n` only the
+/// columns `lead..n` (a rigid body's `diag(m I, I_world)`; `lead = 0` for a full M), the
+/// other entries being exactly zero.
+pub(super) struct MassBlock<'a> {
+    pub(super) m: &'a [f64],
+    pub(super) stride: usize,
+    pub(super) off: usize,
+    pub(super) n: usize,
+    pub(super) lead: usize,
+}
+
 /// The momentum balance of a step, shared by both drivers: `||M (v_{k+1} - v_free) - G P||`
 /// relative to the momenta involved, `max(||G P||, ||M v_free||, ||M v_{k+1}||)` (rounding is
-/// relative to the largest; the absolute norm when all are zero). M is given by its diagonal
-/// blocks `(m, stride, off, n)`: entry `(a, c)` of a block is `m[a stride + c]`, acting on the
-/// velocities `off..off + n` (a body of a scene, or a model's whole M).
+/// relative to the largest; the absolute norm when all are zero), M given by its diagonal
+/// blocks ([`MassBlock`]). The zero entries of a block are skipped: a skipped term is a signed
+/// zero, which changes at most the sign of a zero sum, and every sum is squared.
 pub(super) fn momentum_residual<'a>(
-    blocks: impl Iterator<Item = (&'a [f64], usize, usize, usize)>,
+    blocks: impl Iterator<Item = MassBlock<'a>>,
     v_next: &[f64],
     v_free: &[f64],
     gp: &[f64],
 ) -> f64 {
     let (mut res2, mut gp2, mut mf2, mut mn2) = (0.0, 0.0, 0.0, 0.0);
-    for (m, stride, off, n) in blocks {
+    for MassBlock {
+        m,
+        stride,
+        off,
+        n,
+        lead,
+    } in blocks
+    {
         for a in 0..n {
             let (mut mdv, mut mf, mut mn) = (0.0, 0.0, 0.0);
-            for c in 0..n {
+            let cols = if a < lead { a..a + 1 } else { lead..n };
+            for c in cols {
                 let (vn, vf) = (v_next[off + c], v_free[off + c]);
                 mdv += m[a * stride + c] * (vn - vf);
                 mf += m[a * stride + c] * vf;
