@@ -84,7 +84,12 @@ def count(args: list[str]) -> tuple[int, int]:
 
 
 def _millions(n: int) -> str:
-    return f"{n / 1e6:.1f}M"
+    """Millions to 0.1M from 10M on, to 0.01M from 1M, thousands below."""
+    if n >= 10_000_000:
+        return f"{n / 1e6:.1f}M"
+    if n >= 1_000_000:
+        return f"{n / 1e6:.2f}M"
+    return f"{n / 1e3:.1f}k"
 
 
 def parse_table(block: str) -> tuple[list[str], dict[str, dict[str, tuple[str, str]]]]:

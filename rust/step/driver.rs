@@ -14,6 +14,15 @@
 //!     advance      q_{k+1} from v_{k+1}, the clock
 //!     project      (drift = projection) the post-step projection
 //! ```
+//!
+//! Where the drivers do the same, the stage's work is here once and each driver calls it with
+//! its own data: the search's verdict on a candidate ([`search_verdict`]), a contact's
+//! normal term and curvature term ([`contact_term`]), the contacts' memory and records
+//! ([`remember_contacts`]), `v_next`'s start ([`start_velocities`]) and the clock
+//! ([`advance_clock`]); the located impact is one sequence too (`event::located_step`).
+//! What stays per driver is what differs: the bodies and shapes or the system's callbacks
+//! (M, the gaps and the Jacobian columns), and the sums over them (each driver keeps its own
+//! summation order, so its figures stay bitwise).
 
 use super::super::impact::ImpactMemory;
 use super::event::Located;
