@@ -19,6 +19,7 @@ and falls back in flight), which is the integrator's and not a gain of the conta
 from __future__ import annotations
 
 import os
+from collections import Counter
 from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -284,12 +285,17 @@ class Trajectory:
                          else _load_power(scene, tr.v))
         tr.projection = (np.asarray(raw["projection"]) if "projection" in raw
                          else np.zeros(len(tr.active)))
-        statuses = np.empty(len(raw["status"]), dtype=object)
-        statuses[:] = [Status(s) for s in raw["status"]]
+        # one Status per distinct name (a run has a handful), looked up step by step
+        names = raw["status"]
+        counts = Counter(names)
+        kinds = {name: Status(name) for name in counts}
+        statuses = np.empty(len(names), dtype=object)
+        statuses[:] = list(map(kinds.__getitem__, names))
         tr.solver_status = statuses
         tr.solver_error = np.asarray(raw["error"])
         tr.solver_scaled_error = np.asarray(raw["scaled_error"])
-        failed = sum(s not in (Status.SOLVED, Status.NO_CONTACT) for s in statuses)
+        failed = sum(count for name, count in counts.items()
+                     if kinds[name] not in (Status.SOLVED, Status.NO_CONTACT))
         if tr.stopped is not None:
             tr.status, tr.message = Status.STOPPED, f"stopped early: {tr.stopped}"
         elif failed:

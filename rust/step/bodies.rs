@@ -24,6 +24,10 @@ pub(super) struct BodyInfo {
     pub(super) off_q: usize,
     pub(super) off_v: usize,
     pub(super) nv: usize,
+    /// the translational velocities `0..lead`, on which M and `M^{-1}` are diagonal (`m` and
+    /// `1 / m`); the rotational ones `lead..nv` carry the inertia block. Every other entry of
+    /// the frozen M and `M^{-1}` is exactly zero, and the products with M skip it.
+    pub(super) lead: usize,
     pub(super) mass: f64,
     /// body-frame inertia (spatial) or `J` at (0, 0) (planar).
     pub(super) inertia: Matrix3<f64>,
@@ -80,11 +84,16 @@ pub(super) fn bodies_of(scene: &Scene) -> (Vec<BodyInfo>, Vec<f64>, Vec<f64>) {
             *l = b.mass * scene.gravity[k] + b.force[k];
         }
         let nv = b.kind.nv(dim);
+        let lead = match b.kind {
+            BodyKind::Particle => nv,
+            _ => dim.min(nv),
+        };
         bodies.push(BodyInfo {
             kind: b.kind,
             off_q,
             off_v,
             nv,
+            lead,
             mass: b.mass,
             inertia,
             inertia_inv,
@@ -151,11 +160,7 @@ impl Stepper {
         for (bi, b) in self.bodies.iter().enumerate() {
             let f = &mut self.frozen[bi];
             *f = Frozen::default();
-            let translational = match b.kind {
-                BodyKind::Particle => b.nv,
-                _ => self.dim,
-            };
-            for a in 0..translational {
+            for a in 0..b.lead {
                 f.m[a * 6 + a] = b.mass;
                 f.minv[a * 6 + a] = 1.0 / b.mass;
             }
@@ -246,14 +251,50 @@ impl Stepper {
         out
     }
 
+    /// `M_b^{-1} x` for body b's zero-padded column x (zero past `nv`), over the nonzero
+    /// entries of `M^{-1}` only ([`BodyInfo::lead`]): equal to the full row-by-column sums, a
+    /// skipped term being a signed zero.
+    #[inline]
+    pub(super) fn minv_times(&self, body: usize, x: &[f64; 6]) -> [f64; 6] {
+        let b = &self.bodies[body];
+        let minv = &self.frozen[body].minv;
+        let mut out = [0.0; 6];
+        if (b.lead, b.nv) == (3, 6) {
+            // a spatial body, unrolled (the same products and sums)
+            for a in 0..3 {
+                out[a] = minv[a * 6 + a] * x[a];
+                let row = &minv[(3 + a) * 6 + 3..(3 + a) * 6 + 6];
+                out[3 + a] = row[0] * x[3] + row[1] * x[4] + row[2] * x[5];
+            }
+            return out;
+        }
+        for a in 0..b.lead {
+            out[a] = minv[a * 6 + a] * x[a];
+        }
+        for a in b.lead..b.nv {
+            let row = &minv[a * 6..a * 6 + 6];
+            let mut s = row[b.lead] * x[b.lead];
+            for c in b.lead + 1..b.nv {
+                s += row[c] * x[c];
+            }
+            out[a] = s;
+        }
+        out
+    }
+
     /// kinetic and potential energy at the current state (bodies frozen at it).
     pub(super) fn energies(&self) -> (f64, f64) {
         let (mut t, mut v) = (0.0, 0.0);
         for (bi, b) in self.bodies.iter().enumerate() {
             let m = &self.frozen[bi].m;
             let vel = &self.v[b.off_v..b.off_v + b.nv];
-            for a in 0..b.nv {
-                for c in 0..b.nv {
+            // M's zero entries skipped (module BodyInfo::lead): each skipped term is a signed
+            // zero, which leaves the sum unchanged
+            for a in 0..b.lead {
+                t += 0.5 * vel[a] * m[a * 6 + a] * vel[a];
+            }
+            for a in b.lead..b.nv {
+                for c in b.lead..b.nv {
                     t += 0.5 * vel[a] * m[a * 6 + c] * vel[c];
                 }
             }

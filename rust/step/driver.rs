@@ -14,9 +14,22 @@
 //!     advance      q_{k+1} from v_{k+1}, the clock
 //!     project      (drift = projection) the post-step projection
 //! ```
+//!
+//! Where the drivers do the same, the stage's work is here once and each driver calls it with
+//! its own data: the search's verdict on a candidate ([`search_verdict`]), a contact's
+//! normal term and curvature term ([`contact_term`]), the contacts' memory and records
+//! ([`remember_contacts`]), `v_next`'s start ([`start_velocities`]) and the clock
+//! ([`advance_clock`]); the located impact is one sequence too (`event::located_step`).
+//! What stays per driver is what differs: the bodies and shapes or the system's callbacks
+//! (M, the gaps and the Jacobian columns), and the sums over them (each driver keeps its own
+//! summation order, so its figures stay bitwise).
 
+use super::super::impact::ImpactMemory;
 use super::event::Located;
-use super::{ContactRecord, Drift, StepRecord, StepSettings, Stepper};
+use super::law::{curvature_term, normal_term};
+use super::persistence::CandState;
+use super::solve::SolveBuffers;
+use super::{Active, ContactRecord, Drift, StepRecord, StepSettings, Stepper};
 use crate::error::Result;
 
 /// The stages a driver supplies to [`step`].
@@ -92,6 +105,118 @@ pub(super) fn step<D: Driver>(d: &mut D, contacts: &mut Vec<ContactRecord>) -> R
     Ok(record)
 }
 
+/// The contact search's verdict on one candidate, shared by both drivers (Stewart 2000): with
+/// gap g at `q_k`, normal velocities `vn_k = J_n v_k` and `vn_free = J_n v_free`, and whether
+/// it is owed a rebound (`pending`, module `impact`), `Some(closed)` when it is active
+/// (closed, `g <= gap_tolerance`, or owed a rebound; or open but closing within the step,
+/// `g <= gap_tolerance + 2 h max(-vn_k, -vn_free, 0)`), `None` when it is far (its state is
+/// then forgotten).
+#[inline]
+pub(super) fn search_verdict(
+    settings: &StepSettings,
+    gap: f64,
+    vn_k: f64,
+    vn_free: f64,
+    pending: bool,
+) -> Option<bool> {
+    let tol_gap = settings.gap_tolerance;
+    let closing = (-vn_k).max(-vn_free).max(0.0);
+    if gap > tol_gap + 2.0 * settings.h * closing && !pending {
+        None
+    } else {
+        Some(gap <= tol_gap || pending)
+    }
+}
+
+/// `q_c` and `q_1` of active contact `a` completed, shared by both drivers: given the
+/// contact's rows of `G^T v_free` (`qc`) and `G^T v_k` (`q1`), the normal's restitution, bias
+/// or gap term ([`normal_term`]) and the gap's curvature term
+/// ([`curvature_term`] of the remainder `curvature`) are added to `q_c`'s normal; `mu` gets
+/// the contact's friction coefficient.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub(super) fn contact_term(
+    settings: &StepSettings,
+    a: &mut Active,
+    st: &CandState,
+    (mu_c, e): (f64, f64),
+    qc: &mut [f64],
+    q1: &mut [f64],
+    curvature: f64,
+    mu: &mut Vec<f64>,
+    poisson_impact: &mut bool,
+    record: &mut StepRecord,
+) {
+    mu.push(mu_c);
+    let bound = normal_term(settings, a, st, e, &mut q1[0], poisson_impact, record);
+    qc[0] += bound + curvature_term(curvature, settings.h);
+}
+
+/// The contacts' memory after a solve, shared by both drivers: each active contact keeps its
+/// impulse (warm start), its variables in Lemke's basis and its impact record by identity (a
+/// closed contact consumes its record, an open one that pushed records its impact, one that
+/// did not push has none), and its record of the step (`id_of` its identity,
+/// `velocity_of` its contact velocity `J v_{k+1}`) is appended to `contacts`.
+#[inline]
+pub(super) fn remember_contacts(
+    (dim, step): (usize, usize),
+    active: &[Active],
+    state: &mut [CandState],
+    sol: &SolveBuffers,
+    contacts: &mut Vec<ContactRecord>,
+    id_of: impl Fn(usize) -> usize,
+    velocity_of: impl Fn(&Active) -> [f64; 3],
+) {
+    for (i, a) in active.iter().enumerate() {
+        let p = &sol.impulse[i * dim..(i + 1) * dim];
+        let st = &mut state[a.cand];
+        st.warm[..dim].copy_from_slice(p);
+        st.corrected = sol.corrected;
+        st.basis = sol.basis.get(i).copied().unwrap_or(0);
+        st.impact = if !a.closed && p[0] > 0.0 {
+            ImpactMemory::landed(a.vn_k, p[0])
+        } else {
+            ImpactMemory::default()
+        };
+        let mut impulse = [0.0; 3];
+        impulse[..dim].copy_from_slice(p);
+        contacts.push(ContactRecord {
+            step,
+            id: id_of(a.cand),
+            impulse,
+            velocity: velocity_of(a),
+            approach: a.approach,
+            gap: a.gap,
+            closed: a.closed,
+        });
+    }
+}
+
+/// `v_free` into the kept buffer `v_next` (taken out for the step), and `G P` cleared:
+/// the start of `v_{k+1} = v_free + M^{-1} G P`, shared by both drivers.
+pub(super) fn start_velocities(v_next: &mut Vec<f64>, v_free: &[f64], gp: &mut [f64]) -> Vec<f64> {
+    let mut out = std::mem::take(v_next);
+    out.copy_from_slice(v_free);
+    gp.fill(0.0);
+    out
+}
+
+/// `v = v_{k+1}` (its buffer kept in `v_next` for the next step) and the clock to
+/// `t_{k+1} = (k + 1) h`, shared by both drivers (each moves its own coordinates).
+pub(super) fn advance_clock(
+    v: &mut [f64],
+    v_next: &mut Vec<f64>,
+    next: Vec<f64>,
+    step_index: &mut usize,
+    t: &mut f64,
+    h: f64,
+) {
+    v.copy_from_slice(&next);
+    *v_next = next;
+    *step_index += 1;
+    *t = *step_index as f64 * h;
+}
+
 impl Driver for Stepper {
     fn settings(&self) -> &StepSettings {
         &self.settings
@@ -107,7 +232,7 @@ impl Driver for Stepper {
         self.active.len()
     }
     fn locate(&mut self, contacts: &mut Vec<ContactRecord>) -> Result<Located> {
-        self.located_step(contacts)
+        super::event::located_step(self, contacts)
     }
     fn free_answer(&mut self, record: &mut StepRecord) {
         self.free_of_contacts(record);
@@ -116,10 +241,7 @@ impl Driver for Stepper {
         self.solve_contacts(record)
     }
     fn start_velocities(&mut self) -> Vec<f64> {
-        let mut v_next = std::mem::take(&mut self.v_next);
-        v_next.copy_from_slice(&self.v_free);
-        self.gp.fill(0.0);
-        v_next
+        start_velocities(&mut self.v_next, &self.v_free, &mut self.gp)
     }
     fn apply(&mut self, v_next: &mut [f64]) {
         self.apply_impulses(v_next);
@@ -141,14 +263,13 @@ impl Driver for Stepper {
         Ok(t + v)
     }
     fn advance(&mut self, v_next: Vec<f64>) {
-        self.v.copy_from_slice(&v_next);
-        self.v_next = v_next;
+        let h = self.settings.h;
+        let (t, k) = (&mut self.t, &mut self.step_index);
+        advance_clock(&mut self.v, &mut self.v_next, v_next, k, t, h);
         self.integrate_positions();
         if let Some(js) = self.joints.as_mut() {
             js.project_positions(&self.bodies, &mut self.q);
         }
-        self.step_index += 1;
-        self.t = self.step_index as f64 * self.settings.h;
     }
     fn project(&mut self, e_start: f64) -> Result<f64> {
         Stepper::project(self, e_start)

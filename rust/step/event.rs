@@ -35,6 +35,7 @@
 //! the rebound to the next one, which then fell back to the plain law (O(h) energy).
 
 use super::bodies::displace_body;
+use super::persistence::CandState;
 use super::solve::SolveBuffers;
 use super::{
     frame, Active, ContactRecord, Geometry, Restitution, StepRecord, StepSettings, Stepper,
@@ -194,15 +195,170 @@ pub(super) fn located_record(settings: &StepSettings, hit: &Hit, mu: f64, e: f64
     record
 }
 
+/// What a driver supplies to the located step ([`located_step`]), shared by the scenes' and
+/// the models' steppers.
+pub(super) trait Locating {
+    fn settings(&self) -> &StepSettings;
+    /// the step's active contacts.
+    fn active(&self) -> &[Active];
+    /// keeps `(q_k, v_k)` for [`Self::restore`] and the path.
+    fn save(&mut self);
+    /// back to `(q_k, v_k)`, with M there.
+    fn restore(&mut self) -> Result<()>;
+    /// puts the positions at `q(s)` and the velocities at `q'(s)` on the step's free path
+    /// (module docs), with M there.
+    fn follow(&mut self, s: f64) -> Result<()>;
+    /// the smallest true gap over the step's active contacts at the current q, and which.
+    fn closest(&mut self) -> Result<(f64, usize)>;
+    /// the true gap of active contact i at the current q (after [`Self::closest`]).
+    fn gap_now(&self, i: usize) -> f64;
+    /// applies the impact law to active contact `which` at the current state (the path at
+    /// the impact instant): velocities updated, the impulse returned.
+    fn impact_at(&mut self, which: usize) -> Result<Hit>;
+    /// the rest of the step, `rest = h - s*`, on the parabola from the post-impact velocity;
+    /// the state velocity taken back by `-a h / 2` (module docs), M at the end.
+    fn rest_of_step(&mut self, rest: f64);
+    /// the records of a located step, the contacts' states ([`finish_memory`]), the clock.
+    fn finish_located(&mut self, hit: Hit, contacts: &mut Vec<ContactRecord>) -> StepRecord;
+    /// whether the current q and v are finite.
+    fn path_finite(&self) -> bool;
+}
+
+/// The located step (module docs), one sequence for both drivers; for [`Located::Plain`] and
+/// [`Located::Free`] the state (and M) is left as it was.
+pub(super) fn located_step<D: Locating>(
+    d: &mut D,
+    contacts: &mut Vec<ContactRecord>,
+) -> Result<Located> {
+    if d.active().is_empty() || d.active().iter().any(|a| a.closed) {
+        return Ok(Located::Plain);
+    }
+    d.save();
+    let out = locate(d, contacts)?;
+    if !matches!(out, Located::Done(_)) {
+        d.restore()?;
+    }
+    Ok(out)
+}
+
+/// see [`located_step`]; may leave the state on the path.
+fn locate<D: Locating>(d: &mut D, contacts: &mut Vec<ContactRecord>) -> Result<Located> {
+    let h = d.settings().h;
+    let tol_gap = d.settings().gap_tolerance;
+    let found = first_touch(h, |s| {
+        d.follow(s)?;
+        Ok(d.closest()?.0)
+    })?;
+    let Some(s_star) = found else {
+        return Ok(Located::Free);
+    };
+    d.follow(s_star)?;
+    let (_, which) = d.closest()?;
+    // isolated: every other active contact still open at the instant
+    let others_open = (0..d.active().len()).all(|i| i == which || d.gap_now(i) > tol_gap);
+    if !others_open {
+        return Ok(Located::Plain);
+    }
+    let hit = d.impact_at(which)?;
+    // the rest of the step from the post-impact velocity
+    d.rest_of_step(h - s_star);
+    let penetrates = d.closest()?.0 < -tol_gap;
+    if penetrates || !d.path_finite() {
+        return Ok(Located::Plain);
+    }
+    Ok(Located::Done(d.finish_located(hit, contacts)))
+}
+
+/// The contacts' states after a located impact and its record, shared by both drivers: every
+/// active contact's impact memory, warm start and basis cleared, the hit contact's warm
+/// start its impulse; its record (identity `id`) appended to `contacts`.
+pub(super) fn finish_memory(
+    (dim, step): (usize, usize),
+    active: &[Active],
+    state: &mut [CandState],
+    hit: &Hit,
+    id: usize,
+    contacts: &mut Vec<ContactRecord>,
+) {
+    let a = active[hit.active];
+    for act in active {
+        let st = &mut state[act.cand];
+        st.impact = Default::default();
+        st.warm = [0.0; 3];
+        st.basis = 0;
+    }
+    state[a.cand].warm[..dim].copy_from_slice(&hit.impulse[..dim]);
+    contacts.push(ContactRecord {
+        step,
+        id,
+        impulse: hit.impulse,
+        velocity: hit.velocity,
+        approach: hit.approach,
+        gap: a.gap,
+        closed: true,
+    });
+}
+
 impl Stepper {
     /// the free acceleration of velocity component i over the step.
     fn acceleration(&self, i: usize) -> f64 {
         (self.v_free[i] - self.saved_v[i]) / self.settings.h
     }
 
-    /// puts the positions at `q(s)` and the velocities at `q'(s)` on the step's free path
-    /// (module docs), bodies frozen there.
-    fn follow(&mut self, s: f64) {
+    /// the contact answer of a free located step (see [`Located::Free`], [`free_answer`]).
+    pub(super) fn free_of_contacts(&mut self, record: &mut StepRecord) {
+        free_answer(self.dim, &mut self.active, &mut self.solve, record);
+    }
+
+    /// the G columns of the contact frame's directions at a geometry, per side, and
+    /// `M^{-1}` times them.
+    #[allow(clippy::type_complexity)]
+    fn columns_at(&self, geo: &Geometry) -> ([[[f64; 6]; 3]; 2], [[[f64; 6]; 3]; 2]) {
+        let dim = self.dim;
+        let fr = frame(dim, geo.normal);
+        let mut cols = [[[0.0; 6]; 3]; 2];
+        let mut bcols = [[[0.0; 6]; 3]; 2];
+        for s in 0..geo.nsides {
+            let (body, sign, r) = geo.sides[s];
+            let minv = &self.frozen[body].minv;
+            for (j, d) in fr.iter().enumerate().take(dim) {
+                let mut col = self.column(body, r, *d);
+                for x in &mut col {
+                    *x *= sign;
+                }
+                cols[s][j] = col;
+                bcols[s][j] =
+                    std::array::from_fn(|a| (0..6).map(|c| minv[a * 6 + c] * col[c]).sum());
+            }
+        }
+        (cols, bcols)
+    }
+}
+
+impl Locating for Stepper {
+    fn settings(&self) -> &StepSettings {
+        &self.settings
+    }
+
+    fn active(&self) -> &[Active] {
+        &self.active
+    }
+
+    fn save(&mut self) {
+        self.saved_q.copy_from_slice(&self.q);
+        self.saved_v.copy_from_slice(&self.v);
+    }
+
+    /// bodies frozen at `(q_k, v_k)` again.
+    fn restore(&mut self) -> Result<()> {
+        self.q.copy_from_slice(&self.saved_q);
+        self.v.copy_from_slice(&self.saved_v);
+        self.freeze();
+        Ok(())
+    }
+
+    /// bodies frozen at `q(s)`.
+    fn follow(&mut self, s: f64) -> Result<()> {
         let h = self.settings.h;
         for bi in 0..self.bodies.len() {
             let b = &self.bodies[bi];
@@ -220,10 +376,10 @@ impl Stepper {
             displace_body(q, kind, &d[..nv]);
         }
         self.freeze();
+        Ok(())
     }
 
-    /// the smallest true gap over the step's active contacts at the current q, and which.
-    fn closest(&self) -> (f64, usize) {
+    fn closest(&mut self) -> Result<(f64, usize)> {
         let mut best = (f64::INFINITY, 0);
         for (i, a) in self.active.iter().enumerate() {
             let g = self.geometry(a.cand).gap;
@@ -231,85 +387,13 @@ impl Stepper {
                 best = (g, i);
             }
         }
-        best
+        Ok(best)
     }
 
-    /// The located step (module docs); for [`Located::Plain`] and [`Located::Free`] the state
-    /// is left untouched.
-    pub(super) fn located_step(&mut self, contacts: &mut Vec<ContactRecord>) -> Result<Located> {
-        let h = self.settings.h;
-        let tol_gap = self.settings.gap_tolerance;
-        if self.active.is_empty() || self.active.iter().any(|a| a.closed) {
-            return Ok(Located::Plain);
-        }
-        self.saved_q.copy_from_slice(&self.q);
-        self.saved_v.copy_from_slice(&self.v);
-        let Some(s_star) = self.impact_instant() else {
-            self.restore();
-            return Ok(Located::Free);
-        };
-        self.follow(s_star);
-        let (_, which) = self.closest();
-        // isolated: every other active contact still open at the instant
-        let others_open = self
-            .active
-            .iter()
-            .enumerate()
-            .all(|(i, a)| i == which || self.geometry(a.cand).gap > tol_gap);
-        if !others_open {
-            self.restore();
-            return Ok(Located::Plain);
-        }
-        let hit = self.impact_at(which)?;
-        // the rest of the step from the post-impact velocity
-        let rest = h - s_star;
-        for bi in 0..self.bodies.len() {
-            let b = &self.bodies[bi];
-            let (oq, ov, nv, kind) = (b.off_q, b.off_v, b.nv, b.kind);
-            let mut d = [0.0; 6];
-            for k in 0..nv {
-                let a = self.acceleration(ov + k);
-                d[k] = rest * self.v[ov + k] + 0.5 * a * rest * rest;
-                self.v[ov + k] += a * rest - 0.5 * a * h;
-            }
-            let q = &mut self.q[oq..oq + kind.nq(self.dim)];
-            displace_body(q, kind, &d[..nv]);
-        }
-        self.freeze();
-        let penetrates = self.closest().0 < -tol_gap;
-        let finite = self.q.iter().chain(&self.v).all(|x| x.is_finite());
-        if penetrates || !finite {
-            self.restore();
-            return Ok(Located::Plain);
-        }
-        Ok(Located::Done(self.finish_located(hit, contacts)))
+    fn gap_now(&self, i: usize) -> f64 {
+        self.geometry(self.active[i].cand).gap
     }
 
-    /// the contact answer of a free located step (see [`Located::Free`], [`free_answer`]).
-    pub(super) fn free_of_contacts(&mut self, record: &mut StepRecord) {
-        free_answer(self.dim, &mut self.active, &mut self.solve, record);
-    }
-
-    /// back to `(q_k, v_k)`, bodies frozen there.
-    fn restore(&mut self) {
-        self.q.copy_from_slice(&self.saved_q);
-        self.v.copy_from_slice(&self.saved_v);
-        self.freeze();
-    }
-
-    /// the first instant in `(0, h]` at which an active contact's true gap vanishes on the
-    /// free path ([`first_touch`]).
-    fn impact_instant(&mut self) -> Option<f64> {
-        let h = self.settings.h;
-        let found: Result<Option<f64>> = first_touch(h, |s| {
-            self.follow(s);
-            Ok(self.closest().0)
-        });
-        found.ok().flatten()
-    }
-
-    /// applies the impact law to active contact `which` at the current state (the path at
-    /// the impact instant): velocities updated, the impulse returned.
     fn impact_at(&mut self, which: usize) -> Result<Hit> {
         let dim = self.dim;
         let cand = self.candidates[self.active[which].cand];
@@ -376,54 +460,35 @@ impl Stepper {
         })
     }
 
-    /// the G columns of the contact frame's directions at a geometry, per side, and
-    /// `M^{-1}` times them.
-    #[allow(clippy::type_complexity)]
-    fn columns_at(&self, geo: &Geometry) -> ([[[f64; 6]; 3]; 2], [[[f64; 6]; 3]; 2]) {
-        let dim = self.dim;
-        let fr = frame(dim, geo.normal);
-        let mut cols = [[[0.0; 6]; 3]; 2];
-        let mut bcols = [[[0.0; 6]; 3]; 2];
-        for s in 0..geo.nsides {
-            let (body, sign, r) = geo.sides[s];
-            let minv = &self.frozen[body].minv;
-            for (j, d) in fr.iter().enumerate().take(dim) {
-                let mut col = self.column(body, r, *d);
-                for x in &mut col {
-                    *x *= sign;
-                }
-                cols[s][j] = col;
-                bcols[s][j] =
-                    std::array::from_fn(|a| (0..6).map(|c| minv[a * 6 + c] * col[c]).sum());
+    /// bodies frozen at the step's end.
+    fn rest_of_step(&mut self, rest: f64) {
+        let h = self.settings.h;
+        for bi in 0..self.bodies.len() {
+            let b = &self.bodies[bi];
+            let (oq, ov, nv, kind) = (b.off_q, b.off_v, b.nv, b.kind);
+            let mut d = [0.0; 6];
+            for k in 0..nv {
+                let a = self.acceleration(ov + k);
+                d[k] = rest * self.v[ov + k] + 0.5 * a * rest * rest;
+                self.v[ov + k] += a * rest - 0.5 * a * h;
             }
+            let q = &mut self.q[oq..oq + kind.nq(self.dim)];
+            displace_body(q, kind, &d[..nv]);
         }
-        (cols, bcols)
+        self.freeze();
     }
 
-    /// the records of a located step, the contacts' states, and the clock.
     fn finish_located(&mut self, hit: Hit, contacts: &mut Vec<ContactRecord>) -> StepRecord {
-        let dim = self.dim;
-        let a = self.active[hit.active];
-        let cand = self.candidates[a.cand];
-        for act in &self.active {
-            let st = &mut self.state[act.cand];
-            st.impact = Default::default();
-            st.warm = [0.0; 3];
-            st.basis = 0;
-        }
-        self.state[a.cand].warm[..dim].copy_from_slice(&hit.impulse[..dim]);
-        contacts.push(ContactRecord {
-            step: self.step_index,
-            id: cand.id,
-            impulse: hit.impulse,
-            velocity: hit.velocity,
-            approach: hit.approach,
-            gap: a.gap,
-            closed: true,
-        });
+        let cand = self.candidates[self.active[hit.active].cand];
+        let step = (self.dim, self.step_index);
+        finish_memory(step, &self.active, &mut self.state, &hit, cand.id, contacts);
         let record = located_record(&self.settings, &hit, cand.mu, cand.e);
         self.step_index += 1;
         self.t = self.step_index as f64 * self.settings.h;
         record
+    }
+
+    fn path_finite(&self) -> bool {
+        self.q.iter().chain(&self.v).all(|x| x.is_finite())
     }
 }

@@ -24,7 +24,6 @@
 //! for scenes (module `generalized_event`). A system's callbacks may fail (a user function
 //! raising): the error stops the run and is returned as it is.
 
-use super::super::impact::ImpactMemory;
 use super::driver::{self, Driver};
 use super::event::Located;
 use super::law::SolveWork;
@@ -119,7 +118,7 @@ impl<S: GeneralizedSystem> Driver for GeneralizedStepper<S> {
         self.active.len()
     }
     fn locate(&mut self, contacts: &mut Vec<ContactRecord>) -> Result<Located> {
-        self.located_step(contacts)
+        super::event::located_step(self, contacts)
     }
     fn free_answer(&mut self, record: &mut StepRecord) {
         self.free_of_contacts(record);
@@ -129,10 +128,7 @@ impl<S: GeneralizedSystem> Driver for GeneralizedStepper<S> {
         self.solve_contacts(record)
     }
     fn start_velocities(&mut self) -> Vec<f64> {
-        let mut v_next = std::mem::take(&mut self.v_next);
-        v_next.copy_from_slice(&self.v_free);
-        self.gp.fill(0.0);
-        v_next
+        driver::start_velocities(&mut self.v_next, &self.v_free, &mut self.gp)
     }
     fn apply(&mut self, v_next: &mut [f64]) {
         self.apply_impulses(v_next);
@@ -147,14 +143,12 @@ impl<S: GeneralizedSystem> Driver for GeneralizedStepper<S> {
         GeneralizedStepper::energy(self)
     }
     fn advance(&mut self, v_next: Vec<f64>) {
-        self.v.copy_from_slice(&v_next);
-        self.v_next = v_next;
         let h = self.settings.h;
+        let (t, k) = (&mut self.t, &mut self.step_index);
+        driver::advance_clock(&mut self.v, &mut self.v_next, v_next, k, t, h);
         for (q, v) in self.q.iter_mut().zip(&self.v) {
             *q += h * v;
         }
-        self.step_index += 1;
-        self.t = self.step_index as f64 * h;
     }
     fn project(&mut self, e_start: f64) -> Result<f64> {
         GeneralizedStepper::project(self, e_start)
@@ -323,8 +317,6 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
     /// but closing within the step (`g <= gap_tolerance + 2 h max(-J_n v_k, -J_n v_free)`)
     /// is active; the others forget their state.
     fn search_contacts(&mut self) {
-        let h = self.settings.h;
-        let tol_gap = self.settings.gap_tolerance;
         self.active.clear();
         for c in 0..self.laws.len() {
             let jn = self.row(c, 0);
@@ -332,15 +324,15 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
             let vn_free = dot(jn, &self.v_free);
             let gap = self.gaps[c];
             let pending = self.state[c].impact.pending;
-            let closing = (-vn_k).max(-vn_free).max(0.0);
-            if gap > tol_gap + 2.0 * h * closing && !pending {
+            let Some(closed) = driver::search_verdict(&self.settings, gap, vn_k, vn_free, pending)
+            else {
                 self.state[c] = CandState::default();
                 continue;
-            }
+            };
             let mut act = Active {
                 cand: c,
                 gap,
-                closed: gap <= tol_gap || pending,
+                closed,
                 vn_k,
                 nsides: 1,
                 ..Active::default()
@@ -422,41 +414,36 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
 
     /// the momentum balance of the step ([`super::record::momentum_residual`]), M one block.
     fn momentum_residual(&self, v_next: &[f64]) -> f64 {
-        let blocks = std::iter::once((&self.m[..], self.nv, 0, self.nv));
+        let blocks = std::iter::once(super::record::MassBlock {
+            m: &self.m[..],
+            stride: self.nv,
+            off: 0,
+            n: self.nv,
+            lead: 0,
+        });
         super::record::momentum_residual(blocks, v_next, &self.v_free, &self.gp)
     }
 
-    /// Each active contact keeps its impulse, basis and impact record (as the scenes'
-    /// stepper), and its record of the step is appended to `contacts`.
+    /// The contacts' memory and records ([`driver::remember_contacts`], as the scenes'):
+    /// a contact's identity is its index, its velocity `J v_{k+1}` from its rows.
     fn remember(&mut self, v_next: &[f64], contacts: &mut Vec<ContactRecord>) {
-        let dim = self.dim;
-        for (i, a) in self.active.iter().enumerate() {
-            let p = &self.solve.impulse[i * dim..(i + 1) * dim];
-            let st = &mut self.state[a.cand];
-            st.warm[..dim].copy_from_slice(p);
-            st.corrected = self.solve.corrected;
-            st.basis = self.solve.basis.get(i).copied().unwrap_or(0);
-            st.impact = if !a.closed && p[0] > 0.0 {
-                ImpactMemory::landed(a.vn_k, p[0])
-            } else {
-                ImpactMemory::default()
-            };
-            let mut impulse = [0.0; 3];
-            impulse[..dim].copy_from_slice(p);
-            let mut velocity = [0.0; 3];
-            for (al, vel) in velocity.iter_mut().enumerate().take(dim) {
-                *vel = dot(self.row(a.cand, al), v_next);
-            }
-            contacts.push(ContactRecord {
-                step: self.step_index,
-                id: a.cand,
-                impulse,
-                velocity,
-                approach: a.approach,
-                gap: a.gap,
-                closed: a.closed,
-            });
-        }
+        let (dim, nv, rows) = (self.dim, self.nv, &self.rows);
+        driver::remember_contacts(
+            (dim, self.step_index),
+            &self.active,
+            &mut self.state,
+            &self.solve,
+            contacts,
+            |c| c,
+            |a| {
+                let mut velocity = [0.0; 3];
+                for (al, vel) in velocity.iter_mut().enumerate().take(dim) {
+                    let o = (a.cand * dim + al) * nv;
+                    *vel = dot(&rows[o..o + nv], v_next);
+                }
+                velocity
+            },
+        );
     }
 
     /// the kinetic energy `v^T M v / 2` at the prepared state.

@@ -12,74 +12,51 @@
 //! goes on with the post-impact velocity to `t_{k+1}`, and the state velocity is taken back by
 //! `-a h / 2`. Isolated, free and plain steps are decided as for scenes (module `event`).
 
-use super::super::event::{first_touch, free_answer, impact_law, located_record, Hit, Located};
-use super::{dot, GeneralizedStepper, GeneralizedSystem};
+use super::super::event::{finish_memory, free_answer, impact_law, located_record, Hit, Locating};
+use super::{dot, Active, GeneralizedStepper, GeneralizedSystem};
 use crate::contact::assembly::solve_cholesky;
 use crate::error::{check_finite, Result};
-use crate::step::{ContactRecord, StepRecord};
+use crate::step::{ContactRecord, StepRecord, StepSettings};
 
 impl<S: GeneralizedSystem> GeneralizedStepper<S> {
-    /// The located step (module docs); for [`Located::Plain`] and [`Located::Free`] the state
-    /// (and `M(q_k)`'s factor) is left as it was.
-    pub(super) fn located_step(&mut self, contacts: &mut Vec<ContactRecord>) -> Result<Located> {
-        if self.active.is_empty() || self.active.iter().any(|a| a.closed) {
-            return Ok(Located::Plain);
-        }
-        self.saved_q.copy_from_slice(&self.q);
-        self.saved_v.copy_from_slice(&self.v);
-        let out = self.locate(contacts)?;
-        if !matches!(out, Located::Done(_)) {
-            self.q.copy_from_slice(&self.saved_q);
-            self.v.copy_from_slice(&self.saved_v);
-            if self.mass_moved {
-                self.factor_mass()?;
-                self.mass_moved = false;
-            }
-        }
-        Ok(out)
-    }
-
-    /// see [`Self::located_step`]; may leave the state on the path.
-    fn locate(&mut self, contacts: &mut Vec<ContactRecord>) -> Result<Located> {
-        let h = self.settings.h;
-        let tol_gap = self.settings.gap_tolerance;
-        let Some(s_star) = self.impact_instant()? else {
-            return Ok(Located::Free);
-        };
-        self.follow(s_star);
-        let (_, which) = self.closest()?;
-        // isolated: every other active contact still open at the instant
-        let others_open = self
-            .active
-            .iter()
-            .enumerate()
-            .all(|(i, a)| i == which || self.gaps_pred[a.cand] > tol_gap);
-        if !others_open {
-            return Ok(Located::Plain);
-        }
-        let hit = self.impact_at(which)?;
-        // the rest of the step from the post-impact velocity
-        let rest = h - s_star;
-        for k in 0..self.nv {
-            let a = self.acceleration(k);
-            self.q[k] += rest * self.v[k] + 0.5 * a * rest * rest;
-            self.v[k] += a * rest - 0.5 * a * h;
-        }
-        let penetrates = self.closest()?.0 < -tol_gap;
-        let finite = self.q.iter().chain(&self.v).all(|x| x.is_finite());
-        if penetrates || !finite {
-            return Ok(Located::Plain);
-        }
-        Ok(Located::Done(self.finish_located(hit, contacts)))
-    }
-
     /// the free acceleration of velocity component k over the step.
     fn acceleration(&self, k: usize) -> f64 {
         (self.v_free[k] - self.saved_v[k]) / self.settings.h
     }
 
-    /// puts the positions at `q(s)` and the velocities at `q'(s)` on the step's free path.
-    fn follow(&mut self, s: f64) {
+    /// the contact answer of a free located step ([`free_answer`]).
+    pub(super) fn free_of_contacts(&mut self, record: &mut StepRecord) {
+        free_answer(self.dim, &mut self.active, &mut self.solve, record);
+    }
+}
+
+impl<S: GeneralizedSystem> Locating for GeneralizedStepper<S> {
+    fn settings(&self) -> &StepSettings {
+        &self.settings
+    }
+
+    fn active(&self) -> &[Active] {
+        &self.active
+    }
+
+    fn save(&mut self) {
+        self.saved_q.copy_from_slice(&self.q);
+        self.saved_v.copy_from_slice(&self.v);
+    }
+
+    /// and `M(q_k)`'s factor, when the path factored M elsewhere.
+    fn restore(&mut self) -> Result<()> {
+        self.q.copy_from_slice(&self.saved_q);
+        self.v.copy_from_slice(&self.saved_v);
+        if self.mass_moved {
+            self.factor_mass()?;
+            self.mass_moved = false;
+        }
+        Ok(())
+    }
+
+    /// (M is factored at `q(s)` only where the law is applied, [`Locating::impact_at`]).
+    fn follow(&mut self, s: f64) -> Result<()> {
         let h = self.settings.h;
         for k in 0..self.nv {
             let a = self.acceleration(k);
@@ -87,10 +64,10 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
             self.q[k] = self.saved_q[k] + (s * v0 + 0.5 * a * s * s);
             self.v[k] = v0 + a * s;
         }
+        Ok(())
     }
 
-    /// the gaps and rows at the current q (into the predicted state's buffers), and the
-    /// smallest gap over the step's active contacts with its index among them.
+    /// (the gaps and rows at the current q into the predicted state's buffers).
     fn closest(&mut self) -> Result<(f64, usize)> {
         self.system
             .contacts(&self.q, &mut self.gaps_pred, &mut self.rows_pred)?;
@@ -106,14 +83,8 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
         Ok(best)
     }
 
-    /// the first instant in `(0, h]` at which an active contact's gap vanishes on the free
-    /// path ([`first_touch`]).
-    fn impact_instant(&mut self) -> Result<Option<f64>> {
-        let h = self.settings.h;
-        first_touch(h, |s| {
-            self.follow(s);
-            Ok(self.closest()?.0)
-        })
+    fn gap_now(&self, i: usize) -> f64 {
+        self.gaps_pred[self.active[i].cand]
     }
 
     /// applies the impact law to active contact `which` at the current state (the path at the
@@ -180,28 +151,20 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
         })
     }
 
-    /// the records of a located step, the contacts' states (as the scenes' located step), and
-    /// the clock.
-    fn finish_located(&mut self, hit: Hit, contacts: &mut Vec<ContactRecord>) -> StepRecord {
-        let dim = self.dim;
-        let a = self.active[hit.active];
-        let (mu, e) = self.laws[a.cand];
-        for act in &self.active {
-            let st = &mut self.state[act.cand];
-            st.impact = Default::default();
-            st.warm = [0.0; 3];
-            st.basis = 0;
+    fn rest_of_step(&mut self, rest: f64) {
+        let h = self.settings.h;
+        for k in 0..self.nv {
+            let a = self.acceleration(k);
+            self.q[k] += rest * self.v[k] + 0.5 * a * rest * rest;
+            self.v[k] += a * rest - 0.5 * a * h;
         }
-        self.state[a.cand].warm[..dim].copy_from_slice(&hit.impulse[..dim]);
-        contacts.push(ContactRecord {
-            step: self.step_index,
-            id: a.cand,
-            impulse: hit.impulse,
-            velocity: hit.velocity,
-            approach: hit.approach,
-            gap: a.gap,
-            closed: true,
-        });
+    }
+
+    fn finish_located(&mut self, hit: Hit, contacts: &mut Vec<ContactRecord>) -> StepRecord {
+        let c = self.active[hit.active].cand;
+        let (mu, e) = self.laws[c];
+        let step = (self.dim, self.step_index);
+        finish_memory(step, &self.active, &mut self.state, &hit, c, contacts);
         let record = located_record(&self.settings, &hit, mu, e);
         self.mass_moved = false;
         self.step_index += 1;
@@ -209,8 +172,7 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
         record
     }
 
-    /// the contact answer of a free located step ([`free_answer`]).
-    pub(super) fn free_of_contacts(&mut self, record: &mut StepRecord) {
-        free_answer(self.dim, &mut self.active, &mut self.solve, record);
+    fn path_finite(&self) -> bool {
+        self.q.iter().chain(&self.v).all(|x| x.is_finite())
     }
 }

@@ -4,15 +4,15 @@
 //! the gap's curvature term), the warm start and Lemke's guessed basis by contact, then the
 //! same solve (NSGS with its fallbacks, or Lemke) over the dense or block-sparse W.
 
-use super::super::law::{contact_solve, curvature_term, normal_term, ContactSolve};
+use super::super::driver::contact_term;
+use super::super::law::{contact_solve, ContactSolve};
 use super::{dot, GeneralizedStepper, GeneralizedSystem};
 use crate::error::{check_finite, Result};
 use crate::step::StepRecord;
 
 impl<S: GeneralizedSystem> GeneralizedStepper<S> {
     /// `q_c = G^T v_free` plus each contact's restitution, bias or gap term
-    /// ([`normal_term`], as the scenes') and the gap's curvature term
-    /// ([`curvature_term`]), `q_1 = G^T v_k` (open contacts separated) for Poisson's impact
+    /// (as the scenes', [`contact_term`]) and the gap's curvature term, `q_1 = G^T v_k` (open contacts separated) for Poisson's impact
     /// phase, and mu. The curvature `c = g(q_k + h v_free) - g(q_k) - h J_n v_free` takes one
     /// more `contacts` callback, at the predicted state `q_k + h v_free` (`dq = v dt`).
     pub(super) fn contact_terms(&mut self, record: &mut StepRecord) -> Result<()> {
@@ -27,29 +27,28 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
         self.mu.clear();
         self.poisson_impact = false;
         for i in 0..self.active.len() {
-            let ai = self.active[i];
-            let (mu, e) = self.laws[ai.cand];
-            let st = self.state[ai.cand];
-            self.mu.push(mu);
+            let c = self.active[i].cand;
             for al in 0..dim {
                 let (a, b) = {
-                    let g = self.row(ai.cand, al);
+                    let g = self.row(c, al);
                     (dot(g, &self.v_free), dot(g, &self.v))
                 };
                 self.qc[i * dim + al] = a;
                 self.q1[i * dim + al] = b;
             }
-            let bound = normal_term(
+            let curvature = self.gaps_pred[c] - self.gaps[c] - h * self.qc[i * dim];
+            contact_term(
                 &self.settings,
                 &mut self.active[i],
-                &st,
-                e,
-                &mut self.q1[i * dim],
+                &self.state[c],
+                self.laws[c],
+                &mut self.qc[i * dim..(i + 1) * dim],
+                &mut self.q1[i * dim..(i + 1) * dim],
+                curvature,
+                &mut self.mu,
                 &mut self.poisson_impact,
                 record,
             );
-            let c = self.gaps_pred[ai.cand] - self.gaps[ai.cand] - h * self.qc[i * dim];
-            self.qc[i * dim] += bound + curvature_term(c, h);
         }
         Ok(())
     }

@@ -5,6 +5,7 @@
 //! `poisson`).
 
 use super::super::poisson::{restitution_with_friction, routh};
+use super::driver::contact_term;
 use super::persistence::CandState;
 use super::solve::{solve_step_problem, step_problem, SolveBuffers, SPARSE_FROM};
 use super::{
@@ -85,7 +86,6 @@ impl Stepper {
     /// `q_1 = G^T v_k` (open contacts separated) for Poisson's impact phase, and mu.
     fn contact_terms(&mut self, record: &mut StepRecord) {
         let dim = self.dim;
-        let h = self.settings.h;
         let nc = self.active.len();
         let n = nc * dim;
         self.qc.clear();
@@ -98,10 +98,8 @@ impl Stepper {
             // by reference: an active contact carries its G and M^{-1} G columns
             let ai = &self.active[i];
             let c = ai.cand;
-            let (mu, e) = (self.candidates[c].mu, self.candidates[c].e);
-            self.mu.push(mu);
             // q_c = G^T v_free (and q_1 = G^T v_k for Poisson's impact phase), then the
-            // normal's restitution or gap term
+            // normal's restitution or gap term and curvature term (the shared stage)
             for si in &ai.sides[..ai.nsides] {
                 let b = &self.bodies[si.body];
                 for al in 0..dim {
@@ -109,18 +107,20 @@ impl Stepper {
                     self.q1[i * dim + al] += dot_v(&si.g[al], &self.v, b.off_v, b.nv);
                 }
             }
-            let bound = normal_term(
+            // the gap's second-order remainder over the step on v_free (module `narrow`)
+            let curvature = self.gap_curvature(c, &self.geo_cache[c], &self.v_free);
+            contact_term(
                 &self.settings,
                 &mut self.active[i],
                 &self.state[c],
-                e,
-                &mut self.q1[i * dim],
+                (self.candidates[c].mu, self.candidates[c].e),
+                &mut self.qc[i * dim..(i + 1) * dim],
+                &mut self.q1[i * dim..(i + 1) * dim],
+                curvature,
+                &mut self.mu,
                 &mut self.poisson_impact,
                 record,
             );
-            // the gap's second-order remainder over the step on v_free (module `narrow`)
-            let curvature = self.gap_curvature(c, &self.geo_cache[c], &self.v_free);
-            self.qc[i * dim] += bound + curvature_term(curvature, h);
         }
     }
 }

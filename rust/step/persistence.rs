@@ -69,38 +69,25 @@ impl Stepper {
     /// record, an open one that pushed records its impact, one that did not push has none),
     /// and its record of the step is appended to `contacts`.
     pub(super) fn remember(&mut self, v_next: &[f64], contacts: &mut Vec<ContactRecord>) {
-        let dim = self.dim;
-        let sol = &self.solve;
-        for (i, a) in self.active.iter().enumerate() {
-            let p = &sol.impulse[i * dim..(i + 1) * dim];
-            let st = &mut self.state[a.cand];
-            st.warm[..dim].copy_from_slice(p);
-            st.corrected = sol.corrected;
-            st.basis = sol.basis.get(i).copied().unwrap_or(0);
-            st.impact = if !a.closed && p[0] > 0.0 {
-                ImpactMemory::landed(a.vn_k, p[0])
-            } else {
-                ImpactMemory::default()
-            };
-            let mut impulse = [0.0; 3];
-            impulse[..dim].copy_from_slice(p);
-            let mut velocity = [0.0; 3];
-            for s in &a.sides[..a.nsides] {
-                let b = &self.bodies[s.body];
-                for (j, vj) in velocity.iter_mut().enumerate().take(dim) {
-                    *vj += dot_v(&s.g[j], v_next, b.off_v, b.nv);
+        let (dim, bodies, candidates) = (self.dim, &self.bodies, &self.candidates);
+        super::driver::remember_contacts(
+            (dim, self.step_index),
+            &self.active,
+            &mut self.state,
+            &self.solve,
+            contacts,
+            |c| candidates[c].id,
+            |a| {
+                let mut velocity = [0.0; 3];
+                for s in &a.sides[..a.nsides] {
+                    let b = &bodies[s.body];
+                    for (j, vj) in velocity.iter_mut().enumerate().take(dim) {
+                        *vj += dot_v(&s.g[j], v_next, b.off_v, b.nv);
+                    }
                 }
-            }
-            contacts.push(ContactRecord {
-                step: self.step_index,
-                id: self.candidates[a.cand].id,
-                impulse,
-                velocity,
-                approach: a.approach,
-                gap: a.gap,
-                closed: a.closed,
-            });
-        }
+                velocity
+            },
+        );
     }
 
     /// Rebuilds the sphere pairs of [`Pair::Spheres`] (candidates `n_static..`): every pair of

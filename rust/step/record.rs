@@ -327,39 +327,93 @@ impl Recorded for Stepper {
     }
 }
 
+/// A diagonal block of M for [`momentum_residual`]: entry `(a, c)` is `m[a stride + c]`,
+/// acting on the velocities `off..off + n` (a body of a scene, or a model's whole M); rows
+/// and columns `0..lead` carry only their diagonal entry and the rows `lead..n` only the
+/// columns `lead..n` (a rigid body's `diag(m I, I_world)`; `lead = 0` for a full M), the
+/// other entries being exactly zero.
+pub(super) struct MassBlock<'a> {
+    pub(super) m: &'a [f64],
+    pub(super) stride: usize,
+    pub(super) off: usize,
+    pub(super) n: usize,
+    pub(super) lead: usize,
+}
+
 /// The momentum balance of a step, shared by both drivers: `||M (v_{k+1} - v_free) - G P||`
 /// relative to the momenta involved, `max(||G P||, ||M v_free||, ||M v_{k+1}||)` (rounding is
-/// relative to the largest; the absolute norm when all are zero). M is given by its diagonal
-/// blocks `(m, stride, off, n)`: entry `(a, c)` of a block is `m[a stride + c]`, acting on the
-/// velocities `off..off + n` (a body of a scene, or a model's whole M).
+/// relative to the largest; the absolute norm when all are zero), M given by its diagonal
+/// blocks ([`MassBlock`]). The zero entries of a block are skipped: a skipped term is a signed
+/// zero, which changes at most the sign of a zero sum, and every sum is squared.
 pub(super) fn momentum_residual<'a>(
-    blocks: impl Iterator<Item = (&'a [f64], usize, usize, usize)>,
+    blocks: impl Iterator<Item = MassBlock<'a>>,
     v_next: &[f64],
     v_free: &[f64],
     gp: &[f64],
 ) -> f64 {
-    let (mut res2, mut gp2, mut mf2, mut mn2) = (0.0, 0.0, 0.0, 0.0);
-    for (m, stride, off, n) in blocks {
-        for a in 0..n {
-            let (mut mdv, mut mf, mut mn) = (0.0, 0.0, 0.0);
-            for c in 0..n {
-                let (vn, vf) = (v_next[off + c], v_free[off + c]);
-                mdv += m[a * stride + c] * (vn - vf);
-                mf += m[a * stride + c] * vf;
-                mn += m[a * stride + c] * vn;
-            }
-            let r = mdv - gp[off + a];
-            res2 += r * r;
-            gp2 += gp[off + a] * gp[off + a];
-            mf2 += mf * mf;
-            mn2 += mn * mn;
+    let mut sums = [0.0; 4];
+    for b in blocks {
+        // a rigid body's block with its sizes known at compile time (the same sums)
+        match (b.lead, b.n) {
+            (3, 6) => block_sums::<3, 6>(&b, v_next, v_free, gp, &mut sums),
+            (2, 3) => block_sums::<2, 3>(&b, v_next, v_free, gp, &mut sums),
+            _ => block_sums_of(&b, b.lead, b.n, v_next, v_free, gp, &mut sums),
         }
     }
+    let [res2, gp2, mf2, mn2] = sums;
     let scale2 = gp2.max(mf2).max(mn2);
     if scale2.sqrt() > TINY {
         (res2 / scale2).sqrt()
     } else {
         res2.sqrt()
+    }
+}
+
+/// [`block_sums_of`] for a block of `N` velocities, `LEAD` of them diagonal.
+#[inline(always)]
+fn block_sums<const LEAD: usize, const N: usize>(
+    b: &MassBlock<'_>,
+    v_next: &[f64],
+    v_free: &[f64],
+    gp: &[f64],
+    sums: &mut [f64; 4],
+) {
+    block_sums_of(b, LEAD, N, v_next, v_free, gp, sums);
+}
+
+/// adds one block's `|M (v_{k+1} - v_free) - G P|^2`, `|G P|^2`, `|M v_free|^2` and
+/// `|M v_{k+1}|^2` to `sums` (row by row, each row's sums from 0 in column order over the
+/// block's nonzero columns, [`MassBlock`]).
+#[inline(always)]
+fn block_sums_of(
+    b: &MassBlock<'_>,
+    lead: usize,
+    n: usize,
+    v_next: &[f64],
+    v_free: &[f64],
+    gp: &[f64],
+    sums: &mut [f64; 4],
+) {
+    let (m, stride, off) = (b.m, b.stride, b.off);
+    let (vn, vf, gp) = (
+        &v_next[off..off + n],
+        &v_free[off..off + n],
+        &gp[off..off + n],
+    );
+    for a in 0..n {
+        let (mut mdv, mut mf, mut mn) = (0.0, 0.0, 0.0);
+        let cols = if a < lead { a..a + 1 } else { lead..n };
+        for c in cols {
+            let mac = m[a * stride + c];
+            mdv += mac * (vn[c] - vf[c]);
+            mf += mac * vf[c];
+            mn += mac * vn[c];
+        }
+        let r = mdv - gp[a];
+        sums[0] += r * r;
+        sums[1] += gp[a] * gp[a];
+        sums[2] += mf * mf;
+        sums[3] += mn * mn;
     }
 }
 

@@ -43,10 +43,9 @@ pub use self::record::{
 use self::solve::SolveBuffers;
 use super::broad::BroadPhase;
 use super::poisson::routh;
-use super::{
-    BodyKind, Drift, Pair, PolyhedralSettings, Restitution, Scene, StepSettings, StepSolver,
-};
+use super::{BodyKind, Drift, Pair, Restitution, Scene, StepSettings, StepSolver};
 use crate::contact::assembly::WAssembly;
+use crate::contact::PolyhedralSettings;
 use crate::error::Result;
 
 /// below this a norm counts as zero when forming a relative residual.
@@ -75,9 +74,20 @@ fn row6(m: &[f64; 36], a: usize) -> [f64; 6] {
     std::array::from_fn(|c| m[a * 6 + c])
 }
 
-/// `x . v[off..off + nv]` for a zero-padded column x.
+/// `x . v[off..off + nv]` for a zero-padded column x, summed from 0 in index order (a
+/// spatial body's six terms unrolled, the same sums).
 #[inline(always)]
 fn dot_v(x: &[f64; 6], v: &[f64], off: usize, nv: usize) -> f64 {
+    if nv == 6 {
+        let v = &v[off..off + 6];
+        return 0.0
+            + x[0] * v[0]
+            + x[1] * v[1]
+            + x[2] * v[2]
+            + x[3] * v[3]
+            + x[4] * v[4]
+            + x[5] * v[5];
+    }
     let v = &v[off..off + nv];
     let mut s = 0.0;
     for k in 0..nv {
@@ -317,9 +327,11 @@ impl Stepper {
     fn search_contacts(&mut self) {
         let h = self.settings.h;
         let tol_gap = self.settings.gap_tolerance;
-        self.active.clear();
+        // filled in place (an active contact carries its G and M^{-1} G columns)
+        let mut active = std::mem::take(&mut self.active);
+        active.clear();
         for c in 0..self.candidates.len() {
-            let geo = self.geo_cache[c];
+            let geo = &self.geo_cache[c];
             let mut reach = 0.0;
             for &(body, _, r) in &geo.sides[..geo.nsides] {
                 let [lin, ang] = self.speed_bounds[body];
@@ -332,49 +344,46 @@ impl Stepper {
                 (0.0, 0.0)
             } else {
                 (
-                    self.normal_velocity(&geo, &self.v),
-                    self.normal_velocity(&geo, &self.v_free),
+                    self.normal_velocity(geo, &self.v),
+                    self.normal_velocity(geo, &self.v_free),
                 )
             };
-            let closing = (-vn_k).max(-vn_free).max(0.0);
-            if far || (geo.gap > tol_gap + 2.0 * h * closing && !pending) {
+            let verdict = driver::search_verdict(&self.settings, geo.gap, vn_k, vn_free, pending);
+            let (false, Some(closed)) = (far, verdict) else {
                 self.state[c] = CandState::default();
                 continue;
+            };
+            active.push(Active::default());
+            if let Some(act) = active.last_mut() {
+                self.active_contact(act, c, geo, vn_k, closed);
             }
-            let act = self.active_contact(c, &geo, vn_k, geo.gap <= tol_gap || pending);
-            self.active.push(act);
         }
+        self.active = active;
     }
 
-    /// an active contact from a candidate's geometry: per side, the G columns of the contact
-    /// frame's directions and `M^{-1}` times them.
-    fn active_contact(&self, c: usize, geo: &Geometry, vn_k: f64, closed: bool) -> Active {
+    /// an active contact from a candidate's geometry, into `act` (a default one): per side,
+    /// the G columns of the contact frame's directions and `M^{-1}` times them.
+    fn active_contact(&self, act: &mut Active, c: usize, geo: &Geometry, vn_k: f64, closed: bool) {
         let dim = self.dim;
         let fr = frame(dim, geo.normal);
-        let mut act = Active {
-            cand: c,
-            gap: geo.gap,
-            closed,
-            vn_k,
-            nsides: geo.nsides,
-            ..Active::default()
-        };
+        act.cand = c;
+        act.gap = geo.gap;
+        act.closed = closed;
+        act.vn_k = vn_k;
+        act.nsides = geo.nsides;
         for s in 0..geo.nsides {
             let (body, sign, r) = geo.sides[s];
             let side = &mut act.sides[s];
             side.body = body;
-            let minv = &self.frozen[body].minv;
             for (j, d) in fr.iter().enumerate().take(dim) {
                 let mut col = self.column(body, r, *d);
                 for x in &mut col {
                     *x *= sign;
                 }
                 side.g[j] = col;
-                // M^{-1} is zero past nv, like the column
-                side.b[j] = std::array::from_fn(|a| dot6(&row6(minv, a), &col));
+                side.b[j] = self.minv_times(body, &col);
             }
         }
-        act
     }
 
     /// `v_{k+1} = v_free + M^{-1} G P` (into `v_next`, which holds `v_free`), and `G P`.
@@ -384,6 +393,18 @@ impl Stepper {
             let p = &self.solve.impulse[i * dim..(i + 1) * dim];
             for s in &a.sides[..a.nsides] {
                 let b = &self.bodies[s.body];
+                let (vn, gp) = (
+                    &mut v_next[b.off_v..b.off_v + b.nv],
+                    &mut self.gp[b.off_v..b.off_v + b.nv],
+                );
+                if dim == 3 {
+                    // the same sums as below, from 0 in direction order, unrolled
+                    for k in 0..b.nv {
+                        vn[k] += 0.0 + s.b[0][k] * p[0] + s.b[1][k] * p[1] + s.b[2][k] * p[2];
+                        gp[k] += 0.0 + s.g[0][k] * p[0] + s.g[1][k] * p[1] + s.g[2][k] * p[2];
+                    }
+                    continue;
+                }
                 for k in 0..b.nv {
                     let mut dv = 0.0;
                     let mut g = 0.0;
@@ -391,8 +412,8 @@ impl Stepper {
                         dv += s.b[j][k] * p[j];
                         g += s.g[j][k] * p[j];
                     }
-                    v_next[b.off_v + k] += dv;
-                    self.gp[b.off_v + k] += g;
+                    vn[k] += dv;
+                    gp[k] += g;
                 }
             }
         }
@@ -400,8 +421,13 @@ impl Stepper {
 
     /// the momentum balance of the step ([`record::momentum_residual`]), body by body.
     fn momentum_residual(&self, v_next: &[f64]) -> f64 {
-        let blocks =
-            (self.bodies.iter().zip(&self.frozen)).map(|(b, f)| (&f.m[..], 6, b.off_v, b.nv));
+        let blocks = (self.bodies.iter().zip(&self.frozen)).map(|(b, f)| record::MassBlock {
+            m: &f.m[..],
+            stride: 6,
+            off: b.off_v,
+            n: b.nv,
+            lead: b.lead,
+        });
         record::momentum_residual(blocks, v_next, &self.v_free, &self.gp)
     }
 
