@@ -35,7 +35,7 @@ def main(n: int = 10, t_end: float = 10.0, h: float = 5e-3) -> None:
     print(f"{n} boxes, {t_end} s at h = {h:g} s")
     # NSGS at its default tolerance 1e-12, with the step's default Lemke fallback: a face of
     # four contact points has more rows than the motions it stops, and on this tower NSGS
-    # alone misses its tolerance on many steps (those steps go to Lemke, counted below)
+    # alone misses its tolerance (just above it) on some steps (those go to Lemke, counted below)
     for solver in ["nsgs", "lemke"]:
         tr = scene.simulate(t_end, h, solver=solver)
         drift = np.max(np.abs(tr.q - tr.q[0]))

@@ -104,12 +104,11 @@ fn capsules_and_cylinders_on_a_plane_rest() {
 /// 1e-9 (m, and rad) of its start, at h = 5 ms.
 ///
 /// NSGS runs at its default tolerance 1e-12 with the step's default Lemke fallback. A face's
-/// four contact rows outnumber the motions they stop (W singular), and on this tower NSGS
-/// alone misses its tolerance on many steps: measured in 3D with the fallback off, a scaled
-/// error up to 3.3e-4 after its iteration limit and a drift of 1e-3 m; with the fallback, 701
-/// of the 2000 steps go to Lemke and the drift is 1.2e-10. Relaxing NSGS to 1e-10 (the
-/// tolerance the guide gives for faces) is not enough at this h: its residual velocities
-/// integrate to a drift of 1.8e-9 over 10 s (at h = 1 ms, 2.8e-10).
+/// four contact rows outnumber the motions they stop (W singular), and in 3D NSGS alone can
+/// stall just above its tolerance: measured with the fallback off, 338 of the 2000 steps end
+/// at its iteration limit with a scaled error of 1.4e-12 to 1.7e-12, and the tower then drifts
+/// by 5e-3 m; with the fallback, 27 of the 2000 steps go to Lemke and the drift is 2.7e-11 (in
+/// 2D no step needs the fallback after the first, drift 2.6e-12).
 fn ten_box_tower_stands(dim: usize, lemke: bool) {
     let scene = tower(dim, 10, 0.1, 0.5);
     let mut settings = StepSettings::new(5e-3, 2000);
@@ -130,7 +129,7 @@ fn ten_box_tower_stands(dim: usize, lemke: bool) {
 }
 
 /// The ten-box tower stands 10 s with exact sticking under NSGS and Lemke in 3D, and under
-/// Lemke in 2D.
+/// Lemke in 2D (NSGS in 2D: the next test).
 #[test]
 fn a_ten_box_tower_stands_ten_seconds_with_exact_sticking() {
     for (dim, lemke) in [(3, false), (3, true), (2, true)] {
@@ -138,13 +137,11 @@ fn a_ten_box_tower_stands_ten_seconds_with_exact_sticking() {
     }
 }
 
-/// The 2D ten-box tower under NSGS does not hold the figure: in the Python scene (pairs
-/// declared one by one) at step 29 the contact between the two lowest boxes gives no impulse
-/// for one step, reported solved, and the nine boxes above fall `g h^2` = 2.45e-4 m into it;
-/// here (one `Solids` pair) step 233 ends at NSGS's iteration limit (scaled error 1.1e-5)
-/// and the Lemke fallback does no better. Kept as the figure to reach.
+/// The 2D ten-box tower stands 10 s under NSGS too. It used to fail at state 381: parry's GJK
+/// gave no point at all for boxes 3 and 4 in that order of the pair (two in the other), the
+/// contact was dropped for a step and the six boxes above fell `g h^2` = 2.45e-4 m into box 3
+/// (regression: [`equal_faces_touching_give_their_points_in_either_order`]).
 #[test]
-#[ignore = "2D tower under NSGS: a contact gives no impulse for a step (known failure)"]
 fn a_ten_box_tower_stands_ten_seconds_in_2d_under_nsgs() {
     ten_box_tower_stands(2, false);
 }
@@ -458,4 +455,223 @@ fn a_box_sliding_over_a_mesh_floor_decelerates_at_mu_g() {
             z - half[2]
         );
     }
+}
+
+/// Two equal polygons or polyhedra stacked face to face (rectangles and hexagons in 2D, boxes
+/// and box-shaped hulls in 3D), each turned by up to 1e-10 rad and shifted sideways by up to
+/// 1e-3 of their size, at sizes 1e-3 to 1e3: the narrow phase gives the face's points (2 in
+/// 2D, at least 3 in 3D) with gaps within 1e-9 of the size, whichever solid of the pair comes first.
+/// parry's GJK can fail outright at exact touch (no point at all in one order of the pair);
+/// in a stacked tower that drops a whole contact for a step, and the boxes above fall
+/// `g h^2` into the one below.
+#[test]
+fn equal_faces_touching_give_their_points_in_either_order() {
+    use coulomb::geometry::{contacts2, contacts3, ContactCache2, ContactCache3};
+    use nalgebra::{Isometry2, Isometry3, Vector2, Vector3};
+    let mut rng = coulomb::testing::SplitMix64::new(13);
+    let tiny = |rng: &mut coulomb::testing::SplitMix64, top: f64| {
+        let m = 10f64.powf(rng.range(-16.0, top));
+        if rng.uniform() < 0.5 {
+            -m
+        } else {
+            m
+        }
+    };
+    let hexagon: Vec<[f64; 2]> = (0..6)
+        .map(|k| {
+            let a = std::f64::consts::PI / 3.0 * k as f64;
+            [a.cos(), a.sin()]
+        })
+        .collect();
+    let (mut checked, mut missed) = (0, vec![]);
+    // the states of the 2D ten-box tower (boxes 3 and 4, state 381 at h = 5 ms) where GJK
+    // gave no point in this order, and two points in the other
+    let square = ok(Shape2::rectangle([0.1, 0.1]));
+    let box3 = Isometry2::new(
+        Vector2::new(-7.72774113148572e-15, 0.6999999999999995),
+        -5.4130033788624057e-14,
+    );
+    let box4 = Isometry2::new(
+        Vector2::new(-4.402386077445178e-16, 0.9000000000000006),
+        -2.907785123795748e-14,
+    );
+    for (pa, pb) in [(box3, box4), (box4, box3)] {
+        let mut out = vec![];
+        ok(contacts2(
+            &square,
+            &pa,
+            &square,
+            &pb,
+            1e-9,
+            &mut ContactCache2::default(),
+            &mut out,
+        ));
+        assert_eq!(out.len(), 2, "the tower's boxes 3 and 4: {out:?}");
+        assert!(out.iter().all(|p| p.gap.abs() < 1e-14), "{out:?}");
+    }
+    for s in [1e-3, 0.5, 1.0, 1e3] {
+        let half = [0.5 * s, 0.3 * s, 0.2 * s];
+        let rect = ok(Shape2::rectangle([half[0], half[2]]));
+        let pts: Vec<[f64; 2]> = hexagon.iter().map(|p| [p[0] * s, p[1] * s]).collect();
+        let hex = ok(Shape2::convex_polygon(&pts));
+        // the hexagon's flat faces are at y = +-s cos(30 deg)
+        let hex_half = s * (std::f64::consts::PI / 6.0).cos();
+        let cuboid = ok(Shape3::cuboid(half));
+        let corners: Vec<[f64; 3]> = (0..8)
+            .map(|k| {
+                let sg = |b: usize| if k & b == 0 { -1.0 } else { 1.0 };
+                [sg(1) * half[0], sg(2) * half[1], sg(4) * half[2]]
+            })
+            .collect();
+        let hull = ok(Shape3::convex_hull(&corners));
+        for _ in 0..500 {
+            let (t1, t2) = (tiny(&mut rng, -10.0), tiny(&mut rng, -10.0));
+            let dx = tiny(&mut rng, -3.0) * s;
+            // the lower one at a level of a tower (its coordinates rounded)
+            let level = (rng.next_u64() % 10) as f64;
+            let (x0, y0) = (tiny(&mut rng, -12.0) * s, (2.0 * level + 1.0) * half[2]);
+            for (shape, hh) in [(&rect, half[2]), (&hex, hex_half)] {
+                let low = Isometry2::new(Vector2::new(x0, y0), t1);
+                let up = Isometry2::new(Vector2::new(x0 + dx, y0 + 2.0 * hh), t2);
+                for (pa, pb) in [(low, up), (up, low)] {
+                    let mut out = vec![];
+                    ok(contacts2(
+                        shape,
+                        &pa,
+                        shape,
+                        &pb,
+                        1e-9 * s,
+                        &mut ContactCache2::default(),
+                        &mut out,
+                    ));
+                    checked += 1;
+                    let gaps_ok = out.iter().all(|p| p.gap.abs() <= 1e-9 * s);
+                    if out.len() != 2 || !gaps_ok {
+                        missed.push(format!(
+                            "2D s {s} t {t1:e} {t2:e} dx {dx:e}: {:?}",
+                            out.iter().map(|p| p.gap).collect::<Vec<_>>()
+                        ));
+                    }
+                }
+            }
+            let (t3, t4) = (tiny(&mut rng, -10.0), tiny(&mut rng, -10.0));
+            for shape in [&cuboid, &hull] {
+                let low = Isometry3::new(Vector3::new(x0, -x0, y0), Vector3::new(t1, t3, 0.5 * t2));
+                let up = Isometry3::new(
+                    Vector3::new(x0 + dx, 0.5 * dx - x0, y0 + 2.0 * half[2]),
+                    Vector3::new(t2, t4, 0.5 * t1),
+                );
+                for (pa, pb) in [(low, up), (up, low)] {
+                    let mut out = vec![];
+                    ok(contacts3(
+                        shape,
+                        &pa,
+                        shape,
+                        &pb,
+                        1e-9 * s,
+                        &mut ContactCache3::default(),
+                        &mut out,
+                    ));
+                    checked += 1;
+                    let gaps_ok = out.iter().all(|p| p.gap.abs() <= 1e-9 * s);
+                    // a face is held by its 4 corners (parry's clip of two coincident faces can
+                    // drop one: 3 still hold it)
+                    if out.len() < 3 || !gaps_ok {
+                        missed.push(format!(
+                            "3D s {s} t {t1:e} {t3:e} dx {dx:e}: {:?}",
+                            out.iter().map(|p| p.gap).collect::<Vec<_>>()
+                        ));
+                    }
+                }
+            }
+        }
+    }
+    assert!(
+        missed.is_empty(),
+        "{} of {checked} queries miss the face's points: {:?}",
+        missed.len(),
+        &missed[..missed.len().min(8)]
+    );
+}
+
+/// The worst figures of the contact law over a trajectory, from the recorded impulses and
+/// post-step velocities alone (no solver measure): `(penetration, approach, complementarity,
+/// cone, slip)`, in units of the step's own scales (`g h` for velocities, `m g h` for
+/// impulses, the box's half side for gaps).
+fn law_figures(tr: &Trajectory, mu: f64, m: f64, h: f64, half: f64) -> [f64; 5] {
+    let (vs, ps) = (G * h, m * G * h);
+    let solved = |k: usize| tr.steps[k].status == Some(ContactStatus::Solved);
+    // gaps are judged up to the first step not solved (after it the state may be off)
+    let first_unsolved = (0..tr.steps.len())
+        .find(|&k| tr.steps[k].active > 0 && !solved(k))
+        .unwrap_or(usize::MAX);
+    let mut w = [0.0f64; 5];
+    for c in &tr.contacts {
+        let [pn, pt1, pt2] = c.impulse;
+        let [vn, vt1, vt2] = c.velocity;
+        let pt = pt1.hypot(pt2);
+        let vt = vt1.hypot(vt2);
+        if c.step <= first_unsolved {
+            w[0] = w[0].max(-c.gap / half);
+        }
+        if !c.closed || !solved(c.step) {
+            continue;
+        }
+        // Signorini: P_n >= 0, v_n+ >= 0, P_n v_n+ = 0
+        w[1] = w[1].max(-vn / vs).max(-pn / ps);
+        w[2] = w[2].max(pn.max(0.0) * vn.max(0.0) / (ps * vs));
+        // Coulomb: |P_t| <= mu P_n; sliding only on the cone's edge, against the slip
+        w[3] = w[3].max((pt - mu * pn) / ps);
+        if vt > 1e-9 * vs {
+            let opposed = -(pt1 * vt1 + pt2 * vt2) / vt;
+            w[4] = w[4].max((mu * pn - opposed) / ps);
+        }
+    }
+    w
+}
+
+/// No false success on towers: in 2D and 3D, under NSGS and Lemke, at two h, three mu, three
+/// sizes and two heights, every closed contact of every step reported solved obeys the
+/// contact law from the recorded impulses and velocities alone, checked apart from
+/// the solver's own measure: no penetration beyond 1e-9 of the box's size up to the first step
+/// not solved (a contact left out of a step shows here, as the boxes above fall `g h^2` into it), Signorini's conditions
+/// and Coulomb's cone within 1e-8 of the step's scales (`g h`, `m g h`), and no slip.
+#[test]
+fn towers_obey_the_contact_law_at_every_closed_contact_of_every_step() {
+    let mut runs = 0;
+    for dim in [2, 3] {
+        for lemke in [false, true] {
+            for (h, t) in [(5e-3, 2.0), (1e-3, 0.3)] {
+                for (k, (mu, half)) in [(0.5, 0.1), (0.1, 0.01), (2.0, 1.0)]
+                    .into_iter()
+                    .enumerate()
+                {
+                    let n = if k == 0 { 10 } else { 6 };
+                    let scene = tower(dim, n, half, mu);
+                    let mut settings = StepSettings::new(h, (t / h) as usize);
+                    if lemke {
+                        settings.solver = StepSolver::Lemke(PolyhedralSettings::for_dim(dim));
+                    }
+                    let tr = run(&scene, &settings);
+                    let case =
+                        format!("dim {dim}, lemke {lemke}, h {h}, mu {mu}, half {half}, n {n}");
+                    let unsolved = tr
+                        .steps
+                        .iter()
+                        .filter(|s| s.active > 0 && s.status != Some(ContactStatus::Solved))
+                        .count();
+                    let w = law_figures(&tr, mu, 1.0, h, half);
+                    // an honest miss is allowed here (its status says so); a success is not
+                    println!("{case}: steps not solved {unsolved}, figures {w:?}");
+                    let names = ["penetration", "approach", "complementarity", "cone", "slip"];
+                    let bounds = [1e-9, 1e-8, 1e-8, 1e-8, 1e-8];
+                    for ((x, b), name) in w.iter().zip(bounds).zip(names) {
+                        assert!(*x <= b, "{case}: {name} {x:e} (all: {w:?})");
+                    }
+                    runs += 1;
+                }
+            }
+        }
+    }
+    assert_eq!(runs, 24);
 }

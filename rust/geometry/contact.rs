@@ -144,6 +144,11 @@ const TOUCH: f64 = 1e-10;
 /// Relative margin by which the first query must beat the second to be kept.
 const PREFER: f64 = 1e-12;
 
+/// whether two bounding boxes `(lo, hi)`, each grown by `pad`, meet.
+fn boxes_meet<const D: usize>(a: ([f64; D], [f64; D]), b: ([f64; D], [f64; D]), pad: f64) -> bool {
+    (0..D).all(|k| a.0[k] <= b.1[k] + pad && b.0[k] <= a.1[k] + pad)
+}
+
 fn deepest_gap<P>(points: &[P], gap: impl Fn(&P) -> f64) -> f64 {
     points.iter().map(gap).fold(f64::INFINITY, f64::min)
 }
@@ -417,13 +422,23 @@ macro_rules! contacts_impl {
             $raw(shapes, unit, pose_a, pose_b, zero, prediction, manifolds, ws, out)?;
             let first = deepest_gap(out, |p| p.gap);
             // a half-space's points are its support feature's vertices: no GJK to go wrong
-            if first > TOUCH * size || a.is_half_space() || b.is_half_space() {
+            if a.is_half_space() || b.is_half_space() {
+                return Ok(());
+            }
+            // no point at all, yet the bounding boxes (grown by the prediction) meet: GJK can
+            // also fail outright at exact touch (two equal rectangles stacked face to face,
+            // turned by 1e-14 rad, come back with no point in one order of the pair and two in
+            // the other), so the pulled-apart query below is made for these too
+            let empty = out.is_empty();
+            if (!empty && first > TOUCH * size) || (empty && !boxes_meet(a.aabb(pose_a), b.aabb(pose_b), prediction)) {
                 return Ok(());
             }
             // touching or overlapping: query again with b pulled apart, along the line of
-            // centres between two moving shapes, else along the first answer's normal
+            // centres between two moving shapes (or when the first query gave no normal),
+            // else along the first answer's normal
             let centres = pose_b.translation.vector - pose_a.translation.vector;
-            let along = if !a.is_static() && !b.is_static() && centres.norm() > TOUCH * size {
+            let by_centres = (empty || (!a.is_static() && !b.is_static())) && centres.norm() > TOUCH * size;
+            let along = if by_centres {
                 centres.normalize()
             } else {
                 match out.iter().min_by(|p, q| p.gap.total_cmp(&q.gap)) {
@@ -435,7 +450,7 @@ macro_rules! contacts_impl {
             let ws = (&mut *workspace, &mut *convex);
             $raw(shapes, unit, pose_a, pose_b, shift, prediction, manifolds, ws, retry)?;
             let second = deepest_gap(retry, |p| p.gap);
-            if first <= second + PREFER * size {
+            if (empty && !retry.is_empty()) || first <= second + PREFER * size {
                 std::mem::swap(out, retry);
             }
             Ok(())
