@@ -153,6 +153,23 @@ class Counts:
     worst_false: float = 0.0
 
 
+@dataclass
+class Flip:
+    """One status change of a campaign: the method, the problem (seed, dim, planted, class),
+    its units and the other units (or ``"ulp"``: the one-ulp rounding control), and per solve
+    the status, iterations and message."""
+
+    method: str
+    seed: int
+    dim: int
+    hard: bool
+    units: tuple[int, int]
+    other: tuple[int, int] | str
+    statuses: tuple[str, str]
+    iterations: tuple[int, int]
+    messages: tuple[str, str]
+
+
 METHODS = ("nsgs", "prox", "lemke")
 FALSE = 1e-6  # a success whose law violation exceeds this (relative) is false
 TOL = 1e-8
@@ -165,11 +182,13 @@ def solve(p: Problem, method: str):
     return contact.solve(p.W, p.q, p.mu, dim=p.dim, method=method, tol=TOL, **kw)
 
 
-def campaign(n: int, start: int = 0, ulp: bool = False) -> dict[str, Counts]:
+def campaign(n: int, start: int = 0, ulp: bool = False,
+             flips: list[Flip] | None = None) -> dict[str, Counts]:
     """n generated problems (2 in 3 planted, both dims, units 10^-8..10^8, mu 0..1e12), each
     solved by every method in its units and in other units (status compared); with ``ulp``,
     also with its data moved by one ulp in its own units (:func:`perturb_ulp`, status
-    compared: the rounding control of the unit changes)."""
+    compared: the rounding control of the unit changes). Each status change is appended to
+    ``flips`` when given."""
     out = {m: Counts() for m in METHODS}
     for seed in range(start, start + n):
         rng = np.random.default_rng(10_000 + seed)
@@ -186,9 +205,17 @@ def campaign(n: int, start: int = 0, ulp: bool = False) -> dict[str, Counts]:
             res3 = solve(p3, method) if p3 is not None else res
             c.cases += 1
             c.planted += planted
+            hard = bool(p.mu.max() > 10 or not planted)
+            if flips is not None:
+                for other, res_o in (((ka2, kb2), res2), ("ulp", res3)):
+                    if res.status != res_o.status:
+                        flips.append(Flip(method, seed, dim, hard, (ka, kb), other,
+                                          (res.status, res_o.status),
+                                          (res.iterations, res_o.iterations),
+                                          (res.message, res_o.message)))
             # mu above 10 somewhere (conditioned like mu) or no solution planted: a verdict
             # near the tolerance may differ with the rounding of the scaled data
-            if p.mu.max() > 10 or not planted:
+            if hard:
                 c.hard_cases += 1
                 c.hard_status_changes += res.status != res2.status
                 c.ulp_hard_status_changes += res.status != res3.status
@@ -209,9 +236,15 @@ def campaign(n: int, start: int = 0, ulp: bool = False) -> dict[str, Counts]:
     return out
 
 
-if __name__ == "__main__":  # the long campaign of docs/properties.md
+if __name__ == "__main__":  # the long campaign of docs/properties.md: N [START] [--flips]
     import sys
 
-    n = int(sys.argv[1]) if len(sys.argv) > 1 else 3000
-    for method, c in campaign(n, ulp=True).items():
+    args = [a for a in sys.argv[1:] if not a.startswith("--")]
+    n = int(args[0]) if args else 3000
+    start = int(args[1]) if len(args) > 1 else 0
+    changes: list[Flip] = []
+    for method, c in campaign(n, start, ulp=True, flips=changes).items():
         print(f"{method}: {c}")
+    if "--flips" in sys.argv:  # every status change, one a line
+        for f in changes:
+            print(f)
