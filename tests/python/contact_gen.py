@@ -236,10 +236,31 @@ def campaign(n: int, start: int = 0, ulp: bool = False,
     return out
 
 
-if __name__ == "__main__":  # the long campaign of docs/properties.md: N [START] [--flips]
+def moderate_changes(method: str, n: int, dim: int = 3, seed: int = 1) -> tuple[int, int]:
+    """Status changes on n planted problems with mu <= 10 (the property test's class): each
+    solved as generated, in other units 10^ka, 10^kb (ka, kb in -8..8), and with its data
+    moved by one ulp (:func:`perturb_ulp`); returns (changes with the units, changes by one
+    ulp)."""
+    rng = np.random.default_rng(seed)
+    units = ulps = 0
+    for _ in range(n):
+        s = int(rng.integers(0, 2**31))
+        ka, kb = (int(k) for k in rng.integers(-8, 9, 2))
+        base = generate(s, dim, True, mu_choices=MODERATE_MU)
+        r = solve(base, method)
+        units += r.status != solve(generate(s, dim, True, ka, kb, mu_choices=MODERATE_MU),
+                                   method).status
+        ulps += r.status != solve(perturb_ulp(base, s), method).status
+    return units, ulps
+
+
+if __name__ == "__main__":  # docs/properties.md: N [START] [--flips] | N --moderate
     import sys
 
     args = [a for a in sys.argv[1:] if not a.startswith("--")]
+    if "--moderate" in sys.argv:  # N planted problems, mu <= 10, 3D: prox's changes
+        print(moderate_changes("prox", int(args[0]) if args else 3000))
+        raise SystemExit(0)
     n = int(args[0]) if args else 3000
     start = int(args[1]) if len(args) > 1 else 0
     changes: list[Flip] = []
