@@ -69,15 +69,17 @@
 //! 1e-8; see [`super::measures`]); `error_q` and `error` are reported too.
 
 mod jacobian;
+mod newton;
 mod restart;
 
 use super::lcp_finish::{finish_2d, finish_2d_whole};
-use super::projection::{project_cone, tangent_norm};
+use super::projection::project_cone;
 use super::{measure_into, ContactMeasures, ContactProblem, ContactSolution, ContactStatus};
 use crate::error::{CoulombError, Result};
 use crate::readable::Readable;
 pub use jacobian::cone_projection_jacobian;
 use jacobian::{contact_factors, Jacobian};
+use newton::{line_search, natural_map};
 
 /// Settings of [`solve_prox`].
 #[derive(Clone, Debug)]
@@ -116,38 +118,81 @@ const MAX_RESTARTS: usize = 10;
 /// Newton steps taken after the test passes, for an answer whose projection on the cones
 /// passes too.
 const FEASIBILITY_STEPS: usize = 3;
-/// step halvings in the line search.
-const MAX_HALVINGS: usize = 30;
 
-/// `F(r)` (scaled natural map, see the module notes) into `f`, given `u = W r + q`; returns
-/// `||F||`.
-fn natural_map(dim: usize, mu: &[f64], rho: &[f64], r: &[f64], u: &[f64], f: &mut [f64]) -> f64 {
-    let mut sum = 0.0;
-    for (i, (&mui, &rhoi)) in mu.iter().zip(rho).enumerate() {
-        let o = i * dim;
-        let ri = &r[o..o + dim];
-        let ui = &u[o..o + dim];
-        let ut = tangent_norm(&ui[1..]);
-        let mut x = [0.0; 3];
-        x[0] = ri[0] - rhoi * (ui[0] + mui * ut);
-        for k in 1..dim {
-            x[k] = ri[k] - rhoi * ui[k];
-        }
-        project_cone(&mut x[..dim], mui);
-        for k in 0..dim {
-            let v = ri[k] - x[k];
-            f[o + k] = v;
-            sum += v * v;
-        }
-    }
-    sum.sqrt()
+/// How a run of [`solve_prox`] ended: Newton steps, restarts, the last eta, whether the
+/// restarts were spent, and the 2D LCP finish (working-set contacts, rounds, pivots) when it
+/// gave the answer.
+struct Run {
+    iterations: usize,
+    restarts: usize,
+    eta: f64,
+    stalled: bool,
+    finish: Option<(usize, usize, usize)>,
 }
 
-/// `u = W r + q` into `u`.
-fn velocity(problem: &ContactProblem<'_>, r: &[f64], u: &mut [f64]) {
-    problem.mul_w(r, u);
-    for (ui, qi) in u.iter_mut().zip(problem.q) {
-        *ui += qi;
+impl Run {
+    /// The status and message of the answer r (with its measures): solved exactly when it
+    /// passes the success rule.
+    fn verdict(
+        &self,
+        measures: &ContactMeasures,
+        r: &[f64],
+        s: &ProxSettings,
+        nc: usize,
+    ) -> (ContactStatus, String) {
+        let Self {
+            iterations,
+            restarts,
+            eta,
+            stalled,
+            finish,
+        } = *self;
+        let finished = match finish {
+            Some((contacts, rounds, pivots)) => format!(
+                " and the 2D LCP finish (Lemke, {pivots} pivots in {rounds} rounds on {contacts} of \
+                 {nc} contacts)"
+            ),
+            None => String::new(),
+        };
+        if measures.passes(s.tol) {
+            (
+                ContactStatus::Solved,
+                format!(
+                    "solved in {iterations} Newton steps{finished} (scaled_error {})",
+                    Readable(measures.scaled_error)
+                ),
+            )
+        } else if !measures.scaled_error.is_finite() || r.iter().any(|v| !v.is_finite()) {
+            (
+                ContactStatus::NumericalFailure,
+                format!("the iterates became non-finite after {iterations} Newton steps"),
+            )
+        } else if stalled {
+            // the budget of restarts is spent: like the step budget, a limit of the method (the
+            // arithmetic did not break down), and reported as such, so that a problem stalling
+            // at step 197 in some units and stopping at step 200 in others gets one status
+            (
+                ContactStatus::IterationLimit,
+                format!(
+                    "stalled after {iterations} Newton steps and {restarts} restarts: no step \
+                     decreases the natural-map residual even with the proximal parameter at \
+                     {} (scaled_error {} > tol {})",
+                    Readable(eta),
+                    Readable(measures.scaled_error),
+                    Readable(s.tol)
+                ),
+            )
+        } else {
+            (
+                ContactStatus::IterationLimit,
+                format!(
+                    "stopped at max_iter = {} with scaled_error {} > tol {}",
+                    s.max_iter,
+                    Readable(measures.scaled_error),
+                    Readable(s.tol)
+                ),
+            )
+        }
     }
 }
 
@@ -302,36 +347,31 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
             continue;
         }
         // backtracking on ||F||
-        let mut t = 1.0;
-        let mut accepted = false;
-        for _ in 0..=MAX_HALVINGS {
-            for k in 0..n {
-                r_try[k] = r[k] + t * d[k];
-            }
-            velocity(problem, &r_try, &mut u_try);
-            let phi_try = natural_map(dim, problem.mu, &rho, &r_try, &u_try, &mut f_try);
-            if phi_try <= (1.0 - 1e-4 * t) * phi {
+        match line_search(
+            problem,
+            &rho,
+            phi,
+            (&r, &d),
+            (&mut r_try, &mut u_try, &mut f_try),
+        ) {
+            Some((phi_try, t)) => {
                 phi = phi_try;
-                accepted = true;
-                break;
+                std::mem::swap(&mut r, &mut r_try);
+                std::mem::swap(&mut f, &mut f_try);
+                measures = measure_into(problem, &r, &mut u);
+                if phi < 0.1 * phi_mark {
+                    phi_mark = phi;
+                    iter_mark = iterations;
+                }
+                if t == 1.0 {
+                    eta = (eta * 0.1).max(ETA_MIN);
+                }
             }
-            t *= 0.5;
-        }
-        if accepted {
-            std::mem::swap(&mut r, &mut r_try);
-            std::mem::swap(&mut f, &mut f_try);
-            measures = measure_into(problem, &r, &mut u);
-            if phi < 0.1 * phi_mark {
-                phi_mark = phi;
-                iter_mark = iterations;
-            }
-            if t == 1.0 {
-                eta = (eta * 0.1).max(ETA_MIN);
-            }
-        } else {
-            eta *= 10.0;
-            if eta > ETA_MAX {
-                stalled = true;
+            None => {
+                eta *= 10.0;
+                if eta > ETA_MAX {
+                    stalled = true;
+                }
             }
         }
     }
@@ -346,52 +386,14 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
             finish = Some((fin.contacts, fin.rounds, fin.pivots));
         }
     }
-    let finished = match finish {
-        Some((contacts, rounds, pivots)) => format!(
-            " and the 2D LCP finish (Lemke, {pivots} pivots in {rounds} rounds on {contacts} of \
-             {nc} contacts)"
-        ),
-        None => String::new(),
+    let run = Run {
+        iterations,
+        restarts,
+        eta,
+        stalled,
+        finish,
     };
-    let (status, message) = if measures.passes(s.tol) {
-        (
-            ContactStatus::Solved,
-            format!(
-                "solved in {iterations} Newton steps{finished} (scaled_error {})",
-                Readable(measures.scaled_error)
-            ),
-        )
-    } else if !measures.scaled_error.is_finite() || r.iter().any(|v| !v.is_finite()) {
-        (
-            ContactStatus::NumericalFailure,
-            format!("the iterates became non-finite after {iterations} Newton steps"),
-        )
-    } else if stalled {
-        // the budget of restarts is spent: like the step budget, a limit of the method (the
-        // arithmetic did not break down), and reported as such, so that a problem stalling
-        // at step 197 in some units and stopping at step 200 in others gets one status
-        (
-            ContactStatus::IterationLimit,
-            format!(
-                "stalled after {iterations} Newton steps and {restarts} restarts: no step \
-                 decreases the natural-map residual even with the proximal parameter at \
-                 {} (scaled_error {} > tol {})",
-                Readable(eta),
-                Readable(measures.scaled_error),
-                Readable(s.tol)
-            ),
-        )
-    } else {
-        (
-            ContactStatus::IterationLimit,
-            format!(
-                "stopped at max_iter = {} with scaled_error {} > tol {}",
-                s.max_iter,
-                Readable(measures.scaled_error),
-                Readable(s.tol)
-            ),
-        )
-    };
+    let (status, message) = run.verdict(&measures, &r, s, nc);
     Ok(ContactSolution {
         impulse: r,
         velocity: u,
