@@ -308,9 +308,11 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
                 measures = measure_into(problem, &r, &mut u);
                 phi = natural_map(dim, problem.mu, &rho, &r, &u, &mut f);
             }
-            // the truncated sweeps did not move the iterate: exact local solves (see
-            // `restart`)
-            if phi.is_nan() || phi >= restart::MOVED * at_stall {
+            // the truncated sweeps did not move the iterate, far from passing: exact local
+            // solves (see `restart`)
+            if (phi.is_nan() || phi >= restart::MOVED * at_stall)
+                && (measures.scaled_error.is_nan() || measures.scaled_error > restart::FAR * s.tol)
+            {
                 r_try.copy_from_slice(&r);
                 restart::exact_sweep(problem, &mut r_try, s.tol)?;
                 if r_try.iter().all(|v| v.is_finite()) {

@@ -12,7 +12,8 @@
 //!
 //! First [`RESTART_SWEEPS`] sweeps of [`solve_nsgs`], whose 3D local solve of a contact that
 //! others act on is a truncated descent; when they leave `||F||` above [`MOVED`] of its value
-//! at the stall, one sweep of exact local solves follows ([`exact_sweep`]). Why both: the
+//! at the stall and `scaled_error` above [`FAR`] times tol, one sweep of exact local solves
+//! follows ([`exact_sweep`]). Why both: the
 //! truncated passes may stall themselves where a sliding contact is far from its local
 //! solution (campaign problem 1959 of docs/properties.md, four 3D contacts: NSGS sweeps from
 //! the stall, up to 10,000 of them, stay at scaled_error 1.5e-3, while one sweep of exact
@@ -29,6 +30,11 @@ pub(super) const RESTART_SWEEPS: usize = 100;
 /// a restart whose NSGS sweeps leave `||F||` above this fraction of its value at the stall
 /// takes a sweep of exact local solves too.
 pub(super) const MOVED: f64 = 0.9;
+/// the exact sweep is taken only at a stall whose scaled_error exceeds this multiple of tol:
+/// near the tolerance a stall is on the rounding of a solution, where exact local solves
+/// move the iterate off it (the 3D ten-box tower at tol 1e-12, `tests/step_solids.rs`, then
+/// ends a step at 1.09e-12) and the NSGS sweeps finish it.
+pub(super) const FAR: f64 = 1e3;
 /// sweeps of one one-contact solve (a single contact is solved exactly in one sweep: closed
 /// form, or Newton on the slip angle; the rest is a margin for its descent fallback).
 const LOCAL_SWEEPS: usize = 50;
