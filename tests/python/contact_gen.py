@@ -153,6 +153,23 @@ class Counts:
     worst_false: float = 0.0
 
 
+@dataclass
+class Flip:
+    """One status change of a campaign: the method, the problem (seed, dim, planted, class),
+    its units and the other units (or ``"ulp"``: the one-ulp rounding control), and per solve
+    the status, iterations and message."""
+
+    method: str
+    seed: int
+    dim: int
+    hard: bool
+    units: tuple[int, int]
+    other: tuple[int, int] | str
+    statuses: tuple[str, str]
+    iterations: tuple[int, int]
+    messages: tuple[str, str]
+
+
 METHODS = ("nsgs", "prox", "lemke")
 FALSE = 1e-6  # a success whose law violation exceeds this (relative) is false
 TOL = 1e-8
@@ -165,11 +182,13 @@ def solve(p: Problem, method: str):
     return contact.solve(p.W, p.q, p.mu, dim=p.dim, method=method, tol=TOL, **kw)
 
 
-def campaign(n: int, start: int = 0, ulp: bool = False) -> dict[str, Counts]:
+def campaign(n: int, start: int = 0, ulp: bool = False,
+             flips: list[Flip] | None = None) -> dict[str, Counts]:
     """n generated problems (2 in 3 planted, both dims, units 10^-8..10^8, mu 0..1e12), each
     solved by every method in its units and in other units (status compared); with ``ulp``,
     also with its data moved by one ulp in its own units (:func:`perturb_ulp`, status
-    compared: the rounding control of the unit changes)."""
+    compared: the rounding control of the unit changes). Each status change is appended to
+    ``flips`` when given."""
     out = {m: Counts() for m in METHODS}
     for seed in range(start, start + n):
         rng = np.random.default_rng(10_000 + seed)
@@ -186,9 +205,17 @@ def campaign(n: int, start: int = 0, ulp: bool = False) -> dict[str, Counts]:
             res3 = solve(p3, method) if p3 is not None else res
             c.cases += 1
             c.planted += planted
+            hard = bool(p.mu.max() > 10 or not planted)
+            if flips is not None:
+                for other, res_o in (((ka2, kb2), res2), ("ulp", res3)):
+                    if res.status != res_o.status:
+                        flips.append(Flip(method, seed, dim, hard, (ka, kb), other,
+                                          (res.status, res_o.status),
+                                          (res.iterations, res_o.iterations),
+                                          (res.message, res_o.message)))
             # mu above 10 somewhere (conditioned like mu) or no solution planted: a verdict
             # near the tolerance may differ with the rounding of the scaled data
-            if p.mu.max() > 10 or not planted:
+            if hard:
                 c.hard_cases += 1
                 c.hard_status_changes += res.status != res2.status
                 c.ulp_hard_status_changes += res.status != res3.status
@@ -209,9 +236,36 @@ def campaign(n: int, start: int = 0, ulp: bool = False) -> dict[str, Counts]:
     return out
 
 
-if __name__ == "__main__":  # the long campaign of docs/properties.md
+def moderate_changes(method: str, n: int, dim: int = 3, seed: int = 1) -> tuple[int, int]:
+    """Status changes on n planted problems with mu <= 10 (the property test's class): each
+    solved as generated, in other units 10^ka, 10^kb (ka, kb in -8..8), and with its data
+    moved by one ulp (:func:`perturb_ulp`); returns (changes with the units, changes by one
+    ulp)."""
+    rng = np.random.default_rng(seed)
+    units = ulps = 0
+    for _ in range(n):
+        s = int(rng.integers(0, 2**31))
+        ka, kb = (int(k) for k in rng.integers(-8, 9, 2))
+        base = generate(s, dim, True, mu_choices=MODERATE_MU)
+        r = solve(base, method)
+        units += r.status != solve(generate(s, dim, True, ka, kb, mu_choices=MODERATE_MU),
+                                   method).status
+        ulps += r.status != solve(perturb_ulp(base, s), method).status
+    return units, ulps
+
+
+if __name__ == "__main__":  # docs/properties.md: N [START] [--flips] | N --moderate
     import sys
 
-    n = int(sys.argv[1]) if len(sys.argv) > 1 else 3000
-    for method, c in campaign(n, ulp=True).items():
+    args = [a for a in sys.argv[1:] if not a.startswith("--")]
+    if "--moderate" in sys.argv:  # N planted problems, mu <= 10, 3D: prox's changes
+        print(moderate_changes("prox", int(args[0]) if args else 3000))
+        raise SystemExit(0)
+    n = int(args[0]) if args else 3000
+    start = int(args[1]) if len(args) > 1 else 0
+    changes: list[Flip] = []
+    for method, c in campaign(n, start, ulp=True, flips=changes).items():
         print(f"{method}: {c}")
+    if "--flips" in sys.argv:  # every status change, one a line
+        for f in changes:
+            print(f)

@@ -11,6 +11,8 @@ import pytest
 from contact_gen import law_violation
 from coulomb import contact, lcp
 from helpers import contact_scaled_error
+from hypothesis import example, given, settings
+from hypothesis import strategies as st
 
 METHODS = ("nsgs", "prox", "lemke")
 
@@ -196,3 +198,27 @@ def test_ill_conditioned_polyhedral_lcps_are_solved_in_every_unit_system(
         r = solve(p, "lemke")
         assert r.success, (ka, kb, r.message)
         assert law_violation(p.W, p.q, p.mu, dim, r.impulse, polygon=dim == 3) <= FALSE
+
+
+@settings(max_examples=40, deadline=None, derandomize=True)
+@given(st.integers(-8, 8), st.integers(-8, 8))
+@example(0, -2)
+@example(-4, -2)
+@example(4, -2)
+@example(8, -4)
+@example(4, 8)
+def test_the_robust_mode_leaves_a_stall_that_nsgs_sweeps_cannot_leave_in_every_unit_system(
+        ka: int, kb: int) -> None:
+    # Campaign problem 1959 (four 3D contacts, mu 0.5, 0, 10, 2, planted, W of condition 5e7):
+    # in 5 of 81 unit systems (the examples) the robust mode's Newton path met a stationary
+    # point of ||F|| that is not a solution (a mu = 10 contact sliding while approaching,
+    # scaled_error 1.5e-3), and its restarts by NSGS sweeps stayed there (NSGS's truncated
+    # local passes stall at that point too, even after 10,000 sweeps): `iteration_limit`
+    # there, solved in 47 steps elsewhere. A restart whose sweeps do not move the iterate now
+    # takes a sweep of exact one-contact solves, which leaves it.
+    from contact_gen import FALSE, generate, law_violation, solve
+
+    p = generate(1959, 3, True, ka, kb)
+    r = solve(p, "prox")
+    assert r.success, (ka, kb, r.message)
+    assert law_violation(p.W, p.q, p.mu, 3, r.impulse) <= FALSE, r.message
