@@ -436,6 +436,7 @@ pub fn solve_polyhedral_lcp(
         ls.status == LcpStatus::Solved
             && (problem.dim != 2 || measure_into(problem, r, u).passes(tol))
     };
+    let mut note = String::new();
     // the settings are checked before the shortcut as Lemke would check them
     crate::lcp::lemke::validate(&lref, &settings.lemke)?;
     let mut ls = match separating_answer(problem, &lcp, &lref, tol)? {
@@ -455,6 +456,18 @@ pub fn solve_polyhedral_lcp(
                 ls = t;
                 r = rt;
                 break;
+            }
+        }
+        if !accepted(&ls, &r, &mut u) {
+            // large mu: the capped and scaled LCPs, answers checked on this one
+            let found = large_mu::solve(problem, &lcp, &lref, &settings.lemke, |t, rt| {
+                accepted(t, rt, &mut u)
+            })?;
+            pivots += found.pivots;
+            if let Some((t, rt)) = found.answer {
+                note = format!(", {}", t.message);
+                ls = t;
+                r = rt;
             }
         }
         ls.pivots = pivots;
@@ -483,8 +496,8 @@ pub fn solve_polyhedral_lcp(
         LcpStatus::Solved => (
             ContactStatus::Solved,
             format!(
-                "{what} solved by Lemke in {} pivots (LCP error {}; against the exact disk \
-                 scaled_error {})",
+                "{what} solved by Lemke in {} pivots{note} (LCP error {}; against the exact \
+                 disk scaled_error {})",
                 ls.pivots,
                 Readable(lm.error),
                 Readable(measures.scaled_error)
@@ -518,6 +531,9 @@ pub fn solve_polyhedral(
 ) -> Result<ContactSolution> {
     solve_polyhedral_lcp(problem, settings).map(|(s, _, _)| s)
 }
+
+#[path = "polyhedral_large_mu.rs"]
+mod large_mu;
 
 #[cfg(test)]
 #[path = "polyhedral_tests.rs"]
