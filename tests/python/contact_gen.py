@@ -37,10 +37,11 @@ class Problem:
 
 
 def generate(seed: int, dim: int, planted: bool, ka: int = 0, kb: int = 0,
-             mu_class: float | None = None, mu_choices: tuple[float, ...] = MU_CLASSES
-             ) -> Problem:
+             mu_class: float | None = None, mu_choices: tuple[float, ...] = MU_CLASSES,
+             sliding: bool = True) -> Problem:
     """One problem (see the module notes); ``mu_class`` fixes mu for every contact, otherwise
-    each contact draws one of ``mu_choices``."""
+    each contact draws one of ``mu_choices``; without ``sliding`` a planted contact drawn to
+    slide sticks instead (same draws)."""
     rng = np.random.default_rng(seed)
     nc = int(rng.integers(1, 7))
     n = dim * nc
@@ -64,7 +65,7 @@ def generate(seed: int, dim: int, planted: bool, ka: int = 0, kb: int = 0,
             t /= max(np.linalg.norm(t), 1e-300)
             if mode == 0:  # separating
                 u_star[s] = np.concatenate([[rng.uniform(0.1, 1.0)], rng.standard_normal(dim - 1)])
-            elif mode == 1:  # sticking
+            elif mode == 1 or not sliding:  # sticking
                 rn = rng.uniform(0.1, 1.0)
                 frac = rng.uniform(0.0, 0.9)
                 r_star[s] = np.concatenate([[rn], -min(mu[i], 2.0) * frac * rn * t])
