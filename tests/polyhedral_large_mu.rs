@@ -209,7 +209,8 @@ fn every_success_with_a_huge_mu_satisfies_the_law_and_sliding_is_mostly_solved()
                 s.message
             );
         } else {
-            assert!(!s.message.is_empty());
+            // the refusal says that the large-mu LCPs were tried too
+            assert!(s.message.contains("capped"), "case {k}: {}", s.message);
         }
     }
     println!("{solved} of {cases} solved");

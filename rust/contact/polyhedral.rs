@@ -49,6 +49,12 @@
 //! the rest of the LCP is unchanged. The reported measures are then taken against the exact
 //! ellipse.
 //!
+//! With friction coefficients of 1e8 and more the LCP is conditioned like mu and whether a
+//! pivoting path solves it depends on the rounding of the data; when every path fails, two
+//! reformulations without mu's size in the tableau are tried, the cone rows capped (sticking
+//! contacts) and sliding contacts' β in units of r_n, and an answer of either is kept only when
+//! it is an answer of the given LCP (`polyhedral_large_mu.rs`).
+//!
 //! A is copositive but not positive semidefinite, so
 //! the LCP is solved by [`crate::lcp::solve_lemke`], not by PGS. Frictionless contacts carry
 //! only their normal unknown. The impulses are mapped back (`r_i = (r_n, D_i β_i)`) and the
@@ -436,7 +442,8 @@ pub fn solve_polyhedral_lcp(
         ls.status == LcpStatus::Solved
             && (problem.dim != 2 || measure_into(problem, r, u).passes(tol))
     };
-    let mut note = String::new();
+    // how an answer of the large-mu LCPs was found, or that they did not find one
+    let (mut note, mut refused) = (String::new(), String::new());
     // the settings are checked before the shortcut as Lemke would check them
     crate::lcp::lemke::validate(&lref, &settings.lemke)?;
     let mut ls = match separating_answer(problem, &lcp, &lref, tol)? {
@@ -468,6 +475,13 @@ pub fn solve_polyhedral_lcp(
                 note = format!(", {}", t.message);
                 ls = t;
                 r = rt;
+            } else if found.pivots > 0 {
+                refused = format!(
+                    "; the LCPs with the cone rows of mu > {:e} capped, or sliding contacts \
+                     in units of r_n, gave no answer of this one either ({} pivots)",
+                    large_mu::CAPS[0],
+                    found.pivots
+                );
             }
         }
         ls.pivots = pivots;
@@ -486,7 +500,7 @@ pub fn solve_polyhedral_lcp(
             ContactStatus::NumericalFailure,
             format!(
                 "{what} solved by Lemke in {} pivots (LCP error {}), but the impulses miss \
-                 the tolerance on the contact problem (scaled_error {} > tol {})",
+                 the tolerance on the contact problem (scaled_error {} > tol {}){refused}",
                 ls.pivots,
                 Readable(lm.error),
                 Readable(measures.scaled_error),
@@ -505,11 +519,11 @@ pub fn solve_polyhedral_lcp(
         ),
         LcpStatus::PivotLimit => (
             ContactStatus::IterationLimit,
-            format!("{what}: Lemke {}: {}", ls.status, ls.message),
+            format!("{what}: Lemke {}: {}{refused}", ls.status, ls.message),
         ),
         _ => (
             ContactStatus::NumericalFailure,
-            format!("{what}: Lemke {}: {}", ls.status, ls.message),
+            format!("{what}: Lemke {}: {}{refused}", ls.status, ls.message),
         ),
     };
     let sol = ContactSolution {
