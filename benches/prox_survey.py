@@ -17,7 +17,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-import peer_contact as pc  # noqa: E402
+import peer_contact as pc
 
 
 def main() -> None:
