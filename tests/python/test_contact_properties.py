@@ -22,9 +22,10 @@ from contact_gen import (
     campaign,
     generate,
     law_violation,
+    perturb_ulp,
     solve,
 )
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 LONG = os.environ.get("COULOMB_PROPERTIES") == "long"
@@ -47,6 +48,7 @@ def test_every_success_satisfies_the_law(seed, dim, planted, ka, kb, method):
 
 @SETTINGS
 @given(st.integers(0, 2**31), st.sampled_from([2, 3]), UNITS, UNITS, st.sampled_from(METHODS))
+@example(134217727, 3, 0, 2, "nsgs")  # found by the long profile: a rounding-decided status
 def test_status_is_invariant_under_units(seed, dim, ka, kb, method):
     # Planted problems (a solution exists) with mu up to 10. Beyond, a problem is conditioned
     # like mu, and on problems without a solution an iterative method's path is chaotic: a
@@ -68,7 +70,13 @@ def test_status_is_invariant_under_units(seed, dim, ka, kb, method):
         done, stopped = (r, s) if r.success else (s, r)
         budget = 2000 if method == "nsgs" else 200
         assert done.success and stopped.status == "iteration_limit", (r.message, s.message)
-        assert done.iterations >= 0.75 * budget, (r.message, s.message)
+        if done.iterations < 0.75 * budget:
+            # or a status that the rounding of the data decides, in the same units: one of six
+            # one-ulp perturbations of the base changes it too (NSGS on seed 134217727: solved
+            # in 866 sweeps as given, stopped at 2000 with 1.6e-5 in the units (0, 2) and in 4
+            # of the 6 perturbations, solved in 579 and 1334 sweeps in the other 2)
+            others = {solve(perturb_ulp(base, k), method).status for k in range(6)}
+            assert others != {r.status}, (r.message, s.message)
         return
     assert (r.success, r.status) == (s.success, s.status), (r.message, s.message)
     unique = np.linalg.cond(base.W) < 1e6 and base.mu.max() <= 0.5
