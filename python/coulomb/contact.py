@@ -46,7 +46,11 @@ Methods:
     against the exact disk, so in 3D they reflect the facet approximation (they shrink as
     ``facets`` grows, not monotonically: a sliding contact's impulse snaps to a facet). With
     anisotropic friction the directions are scaled along the tangents so that the polygon is
-    inscribed in the ellipse.
+    inscribed in the ellipse. With friction coefficients of 1e8 and more the LCP is
+    conditioned like mu; when every Lemke path fails, the LCP with the cone rows of mu above
+    1e2, then 1e4, capped there (a sticking contact) and with the sliding ones' unknowns in
+    units of ``P_n`` is solved, and its answer is kept only if it solves the given LCP
+    (``message`` says so; ``iterations`` counts every path's pivots).
 ``"prox"`` (the robust mode)
     A proximal-point semismooth Newton method on the natural map (Rust ``contact::prox``):
     each iteration is one Newton step on the proximal subproblem ``W + eta I`` centred at the
