@@ -37,7 +37,8 @@ use crate::lcp::{measure as measure_lcp, solve_lemke, LcpRef, LcpSolution, LcpSt
 /// The caps `M` tried in turn (pure numbers, like mu, so the same in every unit system): a
 /// sticking contact needs `||r_t|| <= M r_n`, and the capped LCP is conditioned like `M`.
 /// On the property campaign's failures at mu >= 1e8, 1e2 rescues most sticking answers and 1e4
-/// those whose redundant contacts need a larger ratio.
+/// some that 1e2 misses (2D campaign problems 324 and 1360, where the capped answer at 1e2
+/// slides on a contact).
 pub(super) const CAPS: [f64; 2] = [1e2, 1e4];
 
 /// the relative slack of a capped cone row below which a contact with `λ > 0` counts as
