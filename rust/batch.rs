@@ -8,9 +8,10 @@
 //! solve and does not depend on how many threads run or in which order the problems are taken:
 //! the problems share nothing but the read-only inputs.
 //!
-//! [`map`] is the engine: it splits the indices `0..count` into chunks, runs the chunks on a
-//! rayon pool of the requested size (cached, built once per size) and returns the answers in
-//! index order. The calling thread does no solving: it waits for the pool and calls the
+//! [`map_chunks`] is the engine: it splits the indices `0..count` into consecutive chunks,
+//! runs the chunks on a rayon pool of the requested size (cached, built once per size), each
+//! gathering its answers in its own state, and returns the states in order ([`map`]: the
+//! answers in index order). The calling thread does no solving: it waits for the pool and calls the
 //! caller's `watch` hook about every [`crate::interrupt::HOOK_INTERVAL`] (the Python bindings
 //! check for Ctrl-C there, on the interpreter's main thread). When `watch` says stop, a shared
 //! flag tells every worker to stop: the solver loops see it through their
@@ -20,6 +21,7 @@
 //! Input is checked before any work: [`lcp_problems`] and [`contact_problems`] check every
 //! problem's shapes and values and name the failing problem by its index.
 
+use std::ops::Range;
 use std::panic::{catch_unwind, resume_unwind, AssertUnwindSafe};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{mpsc, Arc, Mutex};
@@ -93,12 +95,7 @@ pub fn at_problem(index: usize, e: CoulombError) -> CoulombError {
 
 /// Runs `f(state, i)` for every `i` in `0..count` on `threads` threads (all the cores when
 /// `None`), `state` made by `init` once per chunk of indices; returns the answers in index
-/// order. `watch` is called on the calling thread about every
-/// [`crate::interrupt::HOOK_INTERVAL`] while the work runs; when it returns true the workers
-/// stop (their solver loops at the next poll, the chunks between problems) and the batch
-/// returns [`CoulombError::Interrupted`]. The first error of `f`, by index, is returned with
-/// the problem's index (see [`at_problem`]). A panic in `f` is re-raised on the calling
-/// thread once the workers have stopped.
+/// order. See [`map_chunks`] for the interrupt, errors and panics.
 pub fn map<S, T, I, F>(
     count: usize,
     threads: Option<usize>,
@@ -107,9 +104,50 @@ pub fn map<S, T, I, F>(
     f: F,
 ) -> Result<Vec<T>>
 where
+    S: Send,
     T: Send,
     I: Fn() -> S + Sync,
     F: Fn(&mut S, usize) -> Result<T> + Sync,
+{
+    let parts = map_chunks(
+        count,
+        threads,
+        watch,
+        |range| (init(), Vec::with_capacity(range.len())),
+        |(state, out), i| {
+            out.push(f(state, i)?);
+            Ok(())
+        },
+    )?;
+    let mut out = Vec::with_capacity(count);
+    for (_, part) in parts {
+        out.extend(part);
+    }
+    Ok(out)
+}
+
+/// Splits `0..count` into consecutive chunks, makes each chunk's state with `init(range)`,
+/// runs `f(state, i)` for every `i` of the chunk in order, on `threads` threads (all the
+/// cores when `None`), and returns the states in chunk order: a chunk can gather its answers
+/// in its own columns, allocated and filled on the worker thread.
+///
+/// `watch` is called on the calling thread about every [`crate::interrupt::HOOK_INTERVAL`]
+/// while the work runs; when it returns true the workers stop (their solver loops at the next
+/// poll, the chunks between problems) and the batch returns [`CoulombError::Interrupted`].
+/// The first error of `f`, by index, is returned with the problem's index (see
+/// [`at_problem`]). A panic in `f` is re-raised on the calling thread once the workers have
+/// stopped.
+pub fn map_chunks<S, I, F>(
+    count: usize,
+    threads: Option<usize>,
+    watch: &mut dyn FnMut() -> bool,
+    init: I,
+    f: F,
+) -> Result<Vec<S>>
+where
+    S: Send,
+    I: Fn(Range<usize>) -> S + Sync,
+    F: Fn(&mut S, usize) -> Result<()> + Sync,
 {
     let threads = thread_count(threads)?;
     if count == 0 {
@@ -119,21 +157,20 @@ where
     let chunk = count.div_ceil(threads * CHUNKS_PER_THREAD).max(1);
     let chunks = count.div_ceil(chunk);
     let stop = Arc::new(AtomicBool::new(false));
-    let run_chunk = |c: usize| -> Result<Vec<T>> {
+    let run_chunk = |c: usize| -> Result<S> {
         let flag = stop.clone();
         interrupt::run(
             move || flag.load(Ordering::Relaxed),
             || {
-                let mut state = init();
                 let range = c * chunk..((c + 1) * chunk).min(count);
-                let mut out = Vec::with_capacity(range.len());
+                let mut state = init(range.clone());
                 for i in range {
                     if stop.load(Ordering::Relaxed) || interrupt::stopped() {
                         return Err(CoulombError::Interrupted);
                     }
-                    out.push(f(&mut state, i).map_err(|e| at_problem(i, e))?);
+                    f(&mut state, i).map_err(|e| at_problem(i, e))?;
                 }
-                Ok(out)
+                Ok(state)
             },
         )
     };
@@ -169,11 +206,7 @@ where
     if stop.load(Ordering::Relaxed) {
         return Err(CoulombError::Interrupted);
     }
-    let mut out = Vec::with_capacity(count);
-    for part in all {
-        out.extend(part?);
-    }
-    Ok(out)
+    all.into_iter().collect()
 }
 
 /// Checks the LCPs `(Ms[i], qs[i])` of a batch (`sizes[i]` = n_i, M_i row-major) before any
@@ -214,7 +247,7 @@ pub fn lcp_problems<'a>(
 }
 
 /// The method of problem `i`: `methods` holds one for all problems or one per problem.
-fn pick<M>(methods: &[M], i: usize) -> Result<&M> {
+pub fn pick<M>(methods: &[M], i: usize) -> Result<&M> {
     match methods {
         [one] => Ok(one),
         many => many.get(i).ok_or_else(|| {
@@ -227,7 +260,7 @@ fn pick<M>(methods: &[M], i: usize) -> Result<&M> {
 }
 
 /// checks that `methods` has one entry or one per problem.
-fn check_methods<M>(methods: &[M], count: usize) -> Result<()> {
+pub fn check_methods<M>(methods: &[M], count: usize) -> Result<()> {
     if methods.len() == 1 || methods.len() == count {
         Ok(())
     } else {
@@ -254,21 +287,26 @@ pub fn solve_lcps(
         watch,
         || (LemkeWorkspace::new(0), Instant::now()),
         |(ws, last), i| {
-            let p = &problems[i];
-            let s = match pick(methods, i)? {
-                Method::Lemke(settings) if p.n <= REUSED_WORKSPACE_MAX_N => {
-                    lcp::solve_lemke_with(ws, p, settings)?
-                }
-                other => lcp::solve(p, other)?,
-            };
+            let s = solve_lcp(ws, &problems[i], pick(methods, i)?)?;
             Ok((s, lap(last)))
         },
     )
 }
 
+/// One problem of an LCP batch, as the single solve from Python runs it: small Lemke solves
+/// on the chunk's workspace `ws`, everything else through [`lcp::solve`].
+pub fn solve_lcp(ws: &mut LemkeWorkspace, p: &LcpRef<'_>, method: &Method) -> Result<LcpSolution> {
+    match method {
+        Method::Lemke(settings) if p.n <= REUSED_WORKSPACE_MAX_N => {
+            lcp::solve_lemke_with(ws, p, settings)
+        }
+        other => lcp::solve(p, other),
+    }
+}
+
 /// seconds since `last`, which becomes now: one clock reading per problem times each one
 /// from the end of the previous (the first from the chunk's start).
-fn lap(last: &mut Instant) -> f64 {
+pub fn lap(last: &mut Instant) -> f64 {
     let now = Instant::now();
     let t = now.duration_since(*last).as_secs_f64();
     *last = now;

@@ -5,7 +5,7 @@ core returns."""
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from typing import Any, Generic, TypeVar, overload
 
 import numpy as np
@@ -99,7 +99,7 @@ class BatchResult(Sequence[R], Generic[R]):
     _SCALARS: tuple[str, ...] = ()
     _ITEM: type[Result] = Result
 
-    def __init__(self, columns: dict[str, Any], wall_time: float,
+    def __init__(self, columns: Mapping[str, Any], wall_time: float,
                  shape: tuple[int, ...] | None = None) -> None:
         #: every problem's vector shape when the input was one stack (known when empty too)
         self._shape = shape

@@ -120,7 +120,7 @@ that same test.
 from __future__ import annotations
 
 import time
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any, Literal
 
 import numpy as np
@@ -443,7 +443,7 @@ class ContactBatchResult(BatchResult[ContactResult]):
     _SCALARS = ("iterations", "error", "error_q", "scaled_error", "min_normal_impulse",
                 "max_complementarity", "cone_violation", "dissipation_violation", "solve_time")
 
-    def __init__(self, columns: dict[str, Any], wall_time: float, dim: int,
+    def __init__(self, columns: Mapping[str, Any], wall_time: float, dim: int,
                  shape: tuple[int, ...] | None = None) -> None:
         self._dim = dim
         super().__init__(columns, wall_time, shape)
@@ -604,7 +604,7 @@ def solve_batch(
             raise ShapeError(
                 f"problem {i}: q has length {n}, which is not a multiple of dim = {dim}")
     mua, pairs = _batch_friction(mus, qa, dim)
-    init = None
+    init: list[NDArray[np.float64] | None] | None = None
     if initial is not None:
         init = []
         entries = per_problem(initial, "initial", count)

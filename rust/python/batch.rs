@@ -8,20 +8,25 @@
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
-use numpy::{
-    PyArray1, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods,
-};
-use pyo3::intern;
+use std::time::Instant;
+
+use numpy::{PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+
+#[path = "batch_columns.rs"]
+mod columns;
+use columns::{ContactColumns, LcpColumns};
 
 use super::errors::internal_error;
 use super::{settings, signal_hook, to_py};
 use crate::batch;
+use crate::contact;
 use crate::contact::prox::ProxSettings;
-use crate::contact::{self, ContactSolution};
 use crate::error::CoulombError;
-use crate::lcp::{EnumerateSettings, LcpSolution, LemkeEngine, LemkeSettings, Method, PgsSettings};
+use crate::lcp::{
+    EnumerateSettings, LemkeEngine, LemkeSettings, LemkeWorkspace, Method, PgsSettings,
+};
 
 /// Runs a batch with the GIL released, the calling thread checking for Ctrl-C (the signal
 /// handlers run there, see `super::signal_hook`) while the pool works; a Rust panic becomes
@@ -238,162 +243,6 @@ fn lcp_methods(
         .collect()
 }
 
-/// the flat concatenation of per-problem vectors and the offsets of each (`B + 1` entries).
-fn flat<T: Copy>(parts: impl Iterator<Item = impl AsRef<[T]>>, count: usize) -> (Vec<T>, Vec<i64>) {
-    let mut data = Vec::new();
-    let mut offsets = Vec::with_capacity(count + 1);
-    offsets.push(0);
-    for p in parts {
-        data.extend_from_slice(p.as_ref());
-        offsets.push(data.len() as i64);
-    }
-    (data, offsets)
-}
-
-/// [`flat`] of what `push` appends per item.
-fn flat_with<I, T>(
-    items: impl Iterator<Item = I>,
-    count: usize,
-    push: impl Fn(I, &mut Vec<T>),
-) -> (Vec<T>, Vec<i64>) {
-    let mut data = Vec::new();
-    let mut offsets = Vec::with_capacity(count + 1);
-    offsets.push(0);
-    for item in items {
-        push(item, &mut data);
-        offsets.push(data.len() as i64);
-    }
-    (data, offsets)
-}
-
-/// the messages as one string (`messages`) and the char offsets of each
-/// (`message_offsets`, `B + 1` entries): one Python object instead of B.
-fn messages<'a>(
-    py: Python<'_>,
-    d: &Bound<'_, PyDict>,
-    texts: impl Iterator<Item = &'a str>,
-    count: usize,
-) -> PyResult<()> {
-    let mut all = String::new();
-    let mut offsets = Vec::with_capacity(count + 1);
-    let mut chars = 0i64;
-    offsets.push(0);
-    for t in texts {
-        all.push_str(t);
-        chars += t.chars().count() as i64;
-        offsets.push(chars);
-    }
-    d.set_item(intern!(py, "messages"), all)?;
-    d.set_item(
-        intern!(py, "message_offsets"),
-        PyArray1::from_vec(py, offsets),
-    )?;
-    Ok(())
-}
-
-fn lcp_status_code(s: &LcpSolution) -> u8 {
-    use crate::lcp::LcpStatus as S;
-    match s.status {
-        S::Solved => 0,
-        S::RayTermination => 1,
-        S::PivotLimit => 2,
-        S::IterationLimit => 3,
-        S::NumericalFailure => 4,
-        S::NoSolution => 5,
-    }
-}
-
-fn warm_code(s: &LcpSolution) -> u8 {
-    use crate::lcp::WarmStart as W;
-    match s.warm_start {
-        W::None => 0,
-        W::Accepted => 1,
-        W::Rejected => 2,
-    }
-}
-
-fn col<'py, T: numpy::Element>(
-    py: Python<'py>,
-    out: &[(LcpSolution, f64)],
-    f: impl Fn(&(LcpSolution, f64)) -> T,
-) -> Bound<'py, PyArray1<T>> {
-    PyArray1::from_vec(py, out.iter().map(f).collect())
-}
-
-/// the answers as columns: flat `z`, `w` with `offsets`; one entry per problem for the
-/// scalars (`status` and `warm_start` as codes, in the order of `LcpStatus` and `WarmStart`);
-/// `basis` and `solutions` flat with their own offsets.
-fn lcp_columns<'py>(py: Python<'py>, out: Vec<(LcpSolution, f64)>) -> PyResult<Bound<'py, PyDict>> {
-    let count = out.len();
-    let d = PyDict::new(py);
-    let (z, offsets) = flat(out.iter().map(|(s, _)| &s.z[..]), count);
-    let (w, _) = flat(out.iter().map(|(s, _)| &s.w[..]), count);
-    d.set_item(intern!(py, "z"), PyArray1::from_vec(py, z))?;
-    d.set_item(intern!(py, "w"), PyArray1::from_vec(py, w))?;
-    d.set_item(intern!(py, "offsets"), PyArray1::from_vec(py, offsets))?;
-    d.set_item(
-        intern!(py, "status"),
-        col(py, &out, |(s, _)| lcp_status_code(s)),
-    )?;
-    d.set_item(
-        intern!(py, "warm_start"),
-        col(py, &out, |(s, _)| warm_code(s)),
-    )?;
-    d.set_item(
-        intern!(py, "error"),
-        col(py, &out, |(s, _)| s.measures.error),
-    )?;
-    d.set_item(
-        intern!(py, "scaled_error"),
-        col(py, &out, |(s, _)| s.measures.scaled_error),
-    )?;
-    d.set_item(
-        intern!(py, "min_z"),
-        col(py, &out, |(s, _)| s.measures.min_z),
-    )?;
-    d.set_item(
-        intern!(py, "min_w"),
-        col(py, &out, |(s, _)| s.measures.min_w),
-    )?;
-    d.set_item(
-        intern!(py, "max_complementarity"),
-        col(py, &out, |(s, _)| s.measures.max_complementarity),
-    )?;
-    d.set_item(
-        intern!(py, "pivots"),
-        col(py, &out, |(s, _)| s.pivots as i64),
-    )?;
-    d.set_item(
-        intern!(py, "iterations"),
-        col(py, &out, |(s, _)| s.iterations as i64),
-    )?;
-    d.set_item(
-        intern!(py, "pivots_saved"),
-        col(py, &out, |(s, _)| s.pivots_saved as i64),
-    )?;
-    d.set_item(
-        intern!(py, "restarts"),
-        col(py, &out, |(s, _)| s.restarts as i64),
-    )?;
-    d.set_item(intern!(py, "polished"), col(py, &out, |(s, _)| s.polished))?;
-    d.set_item(intern!(py, "solve_time"), col(py, &out, |(_, t)| *t))?;
-    let (b, b_off) = flat_with(out.iter(), count, |(s, _), v: &mut Vec<i64>| {
-        v.extend(s.basis.iter().map(|&k| k as i64))
-    });
-    d.set_item(intern!(py, "basis"), PyArray1::from_vec(py, b))?;
-    d.set_item(intern!(py, "basis_offsets"), PyArray1::from_vec(py, b_off))?;
-    let (sols, s_off) = flat_with(out.iter(), count, |(s, _), v: &mut Vec<f64>| {
-        s.solutions.iter().for_each(|x| v.extend_from_slice(x))
-    });
-    d.set_item(intern!(py, "solutions"), PyArray1::from_vec(py, sols))?;
-    d.set_item(
-        intern!(py, "solutions_offsets"),
-        PyArray1::from_vec(py, s_off),
-    )?;
-    messages(py, &d, out.iter().map(|(s, _)| s.message.as_str()), count)?;
-    Ok(d)
-}
-
 /// Solves a batch of LCPs `0 <= z_i ⊥ M_i z_i + q_i >= 0` across `threads` threads (all the
 /// cores when None). The Python wrapper `coulomb.lcp.solve_batch` documents the arguments;
 /// this takes them converted: `ms` a `(B, n, n)` float64 array or a list of square ones, `qs`
@@ -436,81 +285,25 @@ fn lcp_solve_batch<'py>(
         Ok((problems, methods))
     })();
     let (problems, methods) = prepared.map_err(|e| to_py(py, e))?;
-    let out = batch_guarded(py, |watch| {
-        batch::solve_lcps(&problems, &methods, threads, watch)
+    let n = problems.first().map_or(0, |p| p.n);
+    let parts = batch_guarded(py, |watch| {
+        batch::check_methods(&methods, problems.len())?;
+        batch::map_chunks(
+            problems.len(),
+            threads,
+            watch,
+            |range| {
+                let cols = LcpColumns::new(range.len(), n);
+                (LemkeWorkspace::new(0), Instant::now(), cols)
+            },
+            |(ws, last, cols), i| {
+                let s = batch::solve_lcp(ws, &problems[i], batch::pick(&methods, i)?)?;
+                cols.push(&s, batch::lap(last));
+                Ok(())
+            },
+        )
     })?;
-    lcp_columns(py, out)
-}
-
-fn contact_status_code(s: &ContactSolution) -> u8 {
-    use crate::contact::ContactStatus as S;
-    match s.status {
-        S::Solved => 0,
-        S::IterationLimit => 1,
-        S::NumericalFailure => 2,
-    }
-}
-
-fn ccol<'py, T: numpy::Element>(
-    py: Python<'py>,
-    out: &[(ContactSolution, f64)],
-    f: impl Fn(&(ContactSolution, f64)) -> T,
-) -> Bound<'py, PyArray1<T>> {
-    PyArray1::from_vec(py, out.iter().map(f).collect())
-}
-
-/// the contact answers as columns: flat `impulse`, `velocity` with `offsets`; one entry per
-/// problem for the scalars (`status` as a code in the order of `ContactStatus`).
-fn contact_columns<'py>(
-    py: Python<'py>,
-    out: Vec<(ContactSolution, f64)>,
-) -> PyResult<Bound<'py, PyDict>> {
-    let count = out.len();
-    let d = PyDict::new(py);
-    let (r, offsets) = flat(out.iter().map(|(s, _)| &s.impulse[..]), count);
-    let (u, _) = flat(out.iter().map(|(s, _)| &s.velocity[..]), count);
-    d.set_item(intern!(py, "impulse"), PyArray1::from_vec(py, r))?;
-    d.set_item(intern!(py, "velocity"), PyArray1::from_vec(py, u))?;
-    d.set_item(intern!(py, "offsets"), PyArray1::from_vec(py, offsets))?;
-    d.set_item(
-        intern!(py, "status"),
-        ccol(py, &out, |(s, _)| contact_status_code(s)),
-    )?;
-    d.set_item(
-        intern!(py, "iterations"),
-        ccol(py, &out, |(s, _)| s.iterations as i64),
-    )?;
-    d.set_item(
-        intern!(py, "error"),
-        ccol(py, &out, |(s, _)| s.measures.error),
-    )?;
-    d.set_item(
-        intern!(py, "error_q"),
-        ccol(py, &out, |(s, _)| s.measures.error_q),
-    )?;
-    d.set_item(
-        intern!(py, "scaled_error"),
-        ccol(py, &out, |(s, _)| s.measures.scaled_error),
-    )?;
-    d.set_item(
-        intern!(py, "min_normal_impulse"),
-        ccol(py, &out, |(s, _)| s.measures.min_normal_impulse),
-    )?;
-    d.set_item(
-        intern!(py, "max_complementarity"),
-        ccol(py, &out, |(s, _)| s.measures.max_complementarity),
-    )?;
-    d.set_item(
-        intern!(py, "cone_violation"),
-        ccol(py, &out, |(s, _)| s.measures.cone_violation),
-    )?;
-    d.set_item(
-        intern!(py, "dissipation_violation"),
-        ccol(py, &out, |(s, _)| s.measures.dissipation_violation),
-    )?;
-    d.set_item(intern!(py, "solve_time"), ccol(py, &out, |(_, t)| *t))?;
-    messages(py, &d, out.iter().map(|(s, _)| s.message.as_str()), count)?;
-    Ok(d)
+    LcpColumns::into_dict(py, parts.into_iter().map(|(_, _, c)| c).collect())
 }
 
 /// Solves a batch of friction-contact problems `u_i = W_i r_i + q_i` (Coulomb's law at every
@@ -609,10 +402,22 @@ fn contact_solve_batch<'py>(
         Ok((problems, methods))
     })();
     let (problems, methods) = prepared.map_err(|e| to_py(py, e))?;
-    let out = batch_guarded(py, |watch| {
-        batch::solve_contacts(&problems, &methods, threads, watch)
+    let n = problems.first().map_or(0, |p| p.dim * p.nc);
+    let parts = batch_guarded(py, |watch| {
+        batch::check_methods(&methods, problems.len())?;
+        batch::map_chunks(
+            problems.len(),
+            threads,
+            watch,
+            |range| (Instant::now(), ContactColumns::new(range.len(), n)),
+            |(last, cols), i| {
+                let s = contact::solve(&problems[i], batch::pick(&methods, i)?)?;
+                cols.push(&s, batch::lap(last));
+                Ok(())
+            },
+        )
     })?;
-    contact_columns(py, out)
+    ContactColumns::into_dict(py, parts.into_iter().map(|(_, c)| c).collect())
 }
 
 /// adds this file's functions to `coulomb._core`.
