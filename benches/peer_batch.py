@@ -226,7 +226,7 @@ def rollout_rows(count: int, repeats: int) -> list[list[str]]:
          [impact_scene(1.0 + 4.0 * i / max(count - 1, 1)) for i in range(count)],
          IMPACT_XML,
          lambda st, i, nq: st.__setitem__(1 + nq + 2, -(1.0 + 4.0 * i / max(count - 1, 1)))),
-        ("resting box", 1.0,
+        ("resting box", 0.5,
          [resting_box_scene(0.01 * i) for i in range(count)],
          RESTING_XML,
          lambda st, i, nq: st.__setitem__(1, 0.01 * i)),
@@ -273,7 +273,7 @@ def main() -> int:
     loop_cap = 1_000 if args.quick else 5_000
     lcp = lcp_rows(sizes, repeats, loop_cap)
     contact = contact_rows([(1, big), (10, 1_000)], repeats, loop_cap)
-    roll = rollout_rows(100 if args.quick else 1_000, repeats)
+    roll = rollout_rows(100 if args.quick else 500, repeats)
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     now = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     cores = os.cpu_count()
@@ -282,7 +282,7 @@ def main() -> int:
         f"{load:.1f} at the end of the run). Times per problem in µs, the best of {repeats} "
         f"runs; \"all\" is the default `threads` (every core). Every batch's answers were "
         f"checked bitwise against the single calls' before timing.\n\n"
-        + table(["problems", "n", "batch", "all", "1 thread", "2 threads", "2 vs 1",
+        + table(["problems", "n", "batch size", "all cores", "1 thread", "2 threads", "2 vs 1",
                  "single call (Python loop)", "quantecon per call", "batch vs loop"],
                 lcp + contact, 1)
         + "\n\nRollouts: `coulomb.rollout` against a loop of `Scene.simulate` and MuJoCo's "

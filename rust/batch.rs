@@ -33,6 +33,7 @@ use rayon::ThreadPool;
 use crate::contact::{self, ContactProblem, ContactSolution};
 use crate::error::{check_finite, CoulombError, Result};
 use crate::interrupt;
+use crate::lcp::kernel::all_finite;
 use crate::lcp::{self, LcpRef, LcpSolution, LemkeWorkspace, Method};
 use crate::step::{simulate_joints, Joint, Scene, StepSettings, Trajectory};
 
@@ -239,8 +240,11 @@ pub fn lcp_problems<'a>(
                 q.len()
             )));
         }
-        check_finite(&format!("Ms[{i}]"), m)?;
-        check_finite(&format!("qs[{i}]"), q)?;
+        // the name is only formatted for a refusal
+        if !(all_finite(m) && all_finite(q)) {
+            check_finite(&format!("Ms[{i}]"), m)?;
+            check_finite(&format!("qs[{i}]"), q)?;
+        }
         out.push(LcpRef { n, m, q });
     }
     Ok(out)

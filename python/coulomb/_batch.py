@@ -112,17 +112,18 @@ class BatchResult(Sequence[R], Generic[R]):
         self.status = kinds[codes] if self._count else np.empty(0, dtype=object)
         self.success = codes == 0
         self._messages: str = columns["messages"]
-        self._message_offsets = np.asarray(columns["message_offsets"]).tolist()
+        self._message_offsets = np.asarray(columns["message_offsets"])
         self.wall_time = float(wall_time)
 
     @property
     def message(self) -> list[str]:
         """Per problem, one line for a person."""
-        text, off = self._messages, self._message_offsets
+        text, off = self._messages, self._message_offsets.tolist()
         return [text[off[i]:off[i + 1]] for i in range(self._count)]
 
     def _message(self, i: int) -> str:
-        return self._messages[self._message_offsets[i]:self._message_offsets[i + 1]]
+        off = self._message_offsets
+        return self._messages[int(off[i]):int(off[i + 1])]
 
     def __len__(self) -> int:
         return self._count
