@@ -440,8 +440,8 @@ def solve_batch(
         eng = "auto" if engine is None else _validate.choice("engine", engine, _ENGINES)
         cover = _per_problem_vectors(covering_vector, "covering_vector", sizes)
         if warm_start is not None:
-            guesses = (warm_start.basis if isinstance(warm_start, LcpBatchResult)
-                       else per_problem(warm_start, "warm_start", count))
+            guesses = per_problem(warm_start.basis if isinstance(warm_start, LcpBatchResult)
+                                  else warm_start, "warm_start", count)
             basis = [at_problem(i, _basis_indices, g, sizes[i]) for i, g in enumerate(guesses)]
         sweeps, omega = 10_000, 1.0
     else:

@@ -16,6 +16,8 @@ from coulomb.errors import (
     ShapeError,
 )
 from helpers import GIL_RELEASED, count_during
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from test_interrupt import BOUND, interrupt
 
 
@@ -82,6 +84,25 @@ def test_a_mixed_size_batch_is_bitwise_the_single_solves():
         assert isinstance(z, list) and [len(v) for v in z] == sizes
 
 
+@settings(max_examples=25, deadline=None)
+@given(sizes=st.lists(st.integers(0, 12), max_size=30), seed=st.integers(0, 2**32 - 1),
+       threads=st.integers(1, 4), scale=st.sampled_from([1e-8, 1.0, 1e8]),
+       method=st.sampled_from(["lemke", "pgs"]))
+def test_any_batch_is_bitwise_the_single_solves(sizes, seed, threads, scale, method):
+    # over the class: sizes mixed, data scaled, SPD and nonsymmetric P-matrices, 1-4 threads
+    rng = np.random.default_rng(seed)
+    pairs = []
+    for k, n in enumerate(sizes):
+        M, q = spd(n, rng) if k % 2 else nonsymmetric(n, rng)
+        pairs.append((scale * M, scale * q))
+    opts = {"max_iter": 50} if method == "pgs" else {}
+    out = lcp.solve_batch([p[0] for p in pairs], [p[1] for p in pairs], method,
+                          threads=threads, **opts)
+    assert len(out) == len(pairs)
+    for r, (M, q) in zip(out, pairs, strict=True):
+        same(r, lcp.solve(M, q, method, **opts))
+
+
 def test_enumeration_and_warm_starts_per_problem():
     rng = np.random.default_rng(3)
     pairs = [nonsymmetric(4, rng) for _ in range(6)]
@@ -134,6 +155,8 @@ def test_lcp_validation_names_the_argument_and_the_problem():
         lcp.solve_batch(Ms, qs, threads=1.5)
     with pytest.raises(InvalidParameterError, match="problem 2"):
         lcp.solve_batch(Ms, qs, warm_start=[[0], [1], [7], None, None])
+    with pytest.raises(ShapeError, match="warm_start"):
+        lcp.solve_batch(Ms[:2], qs[:2], warm_start=lcp.solve_batch(Ms, qs))
     with pytest.raises(ArgumentTypeError, match="Ms"):
         lcp.solve_batch("not a batch", qs)
 
