@@ -48,8 +48,8 @@ const CHUNKS_PER_THREAD: usize = 8;
 /// reuses one per thread (larger ones allocate their own, as there).
 const REUSED_WORKSPACE_MAX_N: usize = 256;
 
-/// the pools built so far, one per thread count.
-static POOLS: Mutex<Vec<(usize, Arc<ThreadPool>)>> = Mutex::new(Vec::new());
+/// the pools built so far, one per thread count, with the process that built them.
+static POOLS: Mutex<Vec<(usize, u32, Arc<ThreadPool>)>> = Mutex::new(Vec::new());
 
 /// the number of threads `threads` asks for: all the cores when `None`.
 pub fn thread_count(threads: Option<usize>) -> Result<usize> {
@@ -66,7 +66,14 @@ pub fn thread_count(threads: Option<usize>) -> Result<usize> {
 fn pool(threads: usize) -> Result<Arc<ThreadPool>> {
     // a poisoned lock only means another batch panicked while holding it: the list is intact
     let mut pools = POOLS.lock().unwrap_or_else(|e| e.into_inner());
-    if let Some((_, p)) = pools.iter().find(|(t, _)| *t == threads) {
+    let pid = std::process::id();
+    if pools.iter().any(|(_, owner, _)| *owner != pid) {
+        // a child forked from the process that built them: their threads did not follow it
+        // into this process, so they are left alone (never dropped: dropping would signal
+        // threads that do not exist here) and new ones built
+        std::mem::forget(std::mem::take(&mut *pools));
+    }
+    if let Some((_, _, p)) = pools.iter().find(|(t, _, _)| *t == threads) {
         return Ok(p.clone());
     }
     let p = rayon::ThreadPoolBuilder::new()
@@ -77,7 +84,7 @@ fn pool(threads: usize) -> Result<Arc<ThreadPool>> {
             CoulombError::InvalidParameter(format!("cannot start {threads} threads: {e}"))
         })?;
     let p = Arc::new(p);
-    pools.push((threads, p.clone()));
+    pools.push((threads, pid, p.clone()));
     Ok(p)
 }
 

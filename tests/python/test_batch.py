@@ -5,6 +5,9 @@ the problem; empty batches; Ctrl-C; the GIL released."""
 
 from __future__ import annotations
 
+import multiprocessing
+import os
+
 import coulomb
 import numpy as np
 import pytest
@@ -311,3 +314,20 @@ def test_ctrl_c_stops_a_batch(call):
     got = interrupt(call)
     assert got["outcome"] == "KeyboardInterrupt", got
     assert got["latency"] < BOUND, got
+
+
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="needs fork")
+def test_a_forked_child_runs_batches_on_its_own_threads():
+    # the parent's pools exist before the fork; their threads do not follow the child
+    rng = np.random.default_rng(9)
+    Ms = np.stack([spd(4, rng)[0] for _ in range(64)])
+    qs = rng.standard_normal((64, 4))
+    parent = lcp.solve_batch(Ms, qs, threads=2)
+    ctx = multiprocessing.get_context("fork")
+    with ctx.Pool(1) as pool:
+        z = pool.apply_async(_child_batch, (Ms, qs)).get(timeout=60)
+    assert z.tobytes() == parent.z.tobytes()
+
+
+def _child_batch(Ms: np.ndarray, qs: np.ndarray) -> np.ndarray:
+    return np.asarray(lcp.solve_batch(Ms, qs, threads=2).z)
