@@ -35,7 +35,7 @@ use crate::error::{check_finite, CoulombError, Result};
 use crate::interrupt;
 use crate::lcp::kernel::all_finite;
 use crate::lcp::{self, LcpRef, LcpSolution, LemkeWorkspace, Method};
-use crate::step::{simulate_joints, Joint, Scene, StepSettings, Trajectory};
+use crate::step::{simulate_joints, Joint, Scene, StepRecord, StepSettings, Trajectory};
 
 /// the most threads a batch may ask for.
 pub const MAX_THREADS: usize = 1024;
@@ -394,11 +394,40 @@ pub fn rollout(
     threads: Option<usize>,
     watch: &mut dyn FnMut() -> bool,
 ) -> Result<Vec<(Trajectory, f64)>> {
+    check_rollout_records(scenes)?;
     map(scenes.len(), threads, watch, Instant::now, |last, i| {
         let s = &scenes[i];
         let tr = simulate_joints(s.scene, s.joints, s.settings, s.record_every)?;
         Ok((tr, lap(last)))
     })
+}
+
+/// the states every scene of a rollout records, together, against the memory budget (each
+/// run checks its own; the rollout holds them all at once), before any step.
+fn check_rollout_records(scenes: &[RolloutScene<'_>]) -> Result<()> {
+    let mut total = 0usize;
+    for s in scenes {
+        let dim = s.scene.dim;
+        let (nq, nv) = s
+            .scene
+            .bodies
+            .iter()
+            .fold((0, 0), |(q, v), b| (q + b.kind.nq(dim), v + b.kind.nv(dim)));
+        let rows = s.settings.steps.div_ceil(s.record_every.max(1)) + 1;
+        let row_bytes = 8 * (nq + nv + 5) + std::mem::size_of::<StepRecord>();
+        total = total.saturating_add(rows.saturating_mul(row_bytes));
+    }
+    crate::limits::check_bytes(
+        &format!(
+            "recording the states of {} scene{}",
+            scenes.len(),
+            if scenes.len() == 1 { "" } else { "s" }
+        ),
+        total,
+        1,
+        "record fewer states with record_every, or roll out fewer scenes at once",
+    )
+    .map(|_| ())
 }
 
 #[cfg(test)]

@@ -380,3 +380,27 @@ fn an_empty_batch_gives_no_answers() {
     assert!(out.is_empty());
     assert!(batch::rollout(&[], Some(1), &mut never).unwrap().is_empty());
 }
+
+#[test]
+fn a_rollout_whose_records_together_exceed_the_budget_is_refused_before_any_step() {
+    // each run's states fit the budget alone (about 2.5 GB of the 4 GiB), the two do not
+    let scene = ball([0.0, 0.0], 0.2, 0.0);
+    let settings = StepSettings::new(1e-3, 15_000_000);
+    let run = || RolloutScene {
+        scene: &scene,
+        joints: &[],
+        settings: &settings,
+        record_every: 1,
+    };
+    let budget = coulomb::limits::memory_budget();
+    let start = Instant::now();
+    match batch::rollout(&[run(), run()], Some(2), &mut never) {
+        Err(CoulombError::TooLarge(msg)) => assert!(msg.contains("2 scenes"), "{msg}"),
+        other => panic!("expected TooLarge, got {:?}", other.map(|o| o.len())),
+    }
+    assert!(
+        start.elapsed() < Duration::from_secs(5),
+        "refused only after running"
+    );
+    assert!(budget >= 3 << 30, "the test assumes the default budget");
+}

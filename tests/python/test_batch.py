@@ -16,6 +16,7 @@ from coulomb.errors import (
     ArgumentTypeError,
     InvalidParameterError,
     NonFiniteError,
+    ProblemTooLargeError,
     ShapeError,
 )
 from helpers import GIL_RELEASED, count_during
@@ -292,6 +293,9 @@ def test_rollout_validation_names_the_scene():
         coulomb.rollout([good, good], 1.0, 1e-3, drift="sideways")
     with pytest.raises(ArgumentTypeError, match="scenes"):
         coulomb.rollout([good, "ball"], 1.0, 1e-3)
+    # each run's states fit the memory budget alone, the two together do not
+    with pytest.raises(ProblemTooLargeError, match="2 scenes"):
+        coulomb.rollout([good, good], 15_000.0, 1e-3)
 
 
 def test_a_batch_releases_the_gil():
