@@ -306,6 +306,92 @@ fn lcp_solve_batch<'py>(
     LcpColumns::into_dict(py, parts.into_iter().map(|(_, _, c)| c).collect())
 }
 
+/// the options of a contact batch, the same for every problem.
+struct ContactOptions<'a> {
+    dim: usize,
+    method: &'a str,
+    tol: f64,
+    max_iter: Option<usize>,
+    relaxation: f64,
+    facets: Option<usize>,
+    eta: Option<f64>,
+    order: &'a str,
+}
+
+/// The contact methods of a batch: one for all problems, or one per problem when warm starts
+/// are given per problem.
+fn contact_methods(
+    o: &ContactOptions<'_>,
+    initials: Vec<Option<Vec<f64>>>,
+) -> Result<Vec<contact::Method>, CoulombError> {
+    let order = match o.order {
+        "forward" => contact::ContactOrder::Forward,
+        "backward" => contact::ContactOrder::Backward,
+        "symmetric" => contact::ContactOrder::Symmetric,
+        other => {
+            return Err(CoulombError::InvalidParameter(format!(
+                "order must be 'forward', 'backward' or 'symmetric' in a batch, got {other:?}"
+            )))
+        }
+    };
+    let one = |init: Option<Vec<f64>>| match o.method {
+        "nsgs" => Ok(contact::Method::Nsgs(settings::nsgs(
+            o.tol,
+            o.max_iter,
+            o.relaxation,
+            init,
+            order.clone(),
+        ))),
+        "lemke" => Ok(contact::Method::Polyhedral(settings::lemke(
+            o.dim, o.tol, o.max_iter, o.facets,
+        ))),
+        "prox" => {
+            let d = ProxSettings::default();
+            Ok(contact::Method::Prox(ProxSettings {
+                tol: o.tol,
+                max_iter: o.max_iter.unwrap_or(d.max_iter),
+                eta: o.eta.unwrap_or(d.eta),
+                initial: init,
+            }))
+        }
+        other => Err(CoulombError::InvalidParameter(format!(
+            "unknown method {other:?}: expected 'nsgs' (exact friction disk), 'lemke' \
+             (polyhedral cone) or 'prox' (robust mode)"
+        ))),
+    };
+    if initials.iter().all(Option::is_none) {
+        Ok(vec![one(None)?])
+    } else {
+        initials.into_iter().map(one).collect()
+    }
+}
+
+/// per-problem optional vectors borrowed (`None` for all, or one entry per problem).
+fn optional_slices<'a>(
+    name: &str,
+    v: &'a Option<Vec<Option<PyReadonlyArray1<'_, f64>>>>,
+    count: usize,
+) -> Result<Vec<Option<&'a [f64]>>, CoulombError> {
+    match v {
+        None => Ok(vec![None; count]),
+        Some(list) if list.len() != count => Err(CoulombError::Shape(format!(
+            "{name} must hold one entry per problem ({count}), got {}",
+            list.len()
+        ))),
+        Some(list) => list
+            .iter()
+            .enumerate()
+            .map(|(i, p)| match p {
+                None => Ok(None),
+                Some(a) => a
+                    .as_slice()
+                    .map(Some)
+                    .map_err(|_| contiguous(&format!("{name}[{i}]"))),
+            })
+            .collect(),
+    }
+}
+
 /// Solves a batch of friction-contact problems `u_i = W_i r_i + q_i` (Coulomb's law at every
 /// contact) across `threads` threads. The Python wrapper `coulomb.contact.solve_batch`
 /// documents the arguments; this takes them converted: `ws` a `(B, n, n)` float64 array or a
@@ -334,70 +420,23 @@ fn contact_solve_batch<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let prepared = (|| {
         batch::thread_count(threads)?;
-        let order = match order {
-            "forward" => contact::ContactOrder::Forward,
-            "backward" => contact::ContactOrder::Backward,
-            "symmetric" => contact::ContactOrder::Symmetric,
-            other => {
-                return Err(CoulombError::InvalidParameter(format!(
-                    "order must be 'forward', 'backward' or 'symmetric' in a batch, got {other:?}"
-                )))
-            }
-        };
         let (sizes, w_parts) = mat_slices("Ws", &ws)?;
         let count = sizes.len();
         let q_parts = vec_slices("qs", &qs)?;
         let mu_parts = vec_slices("mus", &mus)?;
-        let pair_parts: Vec<Option<&[f64]>> = match &mu_pairs {
-            None => vec![None; count],
-            Some(list) => list
-                .iter()
-                .enumerate()
-                .map(|(i, p)| match p {
-                    None => Ok(None),
-                    Some(a) => a
-                        .as_slice()
-                        .map(Some)
-                        .map_err(|_| contiguous(&format!("mus[{i}]"))),
-                })
-                .collect::<Result<_, _>>()?,
-        };
+        let pair_parts = optional_slices("mus", &mu_pairs, count)?;
         let initials = per_problem("initial", &initial, count)?;
-        let one = |init: Option<Vec<f64>>| -> Result<contact::Method, CoulombError> {
-            match method {
-                "nsgs" => Ok(contact::Method::Nsgs(settings::nsgs(
-                    tol,
-                    max_iter,
-                    relaxation,
-                    init,
-                    order.clone(),
-                ))),
-                "lemke" => Ok(contact::Method::Polyhedral(settings::lemke(
-                    dim, tol, max_iter, facets,
-                ))),
-                "prox" => {
-                    let d = ProxSettings::default();
-                    Ok(contact::Method::Prox(ProxSettings {
-                        tol,
-                        max_iter: max_iter.unwrap_or(d.max_iter),
-                        eta: eta.unwrap_or(d.eta),
-                        initial: init,
-                    }))
-                }
-                other => Err(CoulombError::InvalidParameter(format!(
-                    "unknown method {other:?}: expected 'nsgs' (exact friction disk), 'lemke' \
-                     (polyhedral cone) or 'prox' (robust mode)"
-                ))),
-            }
+        let options = ContactOptions {
+            dim,
+            method,
+            tol,
+            max_iter,
+            relaxation,
+            facets,
+            eta,
+            order,
         };
-        let methods = if initials.iter().all(Option::is_none) {
-            vec![one(None)?]
-        } else {
-            initials
-                .into_iter()
-                .map(one)
-                .collect::<Result<Vec<_>, _>>()?
-        };
+        let methods = contact_methods(&options, initials)?;
         let problems = batch::contact_problems(dim, &w_parts, &q_parts, &mu_parts, &pair_parts)?;
         Ok((problems, methods))
     })();
