@@ -27,13 +27,13 @@ def threads_option(threads: Any) -> int | None:
     return None if threads is None else _validate.count("threads", threads, maximum=MAX_THREADS)
 
 
-def at_problem(i: int, fn: Callable[..., Any], *args: Any) -> Any:
+def at_problem(i: int, fn: Callable[..., Any], *args: Any, what: str = "problem") -> Any:
     """``fn(*args)``, a :class:`~coulomb.errors.CoulombError` it raises re-raised (same class)
-    with the problem's index in front of its message."""
+    with the problem's (or scene's, ``what``) index in front of its message."""
     try:
         return fn(*args)
     except CoulombError as exc:
-        raise type(exc)(f"problem {i}: {exc}") from None
+        raise type(exc)(f"{what} {i}: {exc}") from None
 
 
 def stacked(

@@ -75,8 +75,9 @@ drift, drift_bias, restitution, record_every, locate_impacts, settings
     n_threads = threads_option(threads)
     options = [at_problem(i, s._run_args, t_end, h, solver, tol, max_iter, relaxation, facets,
                           gap_tolerance, warm_start, fallback, drift, drift_bias, restitution,
-                          record_every, locate_impacts) for i, s in enumerate(scenes)]
-    specs = [at_problem(i, s._spec) for i, s in enumerate(scenes)]
+                          record_every, locate_impacts, what="scene")
+               for i, s in enumerate(scenes)]
+    specs = [at_problem(i, s._spec, what="scene") for i, s in enumerate(scenes)]
     raws = _core.step_rollout(specs, options, n_threads)
     return [Trajectory._from_core(raw, scene=s, h=a["h"], solver=a["solver"],
                                   gap_tolerance=a["gap_tolerance"], tol=a["tol"],
