@@ -425,6 +425,5 @@ def _friction(
     return mua, pairs
 
 
-
 # the batch (its own file); imported last, as it reads the names above
 from ._contact_batch import ContactBatchResult, solve_batch  # noqa: E402

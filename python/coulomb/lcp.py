@@ -287,6 +287,5 @@ def check(M: ArrayLike, q: ArrayLike, z: ArrayLike) -> Result:
     return Result(_core.lcp_measures(Ma, qa, za))
 
 
-
 # the batch (its own file); imported last, as it reads the names above
 from ._lcp_batch import LcpBatchResult, solve_batch  # noqa: E402
