@@ -7,11 +7,13 @@
 //!   pivoting (the certified default), projected Gauss-Seidel, and complete enumeration.
 //! - [`step`]: the impulse time stepper (Stewart and Trinkle 1996; Stewart 2000) over
 //!   particles and rigid bodies with contact, friction and restitution.
+//! - [`batch`]: many LCPs, friction-contact problems or scenes solved across the cores.
 //! - [`io`]: readers for the standard benchmark formats (Siconos text files).
 //!
 //! The Python bindings (`coulomb._core`) live behind the `python` feature.
 #![allow(non_snake_case)]
 
+pub mod batch;
 pub mod contact;
 pub mod error;
 pub mod geometry;

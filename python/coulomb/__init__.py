@@ -14,6 +14,8 @@ contact
 model
     Scenes (bodies, contact shapes, half-spaces, pairs) and ``Scene.simulate``: Stewart's
     impulse time stepper (Stewart 2000; Stewart and Trinkle 1996), run in Rust.
+    :func:`coulomb.rollout` simulates many scenes at once across the cores (as
+    ``lcp.solve_batch`` and ``contact.solve_batch`` solve many problems).
 trajectory
     The simulation result with its per-step checks (``Trajectory.check``) and plots.
 joints
@@ -61,6 +63,7 @@ from . import (
 )
 from ._core import __version__, memory_budget, set_memory_budget
 from ._result import Result
+from ._rollout import rollout
 from ._status import Status
 from .contact import ContactResult
 from .joints import Fixed, Prismatic, Revolute, Spherical, Weld
@@ -147,6 +150,7 @@ __all__ = [
     "model",
     "painleve",
     "regularized",
+    "rollout",
     "set_memory_budget",
     "settings",
     "study",

@@ -17,8 +17,10 @@ __all__ = [
     "contact_assemble",
     "contact_post_velocity",
     "contact_solve",
+    "contact_solve_batch",
     "lcp_measures",
     "lcp_solve",
+    "lcp_solve_batch",
     "memory_budget",
     "model_simulate",
     "read_siconos_fc",
@@ -26,6 +28,7 @@ __all__ = [
     "set_memory_budget",
     "simd_level",
     "solid_check",
+    "step_rollout",
     "step_simulate",
     "step_stream",
 ]
@@ -87,6 +90,56 @@ class _ContactSolveDict(TypedDict):
     cone_violation: float
     dissipation_violation: float
     solve_time: float
+
+class _LcpBatchDict(TypedDict):
+    """``lcp_solve_batch``: the answers column by column; ``z``, ``w`` flat, problem i at
+    ``offsets[i]:offsets[i + 1]``; ``status`` and ``warm_start`` as codes (in the order of
+    ``_LcpStatusName`` and none / accepted / rejected); ``basis`` and ``solutions`` flat with
+    their own offsets; the messages as one string cut by ``message_offsets`` (in chars)."""
+
+    z: _F64
+    w: _F64
+    offsets: _I64
+    status: NDArray[np.uint8]
+    warm_start: NDArray[np.uint8]
+    error: _F64
+    scaled_error: _F64
+    min_z: _F64
+    min_w: _F64
+    max_complementarity: _F64
+    pivots: _I64
+    iterations: _I64
+    pivots_saved: _I64
+    restarts: _I64
+    polished: NDArray[np.bool_]
+    solve_time: _F64
+    basis: _I64
+    basis_offsets: _I64
+    solutions: _F64
+    solutions_offsets: _I64
+    messages: str
+    message_offsets: _I64
+
+class _ContactBatchDict(TypedDict):
+    """``contact_solve_batch``: the answers column by column; ``impulse``, ``velocity`` flat,
+    problem i at ``offsets[i]:offsets[i + 1]``; ``status`` as codes (in the order of
+    ``_ContactStatusName``); the messages as one string cut by ``message_offsets``."""
+
+    impulse: _F64
+    velocity: _F64
+    offsets: _I64
+    status: NDArray[np.uint8]
+    iterations: _I64
+    error: _F64
+    error_q: _F64
+    scaled_error: _F64
+    min_normal_impulse: _F64
+    max_complementarity: _F64
+    cone_violation: _F64
+    dissipation_violation: _F64
+    solve_time: _F64
+    messages: str
+    message_offsets: _I64
 
 class _SiconosLocalFcDict(TypedDict):
     """``read_siconos_fc`` of a local (``FC2D``/``FC3D``) problem."""
@@ -190,6 +243,38 @@ def contact_solve(
     order: str = "forward",
     permutation: list[int] | None = None,
 ) -> _ContactSolveDict: ...
+def lcp_solve_batch(
+    ms: _F64 | list[_F64],
+    qs: _F64 | list[_F64],
+    method: str,
+    tol: float,
+    max_pivots: int | None = None,
+    covering_vector: list[_F64 | None] | None = None,
+    warm_start: list[list[int] | None] | None = None,
+    polish: bool = True,
+    restarts: int = 2,
+    max_iter: int = 10000,
+    relaxation: float = 1.0,
+    initial: list[_F64 | None] | None = None,
+    engine: str = "auto",
+    threads: int | None = None,
+) -> _LcpBatchDict: ...
+def contact_solve_batch(
+    ws: _F64 | list[_F64],
+    qs: _F64 | list[_F64],
+    mus: _F64 | list[_F64],
+    dim: int,
+    method: str,
+    tol: float,
+    max_iter: int | None = None,
+    relaxation: float = 1.0,
+    initial: list[_F64 | None] | None = None,
+    facets: int | None = None,
+    mu_pairs: list[_F64 | None] | None = None,
+    eta: float | None = None,
+    order: str = "forward",
+    threads: int | None = None,
+) -> _ContactBatchDict: ...
 def read_siconos_fc(path: _Path) -> _SiconosLocalFcDict | _SiconosGlobalFcDict: ...
 
 _Triplets = tuple[int, int, _I64, _I64, _F64]
@@ -224,6 +309,11 @@ def step_simulate(
     record_every: int = 1,
     locate_impacts: bool = False,
 ) -> _StepSimulateDict: ...
+def step_rollout(
+    scenes: list[dict[str, Any]],
+    options: list[dict[str, Any]],
+    threads: int | None = None,
+) -> list[_StepSimulateDict]: ...
 def step_stream(
     scene: dict[str, Any],
     h: float,

@@ -136,7 +136,9 @@ from .errors import InvalidInputError, InvalidParameterError, NonFiniteError, Sh
 from .lcp import _as_array
 from .settings import NSGSSettings, PolyhedralSettings, ProxSettings, accepts
 
-__all__ = ["ContactResult", "assemble", "post_velocity", "solve"]
+__all__ = [
+    "ContactBatchResult", "ContactResult", "assemble", "post_velocity", "solve", "solve_batch",
+]
 
 Method = Literal["nsgs", "lemke", "prox"]
 
@@ -425,3 +427,7 @@ def _friction(
         k = int(np.flatnonzero(mua < 0)[0])
         raise InvalidParameterError(f"friction coefficients must be >= 0, mu[{k}] = {mua[k]}")
     return mua, pairs
+
+
+# the batch (its own file); imported last, as it reads the names above
+from ._contact_batch import ContactBatchResult, solve_batch  # noqa: E402

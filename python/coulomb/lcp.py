@@ -40,7 +40,7 @@ from ._status import Status
 from .errors import ArgumentTypeError, InvalidParameterError, ShapeError
 from .settings import LemkeSettings, PGSSettings, accepts
 
-__all__ = ["LcpResult", "check", "solve"]
+__all__ = ["LcpBatchResult", "LcpResult", "check", "solve", "solve_batch"]
 
 Method = Literal["lemke", "pgs", "enumerate"]
 _METHODS = ("lemke", "pgs", "enumerate")
@@ -285,3 +285,7 @@ def check(M: ArrayLike, q: ArrayLike, z: ArrayLike) -> Result:
     if Ma.shape != (n, n):
         raise ShapeError(f"M must have shape ({n}, {n}) to match q of length {n}, got {Ma.shape}")
     return Result(_core.lcp_measures(Ma, qa, za))
+
+
+# the batch (its own file); imported last, as it reads the names above
+from ._lcp_batch import LcpBatchResult, solve_batch  # noqa: E402

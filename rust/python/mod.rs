@@ -4,12 +4,14 @@
 //! numerics of their own.
 //!
 //! One file per area: [`lcp`] (`lcp_solve`, `lcp_measures`), [`contact`] (`contact_solve`,
-//! `contact_assemble`, `contact_post_velocity`), [`step`] (`step_simulate`), [`model`]
+//! `contact_assemble`, `contact_post_velocity`), [`batch`] (`lcp_solve_batch`,
+//! `contact_solve_batch`; `step_rollout` is in [`step`]), [`step`] (`step_simulate`), [`model`]
 //! (`model_simulate`), [`io`] (the Siconos readers), [`errors`] (the exception of each error
 //! kind), [`settings`] (the contact solvers' settings, built once for `contact`, `step` and
 //! `model`). This file registers them and holds what they share: [`guarded`] (GIL release,
 //! Ctrl-C, panics) and array borrowing.
 
+mod batch;
 mod contact;
 mod errors;
 mod io;
@@ -146,6 +148,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(set_memory_budget, m)?)?;
     lcp::register(m)?;
     contact::register(m)?;
+    batch::register(m)?;
     io::register(m)?;
     m.add_function(wrap_pyfunction!(simd_level, m)?)?;
     step::register(m)?;

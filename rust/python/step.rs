@@ -13,6 +13,8 @@ use super::{guarded, to_py};
 
 #[path = "step_joints.rs"]
 mod joints;
+#[path = "step_rollout.rs"]
+mod rollout;
 #[path = "step_stream.rs"]
 mod stream;
 use crate::contact::ContactOrder;
@@ -569,6 +571,7 @@ pub(super) fn solid_check(solid: &Bound<'_, PyDict>, dim: usize) -> PyResult<()>
 /// registers the stepper's functions in `coulomb._core`.
 pub(super) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(step_simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(rollout::step_rollout, m)?)?;
     m.add_function(wrap_pyfunction!(stream::step_stream, m)?)?;
     m.add_function(wrap_pyfunction!(solid_check, m)?)
 }

@@ -1,0 +1,483 @@
+//! Batches: many independent problems (LCPs, friction-contact problems, whole simulations)
+//! solved across the cores with rayon.
+//!
+//! Every problem of a batch is solved by exactly the code a single solve runs (Lemke's
+//! complementary pivoting, Cottle, Pang and Stone 1992; NSGS on De Saxcé's bipotential form,
+//! Jean 1999 and Acary-Brogliato 2008; the impulse stepper of Stewart and Trinkle 1996), on its
+//! own data and with its own workspace, so each answer is bitwise the answer of the one-at-a-time
+//! solve and does not depend on how many threads run or in which order the problems are taken:
+//! the problems share nothing but the read-only inputs.
+//!
+//! [`map_chunks`] is the engine: it splits the indices `0..count` into consecutive chunks,
+//! runs the chunks on a rayon pool of the requested size (cached, built once per size), each
+//! gathering its answers in its own state, and returns the states in order ([`map`]: the
+//! answers in index order). The calling thread does no solving: it waits for the pool and calls the
+//! caller's `watch` hook about every [`crate::interrupt::HOOK_INTERVAL`] (the Python bindings
+//! check for Ctrl-C there, on the interpreter's main thread). When `watch` says stop, a shared
+//! flag tells every worker to stop: the solver loops see it through their
+//! [`crate::interrupt::poll`]s and the chunks stop between problems, and the batch ends with
+//! [`CoulombError::Interrupted`].
+//!
+//! Input is checked before any work: [`lcp_problems`] and [`contact_problems`] check every
+//! problem's shapes and values and name the failing problem by its index.
+
+use std::ops::Range;
+use std::panic::{catch_unwind, resume_unwind, AssertUnwindSafe};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{mpsc, Arc, Mutex};
+use std::time::Instant;
+
+use rayon::prelude::*;
+use rayon::ThreadPool;
+
+use crate::contact::{self, ContactProblem, ContactSolution};
+use crate::error::{check_finite, CoulombError, Result};
+use crate::interrupt;
+use crate::lcp::kernel::all_finite;
+use crate::lcp::{self, LcpRef, LcpSolution, LemkeWorkspace, Method};
+use crate::step::{simulate_joints, Joint, Scene, StepRecord, StepSettings, Trajectory};
+
+/// the most threads a batch may ask for.
+pub const MAX_THREADS: usize = 1024;
+
+/// chunks per thread: enough for problems of unequal cost to balance, few enough that the
+/// per-chunk set-up (a workspace, the interrupt hook) stays negligible.
+const CHUNKS_PER_THREAD: usize = 8;
+
+/// Lemke solves up to this size reuse one workspace per chunk, as a single solve from Python
+/// reuses one per thread (larger ones allocate their own, as there).
+const REUSED_WORKSPACE_MAX_N: usize = 256;
+
+/// the pools built so far, one per thread count, with the process that built them.
+static POOLS: Mutex<Vec<(usize, u32, Arc<ThreadPool>)>> = Mutex::new(Vec::new());
+
+/// the number of threads `threads` asks for: all the cores when `None`.
+pub fn thread_count(threads: Option<usize>) -> Result<usize> {
+    match threads {
+        None => Ok(std::thread::available_parallelism().map_or(1, |n| n.get())),
+        Some(t) if (1..=MAX_THREADS).contains(&t) => Ok(t),
+        Some(t) => Err(CoulombError::InvalidParameter(format!(
+            "threads must be an int in [1, {MAX_THREADS}], got {t}"
+        ))),
+    }
+}
+
+/// the cached pool of `threads` threads.
+fn pool(threads: usize) -> Result<Arc<ThreadPool>> {
+    // a poisoned lock only means another batch panicked while holding it: the list is intact
+    let mut pools = POOLS.lock().unwrap_or_else(|e| e.into_inner());
+    let pid = std::process::id();
+    if pools.iter().any(|(_, owner, _)| *owner != pid) {
+        // a child forked from the process that built them: their threads did not follow it
+        // into this process, so they are left alone (never dropped: dropping would signal
+        // threads that do not exist here) and new ones built
+        std::mem::forget(std::mem::take(&mut *pools));
+    }
+    if let Some((_, _, p)) = pools.iter().find(|(t, _, _)| *t == threads) {
+        return Ok(p.clone());
+    }
+    let p = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .thread_name(|i| format!("coulomb-batch-{i}"))
+        .build()
+        .map_err(|e| {
+            CoulombError::InvalidParameter(format!("cannot start {threads} threads: {e}"))
+        })?;
+    let p = Arc::new(p);
+    pools.push((threads, pid, p.clone()));
+    Ok(p)
+}
+
+/// `e` with the index of the problem it is about.
+pub fn at_problem(index: usize, e: CoulombError) -> CoulombError {
+    match e {
+        CoulombError::Shape(m) => CoulombError::Shape(format!("problem {index}: {m}")),
+        CoulombError::NonFinite(m) => CoulombError::NonFinite(format!("problem {index}: {m}")),
+        CoulombError::InvalidParameter(m) => {
+            CoulombError::InvalidParameter(format!("problem {index}: {m}"))
+        }
+        CoulombError::TooLarge(m) => CoulombError::TooLarge(format!("problem {index}: {m}")),
+        other => other,
+    }
+}
+
+/// Runs `f(state, i)` for every `i` in `0..count` on `threads` threads (all the cores when
+/// `None`), `state` made by `init` once per chunk of indices; returns the answers in index
+/// order. See [`map_chunks`] for the interrupt, errors and panics.
+pub fn map<S, T, I, F>(
+    count: usize,
+    threads: Option<usize>,
+    watch: &mut dyn FnMut() -> bool,
+    init: I,
+    f: F,
+) -> Result<Vec<T>>
+where
+    S: Send,
+    T: Send,
+    I: Fn() -> S + Sync,
+    F: Fn(&mut S, usize) -> Result<T> + Sync,
+{
+    let parts = map_chunks(
+        count,
+        threads,
+        watch,
+        |range| (init(), Vec::with_capacity(range.len())),
+        |(state, out), i| {
+            out.push(f(state, i)?);
+            Ok(())
+        },
+    )?;
+    let mut out = Vec::with_capacity(count);
+    for (_, part) in parts {
+        out.extend(part);
+    }
+    Ok(out)
+}
+
+/// Splits `0..count` into consecutive chunks, makes each chunk's state with `init(range)`,
+/// runs `f(state, i)` for every `i` of the chunk in order, on `threads` threads (all the
+/// cores when `None`), and returns the states in chunk order: a chunk can gather its answers
+/// in its own columns, allocated and filled on the worker thread.
+///
+/// `watch` is called on the calling thread about every [`crate::interrupt::HOOK_INTERVAL`]
+/// while the work runs; when it returns true the workers stop (their solver loops at the next
+/// poll, the chunks between problems) and the batch returns [`CoulombError::Interrupted`].
+/// The first error of `f`, by index, is returned with the problem's index (see
+/// [`at_problem`]). A panic in `f` is re-raised on the calling thread once the workers have
+/// stopped.
+pub fn map_chunks<S, I, F>(
+    count: usize,
+    threads: Option<usize>,
+    watch: &mut dyn FnMut() -> bool,
+    init: I,
+    f: F,
+) -> Result<Vec<S>>
+where
+    S: Send,
+    I: Fn(Range<usize>) -> S + Sync,
+    F: Fn(&mut S, usize) -> Result<()> + Sync,
+{
+    let threads = thread_count(threads)?;
+    if count == 0 {
+        return Ok(Vec::new());
+    }
+    let pool = pool(threads)?;
+    let chunk = count.div_ceil(threads * CHUNKS_PER_THREAD).max(1);
+    let chunks = count.div_ceil(chunk);
+    let stop = Arc::new(AtomicBool::new(false));
+    let run_chunk = |c: usize| -> Result<S> {
+        let flag = stop.clone();
+        interrupt::run(
+            move || flag.load(Ordering::Relaxed),
+            || {
+                let range = c * chunk..((c + 1) * chunk).min(count);
+                let mut state = init(range.clone());
+                for i in range {
+                    if stop.load(Ordering::Relaxed) || interrupt::stopped() {
+                        return Err(CoulombError::Interrupted);
+                    }
+                    f(&mut state, i).map_err(|e| at_problem(i, e))?;
+                }
+                Ok(state)
+            },
+        )
+    };
+    let (tx, rx) = mpsc::channel();
+    let outcome = pool.in_place_scope(|scope| {
+        scope.spawn(|_| {
+            let all = catch_unwind(AssertUnwindSafe(|| {
+                (0..chunks)
+                    .into_par_iter()
+                    .map(run_chunk)
+                    .collect::<Vec<_>>()
+            }));
+            // the receiver waits until this arrives: sending cannot fail
+            let _ = tx.send(all);
+        });
+        loop {
+            match rx.recv_timeout(interrupt::HOOK_INTERVAL) {
+                Ok(all) => break Some(all),
+                Err(mpsc::RecvTimeoutError::Timeout) => {
+                    if !stop.load(Ordering::Relaxed) && watch() {
+                        stop.store(true, Ordering::Relaxed);
+                    }
+                }
+                Err(mpsc::RecvTimeoutError::Disconnected) => break None,
+            }
+        }
+    });
+    let all = match outcome {
+        Some(Ok(all)) => all,
+        Some(Err(panic)) => resume_unwind(panic),
+        None => resume_unwind(Box::new("a batch worker ended without an answer")),
+    };
+    if stop.load(Ordering::Relaxed) {
+        return Err(CoulombError::Interrupted);
+    }
+    all.into_iter().collect()
+}
+
+/// Checks the LCPs `(Ms[i], qs[i])` of a batch (`sizes[i]` = n_i, M_i row-major) before any
+/// work, naming the first failing problem: `Shape` for lengths that do not fit, `NonFinite`
+/// for a NaN or an infinity.
+pub fn lcp_problems<'a>(
+    sizes: &[usize],
+    ms: &[&'a [f64]],
+    qs: &[&'a [f64]],
+) -> Result<Vec<LcpRef<'a>>> {
+    if ms.len() != sizes.len() || qs.len() != sizes.len() {
+        return Err(CoulombError::Shape(format!(
+            "Ms and qs must hold the same number of problems, got {} and {}",
+            ms.len(),
+            qs.len()
+        )));
+    }
+    let mut out = Vec::with_capacity(sizes.len());
+    for (i, ((&n, &m), &q)) in sizes.iter().zip(ms).zip(qs).enumerate() {
+        if m.len() != n * n {
+            return Err(CoulombError::Shape(format!(
+                "Ms[{i}] must be {n} x {n} ({} entries), got {} entries",
+                n * n,
+                m.len()
+            )));
+        }
+        if q.len() != n {
+            return Err(CoulombError::Shape(format!(
+                "qs[{i}] has length {} but Ms[{i}] is {n} x {n}",
+                q.len()
+            )));
+        }
+        // the name is only formatted for a refusal
+        if !(all_finite(m) && all_finite(q)) {
+            check_finite(&format!("Ms[{i}]"), m)?;
+            check_finite(&format!("qs[{i}]"), q)?;
+        }
+        out.push(LcpRef { n, m, q });
+    }
+    Ok(out)
+}
+
+/// The method of problem `i`: `methods` holds one for all problems or one per problem.
+pub fn pick<M>(methods: &[M], i: usize) -> Result<&M> {
+    match methods {
+        [one] => Ok(one),
+        many => many.get(i).ok_or_else(|| {
+            CoulombError::InvalidParameter(format!(
+                "{} settings given for a batch that has problem {i}",
+                many.len()
+            ))
+        }),
+    }
+}
+
+/// checks that `methods` has one entry or one per problem.
+pub fn check_methods<M>(methods: &[M], count: usize) -> Result<()> {
+    if methods.len() == 1 || methods.len() == count {
+        Ok(())
+    } else {
+        Err(CoulombError::InvalidParameter(format!(
+            "give one method for all {count} problems or one per problem, got {}",
+            methods.len()
+        )))
+    }
+}
+
+/// Solves every LCP of `problems` with `methods` (one for all, or one per problem) across
+/// `threads` threads (see [`map`]); each answer with the seconds its solve took. Each answer
+/// is bitwise the one [`lcp::solve`] gives for the problem alone.
+pub fn solve_lcps(
+    problems: &[LcpRef<'_>],
+    methods: &[Method],
+    threads: Option<usize>,
+    watch: &mut dyn FnMut() -> bool,
+) -> Result<Vec<(LcpSolution, f64)>> {
+    check_methods(methods, problems.len())?;
+    map(
+        problems.len(),
+        threads,
+        watch,
+        || (LemkeWorkspace::new(0), Instant::now()),
+        |(ws, last), i| {
+            let s = solve_lcp(ws, &problems[i], pick(methods, i)?)?;
+            Ok((s, lap(last)))
+        },
+    )
+}
+
+/// One problem of an LCP batch, as the single solve from Python runs it: small Lemke solves
+/// on the chunk's workspace `ws`, everything else through [`lcp::solve`].
+pub fn solve_lcp(ws: &mut LemkeWorkspace, p: &LcpRef<'_>, method: &Method) -> Result<LcpSolution> {
+    match method {
+        Method::Lemke(settings) if p.n <= REUSED_WORKSPACE_MAX_N => {
+            lcp::solve_lemke_with(ws, p, settings)
+        }
+        other => lcp::solve(p, other),
+    }
+}
+
+/// seconds since `last`, which becomes now: one clock reading per problem times each one
+/// from the end of the previous (the first from the chunk's start).
+pub fn lap(last: &mut Instant) -> f64 {
+    let now = Instant::now();
+    let t = now.duration_since(*last).as_secs_f64();
+    *last = now;
+    t
+}
+
+/// Checks the friction-contact problems `(Ws[i], qs[i], mus[i])` of a batch (W_i dense,
+/// row-major; `pairs[i]` the anisotropic `(mu_1, mu_2)` pairs or `None`) before any work, as
+/// [`ContactProblem::new`] does, naming the first failing problem.
+pub fn contact_problems<'a>(
+    dim: usize,
+    ws: &[&'a [f64]],
+    qs: &[&'a [f64]],
+    mus: &[&'a [f64]],
+    pairs: &[Option<&'a [f64]>],
+) -> Result<Vec<ContactProblem<'a>>> {
+    let count = ws.len();
+    if qs.len() != count || mus.len() != count || pairs.len() != count {
+        return Err(CoulombError::Shape(format!(
+            "Ws, qs and mus must hold the same number of problems, got {}, {} and {}",
+            count,
+            qs.len(),
+            mus.len()
+        )));
+    }
+    let mut out = Vec::with_capacity(count);
+    for i in 0..count {
+        let p = ContactProblem::new(dim, ws[i], qs[i], mus[i]).map_err(|e| at_problem(i, e))?;
+        let p = match pairs[i] {
+            Some(pp) => p
+                .with_anisotropic_friction(pp)
+                .map_err(|e| at_problem(i, e))?,
+            None => p,
+        };
+        out.push(p);
+    }
+    Ok(out)
+}
+
+/// Solves every friction-contact problem of `problems` with `methods` (one for all, or one
+/// per problem) across `threads` threads (see [`map`]); each answer with the seconds its solve
+/// took, bitwise the one [`contact::solve`] gives for the problem alone.
+pub fn solve_contacts(
+    problems: &[ContactProblem<'_>],
+    methods: &[contact::Method],
+    threads: Option<usize>,
+    watch: &mut dyn FnMut() -> bool,
+) -> Result<Vec<(ContactSolution, f64)>> {
+    check_methods(methods, problems.len())?;
+    map(problems.len(), threads, watch, Instant::now, |last, i| {
+        let s = contact::solve(&problems[i], pick(methods, i)?)?;
+        Ok((s, lap(last)))
+    })
+}
+
+/// One scene of a rollout: the scene, its joints, its step settings and how often its state
+/// is kept (see [`simulate_joints`]).
+pub struct RolloutScene<'a> {
+    /// bodies, shapes and pairs.
+    pub scene: &'a Scene,
+    /// joints between its bodies.
+    pub joints: &'a [Joint],
+    /// time step, steps and solver.
+    pub settings: &'a StepSettings,
+    /// keep every `record_every`-th step (and the last).
+    pub record_every: usize,
+}
+
+/// Simulates every scene of `scenes` across `threads` threads (see [`map`]); each trajectory
+/// with the seconds its run took, bitwise the one [`simulate_joints`] gives for the scene
+/// alone.
+pub fn rollout(
+    scenes: &[RolloutScene<'_>],
+    threads: Option<usize>,
+    watch: &mut dyn FnMut() -> bool,
+) -> Result<Vec<(Trajectory, f64)>> {
+    check_rollout_records(scenes)?;
+    map(scenes.len(), threads, watch, Instant::now, |last, i| {
+        let s = &scenes[i];
+        let tr = simulate_joints(s.scene, s.joints, s.settings, s.record_every)?;
+        Ok((tr, lap(last)))
+    })
+}
+
+/// the states every scene of a rollout records, together, against the memory budget (each
+/// run checks its own; the rollout holds them all at once), before any step.
+fn check_rollout_records(scenes: &[RolloutScene<'_>]) -> Result<()> {
+    let mut total = 0usize;
+    for s in scenes {
+        let dim = s.scene.dim;
+        let (nq, nv) = s
+            .scene
+            .bodies
+            .iter()
+            .fold((0, 0), |(q, v), b| (q + b.kind.nq(dim), v + b.kind.nv(dim)));
+        let rows = s.settings.steps.div_ceil(s.record_every.max(1)) + 1;
+        let row_bytes = 8 * (nq + nv + 5) + std::mem::size_of::<StepRecord>();
+        total = total.saturating_add(rows.saturating_mul(row_bytes));
+    }
+    crate::limits::check_bytes(
+        &format!(
+            "recording the states of {} scene{}",
+            scenes.len(),
+            if scenes.len() == 1 { "" } else { "s" }
+        ),
+        total,
+        1,
+        "record fewer states with record_every, or roll out fewer scenes at once",
+    )
+    .map(|_| ())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn never() -> bool {
+        false
+    }
+
+    #[test]
+    fn answers_come_in_index_order_whatever_the_threads() {
+        for threads in [1, 2, 3] {
+            let out = map(1000, Some(threads), &mut never, || 0usize, |_, i| Ok(i * i)).unwrap();
+            assert_eq!(out, (0..1000).map(|i| i * i).collect::<Vec<_>>());
+        }
+    }
+
+    #[test]
+    fn the_first_error_by_index_names_its_problem() {
+        let out = map(
+            100,
+            Some(2),
+            &mut never,
+            || (),
+            |_, i| {
+                if i == 37 || i == 90 {
+                    Err(CoulombError::InvalidParameter("bad".into()))
+                } else {
+                    Ok(i)
+                }
+            },
+        );
+        match out {
+            Err(CoulombError::InvalidParameter(m)) => assert!(m.starts_with("problem 37:"), "{m}"),
+            other => panic!("expected an error, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn thread_counts_outside_the_range_are_refused() {
+        for t in [0, MAX_THREADS + 1] {
+            let out = map(3, Some(t), &mut never, || (), |_, i| Ok(i));
+            assert!(matches!(out, Err(CoulombError::InvalidParameter(_))));
+        }
+    }
+
+    #[test]
+    fn an_empty_batch_returns_nothing() {
+        let out = map(0, None, &mut never, || (), |_, i| Ok(i)).unwrap();
+        assert!(out.is_empty());
+    }
+}

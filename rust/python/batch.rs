@@ -1,0 +1,467 @@
+//! Bindings of the batches (`crate::batch`): `lcp_solve_batch` and `contact_solve_batch`
+//! (the step rollout is `step_rollout`, beside the stepper's bindings). The problems come as
+//! one stacked array (`(B, n, n)` matrices and `(B, n)` vectors, borrowed without a copy) or as
+//! lists of arrays of different sizes; the answers go back column by column (one flat array per
+//! field, with offsets for the per-problem vectors), from which `coulomb.batch` makes each
+//! problem's result object on demand. The GIL is released for the whole batch; the calling
+//! thread checks for Ctrl-C while the pool works.
+
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+use std::time::Instant;
+
+use numpy::{PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+#[path = "batch_columns.rs"]
+mod columns;
+use columns::{ContactColumns, LcpColumns};
+
+use super::errors::internal_error;
+use super::{settings, signal_hook, to_py};
+use crate::batch;
+use crate::contact;
+use crate::contact::prox::ProxSettings;
+use crate::error::CoulombError;
+use crate::lcp::{
+    EnumerateSettings, LemkeEngine, LemkeSettings, LemkeWorkspace, Method, PgsSettings,
+};
+
+/// Runs a batch with the GIL released, the calling thread checking for Ctrl-C (the signal
+/// handlers run there, see `super::signal_hook`) while the pool works; a Rust panic becomes
+/// `coulomb.errors.InternalError`.
+pub(super) fn batch_guarded<T: Send>(
+    py: Python<'_>,
+    f: impl FnOnce(&mut dyn FnMut() -> bool) -> Result<T, CoulombError> + Send,
+) -> PyResult<T> {
+    let out = py.detach(|| {
+        catch_unwind(AssertUnwindSafe(|| {
+            let mut watch = signal_hook;
+            f(&mut watch)
+        }))
+    });
+    match out {
+        Ok(Ok(v)) => Ok(v),
+        Ok(Err(e)) => Err(to_py(py, e)),
+        Err(panic) => {
+            let what = panic
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| panic.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "unknown panic".into());
+            Err(internal_error(py, &what))
+        }
+    }
+}
+
+/// Square matrices: stacked `(B, n, n)` or a list of `(n_i, n_i)` arrays.
+#[derive(FromPyObject)]
+enum Mats<'py> {
+    Stack(PyReadonlyArray3<'py, f64>),
+    Many(Vec<PyReadonlyArray2<'py, f64>>),
+}
+
+/// Vectors: stacked `(B, n)` or a list of `(n_i,)` arrays.
+#[derive(FromPyObject)]
+enum Vecs<'py> {
+    Stack(PyReadonlyArray2<'py, f64>),
+    Many(Vec<PyReadonlyArray1<'py, f64>>),
+}
+
+fn contiguous(name: &str) -> CoulombError {
+    CoulombError::Shape(format!("{name} must be a C-contiguous float64 array"))
+}
+
+/// the matrices as slices, with their sizes.
+fn mat_slices<'a>(
+    name: &str,
+    m: &'a Mats<'_>,
+) -> Result<(Vec<usize>, Vec<&'a [f64]>), CoulombError> {
+    match m {
+        Mats::Stack(a) => {
+            let s = a.shape();
+            if s[1] != s[2] {
+                return Err(CoulombError::Shape(format!(
+                    "{name} must have shape (B, n, n), got ({}, {}, {})",
+                    s[0], s[1], s[2]
+                )));
+            }
+            let data = a.as_slice().map_err(|_| contiguous(name))?;
+            let n = s[1];
+            let parts = if n == 0 {
+                vec![&data[..0]; s[0]]
+            } else {
+                data.chunks_exact(n * n).collect()
+            };
+            Ok((vec![n; s[0]], parts))
+        }
+        Mats::Many(list) => {
+            let mut sizes = Vec::with_capacity(list.len());
+            let mut parts = Vec::with_capacity(list.len());
+            for (i, a) in list.iter().enumerate() {
+                let s = a.shape();
+                if s[0] != s[1] {
+                    return Err(CoulombError::Shape(format!(
+                        "{name}[{i}] must be square, got {} x {}",
+                        s[0], s[1]
+                    )));
+                }
+                sizes.push(s[0]);
+                parts.push(
+                    a.as_slice()
+                        .map_err(|_| contiguous(&format!("{name}[{i}]")))?,
+                );
+            }
+            Ok((sizes, parts))
+        }
+    }
+}
+
+/// the vectors as slices.
+fn vec_slices<'a>(name: &str, v: &'a Vecs<'_>) -> Result<Vec<&'a [f64]>, CoulombError> {
+    match v {
+        Vecs::Stack(a) => {
+            let s = a.shape();
+            let data = a.as_slice().map_err(|_| contiguous(name))?;
+            Ok(if s[1] == 0 {
+                vec![&data[..0]; s[0]]
+            } else {
+                data.chunks_exact(s[1]).collect()
+            })
+        }
+        Vecs::Many(list) => list
+            .iter()
+            .enumerate()
+            .map(|(i, a)| {
+                a.as_slice()
+                    .map_err(|_| contiguous(&format!("{name}[{i}]")))
+            })
+            .collect(),
+    }
+}
+
+/// per-problem optional vectors (`None` for all, or one entry per problem, each maybe `None`),
+/// copied.
+fn per_problem(
+    name: &str,
+    v: &Option<Vec<Option<PyReadonlyArray1<'_, f64>>>>,
+    count: usize,
+) -> Result<Vec<Option<Vec<f64>>>, CoulombError> {
+    match v {
+        None => Ok(vec![None; count]),
+        Some(list) if list.len() != count => Err(CoulombError::Shape(format!(
+            "{name} must hold one entry per problem ({count}), got {}",
+            list.len()
+        ))),
+        Some(list) => list
+            .iter()
+            .enumerate()
+            .map(|(i, a)| match a {
+                None => Ok(None),
+                Some(a) => a
+                    .as_slice()
+                    .map(|s| Some(s.to_vec()))
+                    .map_err(|_| contiguous(&format!("{name}[{i}]"))),
+            })
+            .collect(),
+    }
+}
+
+fn lemke_engine(engine: &str) -> Result<LemkeEngine, CoulombError> {
+    match engine {
+        "auto" => Ok(LemkeEngine::Auto),
+        "tableau" => Ok(LemkeEngine::Tableau),
+        "product_form" => Ok(LemkeEngine::ProductForm),
+        other => Err(CoulombError::InvalidParameter(format!(
+            "unknown engine {other:?}: expected 'auto', 'tableau' or 'product_form'"
+        ))),
+    }
+}
+
+/// The LCP methods of a batch: one for all problems when nothing differs between them, else
+/// one per problem (covering vectors, warm starts, PGS starting points given per problem).
+#[allow(clippy::too_many_arguments)]
+fn lcp_methods(
+    count: usize,
+    method: &str,
+    tol: f64,
+    max_pivots: Option<usize>,
+    covers: Vec<Option<Vec<f64>>>,
+    warm: Option<Vec<Option<Vec<usize>>>>,
+    polish: bool,
+    restarts: usize,
+    max_iter: usize,
+    relaxation: f64,
+    initials: Vec<Option<Vec<f64>>>,
+    engine: LemkeEngine,
+) -> Result<Vec<Method>, CoulombError> {
+    let warm = match warm {
+        None => vec![None; count],
+        Some(w) if w.len() != count => {
+            return Err(CoulombError::Shape(format!(
+                "warm_start must hold one basis per problem ({count}), got {}",
+                w.len()
+            )))
+        }
+        Some(w) => w,
+    };
+    let uniform = covers.iter().all(Option::is_none)
+        && warm.iter().all(Option::is_none)
+        && initials.iter().all(Option::is_none);
+    let one = |cover: Option<Vec<f64>>, warm_start: Option<Vec<usize>>, init: Option<Vec<f64>>| {
+        match method {
+            "lemke" => Ok(Method::Lemke(LemkeSettings {
+                tol,
+                max_pivots,
+                covering_vector: cover,
+                warm_start,
+                polish,
+                restarts,
+                engine,
+            })),
+            "pgs" => Ok(Method::Pgs(PgsSettings {
+                tol,
+                max_iter,
+                relaxation,
+                initial: init,
+            })),
+            "enumerate" => Ok(Method::Enumerate(EnumerateSettings { tol })),
+            other => Err(CoulombError::InvalidParameter(format!(
+                "unknown method {other:?}: expected 'lemke', 'pgs' or 'enumerate'"
+            ))),
+        }
+    };
+    if uniform {
+        return Ok(vec![one(None, None, None)?]);
+    }
+    covers
+        .into_iter()
+        .zip(warm)
+        .zip(initials)
+        .map(|((c, w), i)| one(c, w, i))
+        .collect()
+}
+
+/// Solves a batch of LCPs `0 <= z_i ⊥ M_i z_i + q_i >= 0` across `threads` threads (all the
+/// cores when None). The Python wrapper `coulomb.lcp.solve_batch` documents the arguments;
+/// this takes them converted: `ms` a `(B, n, n)` float64 array or a list of square ones, `qs`
+/// `(B, n)` or a list; `covering_vector`, `warm_start`, `initial` one entry per problem.
+#[pyfunction]
+#[pyo3(signature = (ms, qs, method, tol, max_pivots=None, covering_vector=None, warm_start=None,
+                    polish=true, restarts=2, max_iter=10_000, relaxation=1.0, initial=None,
+                    engine="auto", threads=None))]
+#[allow(clippy::too_many_arguments)]
+fn lcp_solve_batch<'py>(
+    py: Python<'py>,
+    ms: Mats<'py>,
+    qs: Vecs<'py>,
+    method: &str,
+    tol: f64,
+    max_pivots: Option<usize>,
+    covering_vector: Option<Vec<Option<PyReadonlyArray1<'py, f64>>>>,
+    warm_start: Option<Vec<Option<Vec<usize>>>>,
+    polish: bool,
+    restarts: usize,
+    max_iter: usize,
+    relaxation: f64,
+    initial: Option<Vec<Option<PyReadonlyArray1<'py, f64>>>>,
+    engine: &str,
+    threads: Option<usize>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let prepared = (|| {
+        batch::thread_count(threads)?;
+        let engine = lemke_engine(engine)?;
+        let (sizes, m_parts) = mat_slices("Ms", &ms)?;
+        let q_parts = vec_slices("qs", &qs)?;
+        let count = sizes.len();
+        let covers = per_problem("covering_vector", &covering_vector, count)?;
+        let initials = per_problem("initial", &initial, count)?;
+        let methods = lcp_methods(
+            count, method, tol, max_pivots, covers, warm_start, polish, restarts, max_iter,
+            relaxation, initials, engine,
+        )?;
+        let problems = batch::lcp_problems(&sizes, &m_parts, &q_parts)?;
+        Ok((problems, methods))
+    })();
+    let (problems, methods) = prepared.map_err(|e| to_py(py, e))?;
+    let n = problems.first().map_or(0, |p| p.n);
+    let parts = batch_guarded(py, |watch| {
+        batch::check_methods(&methods, problems.len())?;
+        batch::map_chunks(
+            problems.len(),
+            threads,
+            watch,
+            |range| {
+                let cols = LcpColumns::new(range.len(), n);
+                (LemkeWorkspace::new(0), Instant::now(), cols)
+            },
+            |(ws, last, cols), i| {
+                let s = batch::solve_lcp(ws, &problems[i], batch::pick(&methods, i)?)?;
+                cols.push(&s, batch::lap(last));
+                Ok(())
+            },
+        )
+    })?;
+    LcpColumns::into_dict(py, parts.into_iter().map(|(_, _, c)| c).collect())
+}
+
+/// the options of a contact batch, the same for every problem.
+struct ContactOptions<'a> {
+    dim: usize,
+    method: &'a str,
+    tol: f64,
+    max_iter: Option<usize>,
+    relaxation: f64,
+    facets: Option<usize>,
+    eta: Option<f64>,
+    order: &'a str,
+}
+
+/// The contact methods of a batch: one for all problems, or one per problem when warm starts
+/// are given per problem.
+fn contact_methods(
+    o: &ContactOptions<'_>,
+    initials: Vec<Option<Vec<f64>>>,
+) -> Result<Vec<contact::Method>, CoulombError> {
+    let order = match o.order {
+        "forward" => contact::ContactOrder::Forward,
+        "backward" => contact::ContactOrder::Backward,
+        "symmetric" => contact::ContactOrder::Symmetric,
+        other => {
+            return Err(CoulombError::InvalidParameter(format!(
+                "order must be 'forward', 'backward' or 'symmetric' in a batch, got {other:?}"
+            )))
+        }
+    };
+    let one = |init: Option<Vec<f64>>| match o.method {
+        "nsgs" => Ok(contact::Method::Nsgs(settings::nsgs(
+            o.tol,
+            o.max_iter,
+            o.relaxation,
+            init,
+            order.clone(),
+        ))),
+        "lemke" => Ok(contact::Method::Polyhedral(settings::lemke(
+            o.dim, o.tol, o.max_iter, o.facets,
+        ))),
+        "prox" => {
+            let d = ProxSettings::default();
+            Ok(contact::Method::Prox(ProxSettings {
+                tol: o.tol,
+                max_iter: o.max_iter.unwrap_or(d.max_iter),
+                eta: o.eta.unwrap_or(d.eta),
+                initial: init,
+            }))
+        }
+        other => Err(CoulombError::InvalidParameter(format!(
+            "unknown method {other:?}: expected 'nsgs' (exact friction disk), 'lemke' \
+             (polyhedral cone) or 'prox' (robust mode)"
+        ))),
+    };
+    if initials.iter().all(Option::is_none) {
+        Ok(vec![one(None)?])
+    } else {
+        initials.into_iter().map(one).collect()
+    }
+}
+
+/// per-problem optional vectors borrowed (`None` for all, or one entry per problem).
+fn optional_slices<'a>(
+    name: &str,
+    v: &'a Option<Vec<Option<PyReadonlyArray1<'_, f64>>>>,
+    count: usize,
+) -> Result<Vec<Option<&'a [f64]>>, CoulombError> {
+    match v {
+        None => Ok(vec![None; count]),
+        Some(list) if list.len() != count => Err(CoulombError::Shape(format!(
+            "{name} must hold one entry per problem ({count}), got {}",
+            list.len()
+        ))),
+        Some(list) => list
+            .iter()
+            .enumerate()
+            .map(|(i, p)| match p {
+                None => Ok(None),
+                Some(a) => a
+                    .as_slice()
+                    .map(Some)
+                    .map_err(|_| contiguous(&format!("{name}[{i}]"))),
+            })
+            .collect(),
+    }
+}
+
+/// Solves a batch of friction-contact problems `u_i = W_i r_i + q_i` (Coulomb's law at every
+/// contact) across `threads` threads. The Python wrapper `coulomb.contact.solve_batch`
+/// documents the arguments; this takes them converted: `ws` a `(B, n, n)` float64 array or a
+/// list of square ones (dense), `qs` and `mus` `(B, .)` arrays or lists, `mu_pairs` the flat
+/// anisotropic pairs per problem (or None), `initial` the warm starts per problem.
+#[pyfunction]
+#[pyo3(signature = (ws, qs, mus, dim, method, tol, max_iter=None, relaxation=1.0, initial=None,
+                    facets=None, mu_pairs=None, eta=None, order="forward", threads=None))]
+#[allow(clippy::too_many_arguments)]
+fn contact_solve_batch<'py>(
+    py: Python<'py>,
+    ws: Mats<'py>,
+    qs: Vecs<'py>,
+    mus: Vecs<'py>,
+    dim: usize,
+    method: &str,
+    tol: f64,
+    max_iter: Option<usize>,
+    relaxation: f64,
+    initial: Option<Vec<Option<PyReadonlyArray1<'py, f64>>>>,
+    facets: Option<usize>,
+    mu_pairs: Option<Vec<Option<PyReadonlyArray1<'py, f64>>>>,
+    eta: Option<f64>,
+    order: &str,
+    threads: Option<usize>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let prepared = (|| {
+        batch::thread_count(threads)?;
+        let (sizes, w_parts) = mat_slices("Ws", &ws)?;
+        let count = sizes.len();
+        let q_parts = vec_slices("qs", &qs)?;
+        let mu_parts = vec_slices("mus", &mus)?;
+        let pair_parts = optional_slices("mus", &mu_pairs, count)?;
+        let initials = per_problem("initial", &initial, count)?;
+        let options = ContactOptions {
+            dim,
+            method,
+            tol,
+            max_iter,
+            relaxation,
+            facets,
+            eta,
+            order,
+        };
+        let methods = contact_methods(&options, initials)?;
+        let problems = batch::contact_problems(dim, &w_parts, &q_parts, &mu_parts, &pair_parts)?;
+        Ok((problems, methods))
+    })();
+    let (problems, methods) = prepared.map_err(|e| to_py(py, e))?;
+    let n = problems.first().map_or(0, |p| p.dim * p.nc);
+    let parts = batch_guarded(py, |watch| {
+        batch::check_methods(&methods, problems.len())?;
+        batch::map_chunks(
+            problems.len(),
+            threads,
+            watch,
+            |range| (Instant::now(), ContactColumns::new(range.len(), n)),
+            |(last, cols), i| {
+                let s = contact::solve(&problems[i], batch::pick(&methods, i)?)?;
+                cols.push(&s, batch::lap(last));
+                Ok(())
+            },
+        )
+    })?;
+    ContactColumns::into_dict(py, parts.into_iter().map(|(_, c)| c).collect())
+}
+
+/// adds this file's functions to `coulomb._core`.
+pub(super) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(lcp_solve_batch, m)?)?;
+    m.add_function(wrap_pyfunction!(contact_solve_batch, m)?)?;
+    Ok(())
+}
