@@ -187,7 +187,9 @@ impl Sweep<'_, '_> {
         }
     }
 
-    /// the updates of the contacts of `sequence`, in turn (see [`Self::run`]).
+    /// the updates of the contacts of `sequence`, in turn (see [`Self::run`]). Not inlined, so
+    /// a profiler sees the sweep as one function (`benches/nsgs/callgrind.py`).
+    #[inline(never)]
     fn visit(
         &self,
         sequence: impl Iterator<Item = usize>,
