@@ -4,7 +4,8 @@
 //! `cargo run --release --example nsgs_sweeps -- SWEEPS (pile NC | FILE)`, FILE a raw file or a
 //! Siconos friction-contact `.dat` file (given dense, as `nsgs_survey` gives it): a solve with a
 //! tolerance no iterate reaches, so exactly SWEEPS sweeps from zero; prints the sweeps done and
-//! the final `scaled_error`. Under `valgrind --tool=callgrind`, the inclusive count of the sweep
+//! the final `scaled_error` and a digest of the impulses' bits (equal digests: bitwise equal
+//! iterates, to compare two builds). Under `valgrind --tool=callgrind`, the inclusive count of the sweep
 //! function (`Sweep::visit`) divided by SWEEPS and nc is the instructions per contact per sweep
 //! (`benches/nsgs/callgrind.py` does this).
 
