@@ -69,10 +69,16 @@ fn main() {
         None => panic!("usage: nsgs_sweeps SWEEPS (pile NC | FILE)"),
     };
     match solution {
-        Ok(r) => println!(
-            "nc {}, {} sweeps, scaled_error {:.3e}",
-            nc, r.iterations, r.measures.scaled_error
-        ),
+        Ok(r) => {
+            // FNV-1a over the impulses' bit patterns
+            let digest = r.impulse.iter().fold(0xcbf2_9ce4_8422_2325_u64, |h, v| {
+                (h ^ v.to_bits()).wrapping_mul(0x0100_0000_01b3)
+            });
+            println!(
+                "nc {}, {} sweeps, scaled_error {:.3e}, digest {digest:016x}",
+                nc, r.iterations, r.measures.scaled_error
+            )
+        }
         Err(e) => println!("failed: {e}"),
     }
 }
