@@ -40,7 +40,6 @@
 //! solved as above in the eigenbasis of `E S E` (precomputed). When `S = t I` this minimiser
 //! is the ellipse projection of `-g / t` ([`super::super::projection::project_ellipse`]).
 
-use super::super::projection::secular;
 use super::closed::inverse3;
 
 /// passes of the normal / tangential block descent inside one contact (dim 3, and the 2D
@@ -159,6 +158,11 @@ pub(super) fn disk_qp(e: &Eig2, g: [f64; 2], radius: f64) -> [f64; 2] {
 
 /// [`disk_qp`] with the multiplier λ of a nearby problem as the secular solver's start (NaN:
 /// none); on return `lambda` holds this problem's multiplier.
+///
+/// In the eigenbasis of S the minimiser is `x_k = -g_k / (d_k + λ)` with λ = 0 when the
+/// unconstrained minimiser `-S^+ g` lies in the disk ([`interior`]: a sticking tangential
+/// impulse, one division per component) and otherwise λ > 0 the root of the secular equation
+/// `||x(λ)|| = radius` ([`secular_root`]).
 pub(super) fn disk_qp_from(e: &Eig2, g: [f64; 2], radius: f64, lambda_hint: &mut f64) -> [f64; 2] {
     if radius <= 0.0 {
         return [0.0, 0.0];
@@ -168,24 +172,88 @@ pub(super) fn disk_qp_from(e: &Eig2, g: [f64; 2], radius: f64, lambda_hint: &mut
     let gl = e.cs * g[0] + e.sn * g[1];
     let d = [e.small, e.large];
     let gg = [gs, gl];
-    let lambda = if secular(d, gg, 0.0) <= radius * radius {
-        0.0
-    } else {
-        secular_root(d, gg, radius, *lambda_hint)
+    let x = match interior(d, gg, radius) {
+        Some(x) => {
+            *lambda_hint = 0.0;
+            x
+        }
+        None => {
+            let lambda = secular_root(d, gg, radius, *lambda_hint);
+            *lambda_hint = lambda;
+            on_circle(d, gg, radius, lambda)
+        }
     };
-    *lambda_hint = lambda;
+    [-e.sn * x[0] + e.cs * x[1], e.cs * x[0] + e.sn * x[1]]
+}
+
+/// The unconstrained minimiser `x_k = -g_k / d_k` (0 where `d_k = g_k = 0`: the minimum-norm
+/// one) when it lies in the disk, `Σ_k g_k^2 / d_k^2 <= radius^2`; `None` when it does not or
+/// does not exist (`d_k = 0` with `g_k != 0`).
+#[inline]
+fn interior(d: [f64; 2], g: [f64; 2], radius: f64) -> Option<[f64; 2]> {
+    if surely_outside(d, g, radius) {
+        return None;
+    }
+    let mut x = [0.0; 2];
+    let mut ss = 0.0;
+    for k in 0..2 {
+        if d[k] > 0.0 {
+            let p = g[k] / d[k];
+            ss += p * p;
+            x[k] = -p;
+        } else if g[k] != 0.0 {
+            return None;
+        }
+    }
+    if !(ss <= radius * radius) {
+        return None;
+    }
+    // `ss <= fl(radius^2)` gives `sqrt(ss) <= radius` (correctly rounded square roots, and
+    // `sqrt(fl(r^2)) = r` without over- or underflow); outside that range, clamp as
+    // [`on_circle`] does
+    if !(ss > 1e-290 && ss < 1e290) {
+        let norm = x[0].hypot(x[1]);
+        if norm > radius {
+            x[0] *= radius / norm;
+            x[1] *= radius / norm;
+        }
+    }
+    Some(x)
+}
+
+/// Whether `Σ_k g_k^2 / d_k^2 > radius^2` is decided without a division: for positive `d_k`
+/// it reads `(g_0 d_1)^2 + (g_1 d_0)^2 > (radius d_0 d_1)^2`, whose two sides are computed to a
+/// few units of rounding (no over- or underflow in the checked range), so a margin of 1e-9
+/// between them gives the same answer as the quotients would, rounding included. `false`:
+/// not decided (the quotients decide, [`interior`]).
+#[inline]
+fn surely_outside(d: [f64; 2], g: [f64; 2], radius: f64) -> bool {
+    if !(d[0] > 0.0 && d[1] > 0.0 && radius > 1e-140 && radius < 1e140) {
+        return false;
+    }
+    let a = g[0] * d[1];
+    let b = g[1] * d[0];
+    let lhs = a * a + b * b;
+    let rd = radius * d[0] * d[1];
+    let rhs = rd * rd;
+    rhs > 1e-280 && lhs < 1e280 && lhs > rhs * (1.0 + 1e-9)
+}
+
+/// `x_k = -g_k / (d_k + λ)` (0 where `d_k + λ <= 0`), brought onto the disk when rounding in λ
+/// leaves it a hair outside.
+#[inline]
+fn on_circle(d: [f64; 2], g: [f64; 2], radius: f64, lambda: f64) -> [f64; 2] {
     let mut x = [0.0; 2];
     for k in 0..2 {
         let den = d[k] + lambda;
-        x[k] = if den > 0.0 { -gg[k] / den } else { 0.0 };
+        x[k] = if den > 0.0 { -g[k] / den } else { 0.0 };
     }
-    // rounding in λ can leave x a hair outside the disk
     let norm = norm2(x);
     if norm > radius {
         x[0] *= radius / norm;
         x[1] *= radius / norm;
     }
-    [-e.sn * x[0] + e.cs * x[1], e.cs * x[0] + e.sn * x[1]]
+    x
 }
 
 /// `||x||` of a 2-vector: the square root of the sum of squares where that neither overflows
@@ -329,6 +397,10 @@ pub(super) fn local_descent(
         }
     }
 }
+
+#[cfg(test)]
+#[path = "local_disk_tests.rs"]
+mod disk_tests;
 
 /// Blocks for the local solvers' tests.
 #[cfg(test)]
