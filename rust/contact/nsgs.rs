@@ -33,6 +33,7 @@
 //! changes case, where the sweeps would have taken it ([`extrapolate`]).
 
 mod closed;
+mod disk;
 mod extrapolate;
 mod local;
 mod rows;

@@ -1,5 +1,6 @@
-//! Unit tests of the tangential disk solve of `local.rs`: its fast paths (the interior
-//! minimiser, the division-free outside test) return bitwise what the general path returns.
+//! Unit tests of `disk.rs`: the trust-region solve is the minimiser over the disk, and its
+//! fast paths (the interior minimiser, the division-free outside test) return bitwise what the
+//! general path returns.
 
 use super::*;
 use crate::contact::projection::secular;
@@ -174,5 +175,61 @@ fn an_interior_minimiser_is_returned_with_multiplier_zero() {
             res[0].abs().max(res[1].abs()) <= 1e-12 * size,
             "case {case}: {res:?} vs {size:e}"
         );
+    }
+}
+
+fn qp_value(t: [f64; 3], g: [f64; 2], x: [f64; 2]) -> f64 {
+    0.5 * (t[0] * x[0] * x[0] + 2.0 * t[1] * x[0] * x[1] + t[2] * x[1] * x[1])
+        + g[0] * x[0]
+        + g[1] * x[1]
+}
+
+#[test]
+fn disk_qp_beats_sampling_of_the_disk() {
+    let mut rng = SplitMix64::new(17);
+    for case in 0..300 {
+        let l = [rng.normal(), rng.normal(), rng.normal(), rng.normal()];
+        // T = L L^T (PSD), sometimes singular
+        let mut t = [
+            l[0] * l[0] + l[1] * l[1],
+            l[0] * l[2] + l[1] * l[3],
+            l[2] * l[2] + l[3] * l[3],
+        ];
+        if case % 5 == 0 {
+            t = [l[0] * l[0], l[0] * l[2], l[2] * l[2]];
+        }
+        let g = [rng.normal() * 2.0, rng.normal() * 2.0];
+        let radius = rng.range(0.01, 2.0);
+        let e = Eig2::of(t);
+        let x = disk_qp(&e, g, radius);
+        assert!(x[0].hypot(x[1]) <= radius * (1.0 + 1e-14));
+        let fx = qp_value(t, g, x);
+        for _ in 0..400 {
+            let rho = radius * rng.uniform().sqrt();
+            let phi = rng.range(0.0, std::f64::consts::TAU);
+            let y = [rho * phi.cos(), rho * phi.sin()];
+            assert!(fx <= qp_value(t, g, y) + 1e-12, "case {case}");
+        }
+    }
+}
+
+#[test]
+fn eigendecomposition_reconstructs_the_block() {
+    for t in [
+        [2.0, 0.0, 1.0],
+        [1.0, 0.0, 2.0],
+        [1.0, 0.5, 0.3],
+        [0.5, -0.5, 0.5],
+    ] {
+        let e = Eig2::of(t);
+        // Q diag(small, large) Q^T with columns (-sn, cs) and (cs, sn)
+        let r00 = e.small * e.sn * e.sn + e.large * e.cs * e.cs;
+        let r01 = -e.small * e.sn * e.cs + e.large * e.cs * e.sn;
+        let r11 = e.small * e.cs * e.cs + e.large * e.sn * e.sn;
+        assert!(
+            (r00 - t[0]).abs() < 1e-14 && (r01 - t[1]).abs() < 1e-14,
+            "{t:?}: {r00} {r01} {r11}"
+        );
+        assert!((r11 - t[2]).abs() < 1e-14 && e.small <= e.large);
     }
 }
