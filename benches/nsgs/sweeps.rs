@@ -15,8 +15,11 @@ use coulomb::io::siconos::{read_siconos_fc, SiconosFcFile};
 #[path = "../../tests/pile/mod.rs"]
 mod pile;
 
-/// dim, W dense row-major, q and mu of a raw file (see `benches/nsgs/dump_fclib.py`).
-fn read_raw(path: &str) -> Option<(usize, Vec<f64>, Vec<f64>, Vec<f64>)> {
+/// dim, W dense row-major, q and mu.
+type Dense = (usize, Vec<f64>, Vec<f64>, Vec<f64>);
+
+/// a raw file (see `benches/nsgs/dump_fclib.py`) or a Siconos `.dat` file.
+fn read_raw(path: &str) -> Option<Dense> {
     if path.ends_with(".dat") {
         return match read_siconos_fc(std::path::Path::new(path)) {
             Ok(SiconosFcFile::Local(p)) => Some((p.dim, p.w.to_dense().data, p.q, p.mu)),

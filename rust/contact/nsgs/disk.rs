@@ -100,7 +100,9 @@ fn interior(d: [f64; 2], g: [f64; 2], radius: f64) -> Option<[f64; 2]> {
             return None;
         }
     }
-    if !(ss <= radius * radius) {
+    // NaN is not inside
+    let inside = ss <= radius * radius;
+    if !inside {
         return None;
     }
     // `ss <= fl(radius^2)` gives `sqrt(ss) <= radius` (correctly rounded square roots, and

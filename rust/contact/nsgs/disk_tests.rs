@@ -53,10 +53,10 @@ fn block(rng: &mut SplitMix64, case: usize) -> [f64; 3] {
         2 => large * log_range(rng, 1e-12, 1e-6),
         _ => large * rng.uniform(),
     };
-    if case % 11 == 0 {
+    if case.is_multiple_of(11) {
         return [0.0; 3];
     }
-    let th = if case % 5 == 0 {
+    let th = if case.is_multiple_of(5) {
         0.0
     } else {
         rng.range(0.0, std::f64::consts::PI)
@@ -132,11 +132,11 @@ fn the_division_free_outside_test_never_contradicts_the_quotients() {
         let eps = [0.0, 1e-15, -1e-15, 1e-9, -1e-9, 1e-6, 1e-2][case % 7];
         let rho = radius * (1.0 + eps);
         let g = [-d[0] * rho * phi.cos(), -d[1] * rho * phi.sin()];
-        let quotients_outside = !(secular(d, g, 0.0) <= radius * radius);
+        let quotients_inside = secular(d, g, 0.0) <= radius * radius;
         if surely_outside(d, g, radius) {
             decided += 1;
             assert!(
-                quotients_outside,
+                !quotients_inside,
                 "case {case}: d {d:?} g {g:?} radius {radius:e}"
             );
         }
