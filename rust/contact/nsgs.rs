@@ -33,6 +33,7 @@
 //! changes case, where the sweeps would have taken it ([`extrapolate`]).
 
 mod closed;
+mod disk;
 mod extrapolate;
 mod local;
 mod rows;
@@ -187,7 +188,9 @@ impl Sweep<'_, '_> {
         }
     }
 
-    /// the updates of the contacts of `sequence`, in turn (see [`Self::run`]).
+    /// the updates of the contacts of `sequence`, in turn (see [`Self::run`]). Not inlined, so
+    /// a profiler sees the sweep as one function (`benches/nsgs/callgrind.py`).
+    #[inline(never)]
     fn visit(
         &self,
         sequence: impl Iterator<Item = usize>,

@@ -420,9 +420,11 @@ impl BlockCsr {
     fn tiles_mul_into(&self, lo: usize, hi: usize, x: &[f64], mut out: [f64; 3]) -> [f64; 3] {
         let cols = &self.cols[lo..hi];
         if self.dim == 3 {
-            let values = &self.values[lo * 9..hi * 9];
-            for (&j, b) in cols.iter().zip(values.chunks_exact(9)) {
-                let xj = &x[3 * j..3 * j + 3];
+            // x as contacts' triples and the tiles as arrays: one bounds check per tile
+            let (xs, _) = x.as_chunks::<3>();
+            let (values, _) = self.values[lo * 9..hi * 9].as_chunks::<9>();
+            for (&j, b) in cols.iter().zip(values) {
+                let xj = &xs[j];
                 out[0] += b[0] * xj[0];
                 out[0] += b[1] * xj[1];
                 out[0] += b[2] * xj[2];
@@ -434,9 +436,10 @@ impl BlockCsr {
                 out[2] += b[8] * xj[2];
             }
         } else {
-            let values = &self.values[lo * 4..hi * 4];
-            for (&j, b) in cols.iter().zip(values.chunks_exact(4)) {
-                let xj = &x[2 * j..2 * j + 2];
+            let (xs, _) = x.as_chunks::<2>();
+            let (values, _) = self.values[lo * 4..hi * 4].as_chunks::<4>();
+            for (&j, b) in cols.iter().zip(values) {
+                let xj = &xs[j];
                 out[0] += b[0] * xj[0];
                 out[0] += b[1] * xj[1];
                 out[1] += b[2] * xj[0];

@@ -24,7 +24,7 @@
 //! ```
 //!
 //! solved in the eigenbasis of S (precomputed) with a safeguarded Newton on the secular
-//! equation; its fixed points are exactly the local solutions with the stored A. The passes
+//! equation ([`super::disk`]); its fixed points are exactly the local solutions with the stored A. The passes
 //! (normal, tangential) repeat until the impulse no longer changes, at most [`LOCAL_ITERS`]:
 //! when `c_n`, `c_t` and k vanish (a particle, or a frame aligned with the principal axes) one
 //! pass is exact and is the only one done; otherwise the passes converge linearly and the
@@ -40,8 +40,8 @@
 //! solved as above in the eigenbasis of `E S E` (precomputed). When `S = t I` this minimiser
 //! is the ellipse projection of `-g / t` ([`super::super::projection::project_ellipse`]).
 
-use super::super::projection::secular;
 use super::closed::inverse3;
+use super::disk::{disk_qp_from, Eig2};
 
 /// passes of the normal / tangential block descent inside one contact (dim 3, and the 2D
 /// fallback).
@@ -120,147 +120,6 @@ impl LocalBlock {
         b.coupled = b.cn != [0.0; 2] || b.ct != [0.0; 2] || b.k != 0.0;
         b
     }
-}
-
-/// `S = Q diag(small, large) Q^T` with `Q = [(-sn, cs), (cs, sn)]` (columns: the eigenvectors
-/// of the smaller and larger eigenvalue).
-#[derive(Clone, Copy, Debug, Default)]
-pub(super) struct Eig2 {
-    cs: f64,
-    sn: f64,
-    small: f64,
-    large: f64,
-}
-
-impl Eig2 {
-    pub(super) fn of(t: [f64; 3]) -> Self {
-        let (p, s, r) = (t[0], t[1], t[2]);
-        let m = 0.5 * (p + r);
-        let del = (0.5 * (p - r)).hypot(s);
-        let theta = 0.5 * s.atan2(0.5 * (p - r));
-        Self {
-            cs: theta.cos(),
-            sn: theta.sin(),
-            // a PSD block has no negative eigenvalues: clamp rounding
-            small: (m - del).max(0.0),
-            large: (m + del).max(0.0),
-        }
-    }
-}
-
-/// `argmin 1/2 x^T S x + g . x  over ||x|| <= radius` for positive semidefinite S given by its
-/// eigendecomposition (the trust-region subproblem in 2D). In the hard case (S singular, g
-/// orthogonal to the null direction) the minimum-norm minimiser is returned.
-#[cfg(test)]
-pub(super) fn disk_qp(e: &Eig2, g: [f64; 2], radius: f64) -> [f64; 2] {
-    let mut hint = f64::NAN;
-    disk_qp_from(e, g, radius, &mut hint)
-}
-
-/// [`disk_qp`] with the multiplier λ of a nearby problem as the secular solver's start (NaN:
-/// none); on return `lambda` holds this problem's multiplier.
-pub(super) fn disk_qp_from(e: &Eig2, g: [f64; 2], radius: f64, lambda_hint: &mut f64) -> [f64; 2] {
-    if radius <= 0.0 {
-        return [0.0, 0.0];
-    }
-    // coordinates in the eigenbasis: index 0 the small eigenvalue, 1 the large one
-    let gs = -e.sn * g[0] + e.cs * g[1];
-    let gl = e.cs * g[0] + e.sn * g[1];
-    let d = [e.small, e.large];
-    let gg = [gs, gl];
-    let lambda = if secular(d, gg, 0.0) <= radius * radius {
-        0.0
-    } else {
-        secular_root(d, gg, radius, *lambda_hint)
-    };
-    *lambda_hint = lambda;
-    let mut x = [0.0; 2];
-    for k in 0..2 {
-        let den = d[k] + lambda;
-        x[k] = if den > 0.0 { -gg[k] / den } else { 0.0 };
-    }
-    // rounding in λ can leave x a hair outside the disk
-    let norm = norm2(x);
-    if norm > radius {
-        x[0] *= radius / norm;
-        x[1] *= radius / norm;
-    }
-    [-e.sn * x[0] + e.cs * x[1], e.cs * x[0] + e.sn * x[1]]
-}
-
-/// `||x||` of a 2-vector: the square root of the sum of squares where that neither overflows
-/// nor underflows to a loss of accuracy, `hypot` otherwise.
-#[inline]
-fn norm2(x: [f64; 2]) -> f64 {
-    let ss = x[0] * x[0] + x[1] * x[1];
-    if ss > 1e-290 && ss < 1e290 {
-        ss.sqrt()
-    } else {
-        x[0].hypot(x[1])
-    }
-}
-
-/// The root `λ > 0` of the secular equation `Σ_k g_k^2 / (d_k + λ)^2 = radius^2` when its
-/// left side exceeds `radius^2` at 0 (Moré and Sorensen 1983): Newton on
-/// `ψ(λ) = 1 / sqrt(S(λ)) - 1 / radius`, which is exactly linear for `d_0 = d_1` (the disk),
-/// safeguarded by the bracket `[||g|| / radius - max d, ||g|| / radius - min d]` (bisection
-/// when a step leaves it), started from `hint` when it lies inside the bracket (the previous
-/// pass's or sweep's multiplier: a step or two), else from the bracket's right end. Newton
-/// converges quadratically there, so a step below 1e-9 of λ ends it (the next would be below
-/// rounding). With `S' = -2 T`, `T = Σ_k g_k^2 / (d_k + λ)^3`, the step is
-/// `ψ / ψ' = ψ S^(3/2) / T`: two divisions, a square root and its inverse per step.
-fn secular_root(d: [f64; 2], g: [f64; 2], radius: f64, hint: f64) -> f64 {
-    let gnorm = norm2(g);
-    let inv_radius = 1.0 / radius;
-    let mut lo = (gnorm / radius - d[0].max(d[1])).max(0.0);
-    let mut hi = (gnorm / radius - d[0].min(d[1])).max(lo);
-    let mut lambda = if hint > lo && hint < hi { hint } else { hi };
-    for _ in 0..100 {
-        let mut s = 0.0;
-        let mut t = 0.0;
-        for k in 0..2 {
-            let den = d[k] + lambda;
-            if den > 0.0 {
-                let inv = 1.0 / den;
-                let p = g[k] * inv;
-                let pp = p * p;
-                s += pp;
-                t += pp * inv;
-            }
-        }
-        if !(s > 0.0 && s.is_finite()) {
-            break;
-        }
-        let inv_root = 1.0 / s.sqrt();
-        let psi = inv_root - inv_radius;
-        if psi.abs() <= f64::EPSILON * inv_radius {
-            break;
-        }
-        if psi < 0.0 {
-            lo = lambda;
-        } else {
-            hi = lambda;
-        }
-        let dpsi = t * inv_root * inv_root * inv_root;
-        let mut next = if dpsi > 0.0 {
-            lambda - psi / dpsi
-        } else {
-            f64::NAN
-        };
-        let newton = next > lo && next < hi;
-        if !newton {
-            next = 0.5 * (lo + hi);
-        }
-        let step = (next - lambda).abs();
-        lambda = next;
-        if (newton && step <= 1e-9 * lambda)
-            || step <= 4.0 * f64::EPSILON * lambda.abs().max(f64::MIN_POSITIVE)
-            || hi - lo <= 4.0 * f64::EPSILON * hi.abs()
-        {
-            break;
-        }
-    }
-    lambda
 }
 
 /// Block descent inside one contact (see the module notes); `r` holds the current local
@@ -424,62 +283,6 @@ mod tests {
     use super::tests_support::{body_block, local_residual};
     use super::*;
     use crate::testing::SplitMix64;
-
-    fn qp_value(t: [f64; 3], g: [f64; 2], x: [f64; 2]) -> f64 {
-        0.5 * (t[0] * x[0] * x[0] + 2.0 * t[1] * x[0] * x[1] + t[2] * x[1] * x[1])
-            + g[0] * x[0]
-            + g[1] * x[1]
-    }
-
-    #[test]
-    fn disk_qp_beats_sampling_of_the_disk() {
-        let mut rng = SplitMix64::new(17);
-        for case in 0..300 {
-            let l = [rng.normal(), rng.normal(), rng.normal(), rng.normal()];
-            // T = L L^T (PSD), sometimes singular
-            let mut t = [
-                l[0] * l[0] + l[1] * l[1],
-                l[0] * l[2] + l[1] * l[3],
-                l[2] * l[2] + l[3] * l[3],
-            ];
-            if case % 5 == 0 {
-                t = [l[0] * l[0], l[0] * l[2], l[2] * l[2]];
-            }
-            let g = [rng.normal() * 2.0, rng.normal() * 2.0];
-            let radius = rng.range(0.01, 2.0);
-            let e = Eig2::of(t);
-            let x = disk_qp(&e, g, radius);
-            assert!(x[0].hypot(x[1]) <= radius * (1.0 + 1e-14));
-            let fx = qp_value(t, g, x);
-            for _ in 0..400 {
-                let rho = radius * rng.uniform().sqrt();
-                let phi = rng.range(0.0, std::f64::consts::TAU);
-                let y = [rho * phi.cos(), rho * phi.sin()];
-                assert!(fx <= qp_value(t, g, y) + 1e-12, "case {case}");
-            }
-        }
-    }
-
-    #[test]
-    fn eigendecomposition_reconstructs_the_block() {
-        for t in [
-            [2.0, 0.0, 1.0],
-            [1.0, 0.0, 2.0],
-            [1.0, 0.5, 0.3],
-            [0.5, -0.5, 0.5],
-        ] {
-            let e = Eig2::of(t);
-            // Q diag(small, large) Q^T with columns (-sn, cs) and (cs, sn)
-            let r00 = e.small * e.sn * e.sn + e.large * e.cs * e.cs;
-            let r01 = -e.small * e.sn * e.cs + e.large * e.cs * e.sn;
-            let r11 = e.small * e.cs * e.cs + e.large * e.sn * e.sn;
-            assert!(
-                (r00 - t[0]).abs() < 1e-14 && (r01 - t[1]).abs() < 1e-14,
-                "{t:?}: {r00} {r01} {r11}"
-            );
-            assert!((r11 - t[2]).abs() < 1e-14 && e.small <= e.large);
-        }
-    }
 
     #[test]
     fn anisotropic_tangential_update_is_the_ellipse_projection_for_isotropic_t() {
