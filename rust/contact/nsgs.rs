@@ -38,6 +38,7 @@ mod local;
 mod rows;
 mod schedule;
 mod slide;
+mod stick;
 
 pub use local::LOCAL_ITERS;
 
@@ -329,6 +330,9 @@ pub fn solve_nsgs(problem: &ContactProblem<'_>, s: &NsgsSettings) -> Result<Cont
     let mut measures = measure_into(problem, &r, &mut u);
     let mut schedule = CheckSchedule::new(s.tol, measures.scaled_error);
     let mut extrapolation = extrapolate::Extrapolation::new(n);
+    let mut stick = stick::StickSolve::default();
+    // the last measured sweep and error, for the sticking-set solve's slowness test
+    let mut last = (0usize, measures.scaled_error);
     let mut sweeps = 0;
     // whether `measures` are those of the current r
     let mut current = true;
@@ -347,6 +351,10 @@ pub fn solve_nsgs(problem: &ContactProblem<'_>, s: &NsgsSettings) -> Result<Cont
             if !measures.passes(s.tol) {
                 extrapolation.try_after_measure(problem, &mut r, &mut u, &mut measures, sweeps);
             }
+            if !measures.passes(s.tol) && stick::due(&stick, sweeps, last, measures.scaled_error) {
+                stick.try_at(problem, &mut r, &mut u, &mut measures, sweeps);
+            }
+            last = (sweeps, measures.scaled_error);
             if !measures.passes(s.tol) {
                 schedule.measured(sweeps, measures.scaled_error, change);
             }
