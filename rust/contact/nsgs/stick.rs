@@ -160,18 +160,28 @@ impl StickSolve {
                 continue;
             }
             // a separated contact that now approaches by more than the data's rounding
-            // joins the sticking set, once
+            // joins the sticking set, a sliding one that separates by more is released
+            // (r = 0) and one that approaches sticks, once
             for i in 0..problem.nc {
                 let o = i * dim;
-                if self.fixed[i]
-                    && !self.moved[i]
-                    && self.trial[o] == 0.0
-                    && problem.anisotropy(i).is_none()
-                    && self.u_trial[o] < -1e-12 * qmax
-                {
+                if !self.fixed[i] || self.moved[i] || problem.anisotropy(i).is_some() {
+                    continue;
+                }
+                let un = self.u_trial[o];
+                if un < -1e-12 * qmax {
                     self.fixed[i] = false;
                     self.moved[i] = true;
                     changed = true;
+                } else if un > 1e-12 * qmax && self.trial[o] > 0.0 {
+                    self.moved[i] = true;
+                    self.trial[o..o + dim].fill(0.0);
+                    changed = true;
+                }
+            }
+            if changed {
+                problem.mul_w(&self.trial, &mut self.u_trial);
+                for (v, &qk) in self.u_trial.iter_mut().zip(problem.q) {
+                    *v += qk;
                 }
             }
             if !changed {
@@ -189,6 +199,14 @@ impl StickSolve {
         let mt = measure_into(problem, &self.trial, &mut self.u_trial);
         if std::env::var("STICK_TRACE").is_ok() {
             let nfix = self.fixed.iter().filter(|&&f| f).count();
+            for i in 0..problem.nc {
+                let o = i * dim;
+                let t = &self.trial[o..o + dim];
+                let v = &self.u_trial[o..o + dim];
+                if v.iter().fold(0.0f64, |a, b| a.max(b.abs())) > 1e-10 * qmax {
+                    eprintln!("   c {i} fixed {} moved {} r {t:?} u {v:?} r0 {:?}", self.fixed[i], self.moved[i], &r[o..o + dim]);
+                }
+            }
             eprintln!(
                 "stick: sweep {sweeps} nc {} rows {} fixed {nfix} err {:e} -> {:e}",
                 problem.nc,
