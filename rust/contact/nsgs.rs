@@ -31,6 +31,11 @@
 //! impulses change by the same step every sweep (a drift along a null direction of W on the
 //! contacts' current faces), the iterate moves along that step to the first contact that
 //! changes case, where the sweeps would have taken it ([`extrapolate`]).
+//!
+//! Optionally ([`NsgsSettings::sticking`]), when the error decreases slowly the exact answer
+//! on the contacts' current cases is tried: the least-norm impulses that stop the sticking
+//! contacts, by one sparse Cholesky factor ([`stick`]); on boxes resting face on face, whose
+//! four coplanar points make W singular, it ends the slow sweeps at once.
 
 mod closed;
 mod extrapolate;
@@ -65,6 +70,10 @@ pub struct NsgsSettings {
     pub initial: Option<Vec<f64>>,
     /// the order in which a sweep visits the contacts.
     pub order: ContactOrder,
+    /// when the sweeps slow down, also try the exact solve on the contacts' current cases
+    /// (the sticking-set solve of redundant face contacts, see the module notes); off by
+    /// default.
+    pub sticking: bool,
 }
 
 /// The order of the contacts in an NSGS sweep. Gauss-Seidel's result depends on it: a
@@ -91,6 +100,7 @@ impl Default for NsgsSettings {
             relaxation: 1.0,
             initial: None,
             order: ContactOrder::Forward,
+            sticking: false,
         }
     }
 }
@@ -351,8 +361,11 @@ pub fn solve_nsgs(problem: &ContactProblem<'_>, s: &NsgsSettings) -> Result<Cont
             if !measures.passes(s.tol) {
                 extrapolation.try_after_measure(problem, &mut r, &mut u, &mut measures, sweeps);
             }
-            if !measures.passes(s.tol) && stick::due(&stick, sweeps, last, measures.scaled_error) {
-                stick.try_at(problem, &mut r, &mut u, &mut measures, sweeps);
+            if s.sticking
+                && !measures.passes(s.tol)
+                && stick::due(&stick, sweeps, last, measures.scaled_error)
+            {
+                stick.try_at(problem, &mut r, &mut u, &mut measures, sweeps, s.tol);
             }
             last = (sweeps, measures.scaled_error);
             if !measures.passes(s.tol) {
