@@ -9,8 +9,8 @@
 //! directions.
 //!
 //! When no contact changes case, though, the problem is linear: with A the rows of the
-//! sticking contacts (`r_n > 0` inside the cone: all `dim` rows; a pushing frictionless
-//! contact: its normal row) and F the others (separated or sliding, their impulses kept),
+//! sticking contacts (all `dim` rows; a frictionless contact: its normal row) and F the others
+//! (separated, sliding or anisotropic, their impulses kept),
 //!
 //! ```text
 //!     u_A = W_AA r_A + W_AF r_F + q_A = 0        (Moreau's sticking law, u = 0 inside the cone)
@@ -25,6 +25,12 @@
 //! `(S + δ I) y_{k+1} = c + δ y_k` from `y_0 = 0` stays in the range of S and converges to its
 //! least-norm solution at the ratio `δ / (λ + δ)` per iteration on an eigenvalue λ of S, on
 //! one sparse Cholesky factor of `S + δ I` (faer's, with a fill-reducing ordering).
+//!
+//! The sticking set starts as every pushing contact with isotropic friction. A contact whose
+//! answer stops pushing or leaves its cone is then fixed (at the sweeps' impulse if they left
+//! it sliding, else at 0), a separated contact that approaches joins the set, and a kept
+//! sliding one that separates is released (r = 0), each contact once, and the solve is
+//! repeated, at most [`ROUNDS`] times (an active-set iteration on the contacts' cases).
 //!
 //! The trial, projected on the friction cones, replaces the iterate only when the verdict's
 //! measure (`scaled_error`, from the original W and q) passes the tolerance or at least
@@ -51,8 +57,9 @@ const ROUNDS: usize = 12;
 const FROM: usize = 4;
 /// the error's decrease per sweep above which the sweeps count as slow.
 const SLOW_RATE: f64 = 0.95;
-/// tries per NSGS solve at most, and the fewest sweeps between two.
+/// tries per NSGS solve at most.
 const MAX_TRIES: usize = 2;
+/// the fewest sweeps between two tries.
 const RETRY_GAP: usize = 32;
 
 /// whether the sticking-set solve is tried after the measure of sweep `sweeps` (`error`,
@@ -85,7 +92,7 @@ pub(super) struct StickSolve {
     trial: Vec<f64>,
     u_trial: Vec<f64>,
     /// tries made in this solve, and the sweep of the last one.
-    pub(super) tries: usize,
+    tries: usize,
     last_try: usize,
 }
 
