@@ -16,7 +16,10 @@
 //! benches/peer_step.py.
 //!
 //! NSGS's sweep order, relaxation and sweep limit can be changed for experiments through the
-//! environment: `ORDER=symmetric|backward|forward`, `RELAX=1.3`, `MAXIT=100`.
+//! environment: `ORDER=symmetric|backward|forward`, `RELAX=1.3`, `MAXIT=100`; `STICK=1` turns on
+//! NSGS's sticking-set solve. `QUIET=1` lists no steps, `CONTACTS=K` prints the contacts of the
+//! first K steps; the boxes' drift (largest displacement from the start) and the fallback count
+//! are printed.
 use coulomb::geometry::Shape3;
 use coulomb::step::{
     simulate, Body, BodyKind, HalfSpace, Pair, Scene, Shape, Solid, SolidShape, StepSettings,
@@ -358,6 +361,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     {
         s.max_iter = w.parse()?;
     }
+    if let (Ok(_), coulomb::step::StepSolver::Nsgs(s)) =
+        (std::env::var("STICK"), &mut settings.solver)
+    {
+        s.sticking = true;
+    }
     let start = std::time::Instant::now();
     let tr = simulate(&scene, &settings)?;
     let sec = start.elapsed().as_secs_f64();
@@ -366,13 +374,50 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let worst = tr.steps.iter().map(|s| s.iterations).max().unwrap_or(0);
     println!("sweeps {sweeps}, worst step {worst}");
     for (k, s) in tr.steps.iter().enumerate() {
-        if s.iterations > 300 || s.fallback {
+        if (s.iterations > 300 || s.fallback) && std::env::var("QUIET").is_err() {
             println!(
                 "step {k}: {} sweeps, error {:.2e}, fallback {}, {} contacts",
                 s.iterations, s.error, s.fallback, s.active
             );
         }
     }
+    if let Ok(upto) = std::env::var("CONTACTS") {
+        // the contacts of the first steps: id, gap, impulse, velocity
+        let upto: usize = upto.parse()?;
+        for c in tr.contacts.iter().filter(|c| c.step < upto) {
+            println!(
+                "k {} id {} gap {:.3e} closed {} r [{:.3e} {:.3e} {:.3e}] u [{:.2e} {:.2e} {:.2e}]",
+                c.step,
+                c.id,
+                c.gap,
+                c.closed,
+                c.impulse[0],
+                c.impulse[1],
+                c.impulse[2],
+                c.velocity[0],
+                c.velocity[1],
+                c.velocity[2]
+            );
+        }
+    }
+    let fallbacks = tr.steps.iter().filter(|s| s.fallback).count();
+    // the largest displacement of a body's position from its start (spatial bodies: 7
+    // coordinates each, position first), and the first step where it exceeds 1e-9
+    let mut drift: f64 = 0.0;
+    let mut first_over = None;
+    if tr.dim == 3 && tr.nq % 7 == 0 {
+        for (k, q) in tr.q.chunks_exact(tr.nq).enumerate() {
+            for (b, x) in q.chunks_exact(7).enumerate() {
+                for (c, xc) in x.iter().enumerate().take(3) {
+                    drift = drift.max((xc - tr.q[b * 7 + c]).abs());
+                }
+            }
+            if drift > 1e-9 && first_over.is_none() {
+                first_over = Some(k);
+            }
+        }
+    }
+    println!("{fallbacks} fallbacks; drift {drift:.3e} m (over 1e-9 from step {first_over:?})");
     let unsolved = tr
         .steps
         .iter()

@@ -31,6 +31,11 @@
 //! impulses change by the same step every sweep (a drift along a null direction of W on the
 //! contacts' current faces), the iterate moves along that step to the first contact that
 //! changes case, where the sweeps would have taken it ([`extrapolate`]).
+//!
+//! Optionally ([`NsgsSettings::sticking`]), when the error decreases slowly the exact answer
+//! on the contacts' current cases is tried: the least-norm impulses that stop the sticking
+//! contacts, by one sparse Cholesky factor ([`stick`]); on boxes resting face on face, whose
+//! four coplanar points make W singular, it ends the slow sweeps at once.
 
 mod closed;
 mod disk;
@@ -39,6 +44,7 @@ mod local;
 mod rows;
 mod schedule;
 mod slide;
+mod stick;
 
 pub use local::LOCAL_ITERS;
 
@@ -65,6 +71,10 @@ pub struct NsgsSettings {
     pub initial: Option<Vec<f64>>,
     /// the order in which a sweep visits the contacts.
     pub order: ContactOrder,
+    /// when the sweeps slow down, also try the exact solve on the contacts' current cases
+    /// (the sticking-set solve of redundant face contacts, see the module notes); off by
+    /// default.
+    pub sticking: bool,
 }
 
 /// The order of the contacts in an NSGS sweep. Gauss-Seidel's result depends on it: a
@@ -91,6 +101,7 @@ impl Default for NsgsSettings {
             relaxation: 1.0,
             initial: None,
             order: ContactOrder::Forward,
+            sticking: false,
         }
     }
 }
@@ -332,6 +343,9 @@ pub fn solve_nsgs(problem: &ContactProblem<'_>, s: &NsgsSettings) -> Result<Cont
     let mut measures = measure_into(problem, &r, &mut u);
     let mut schedule = CheckSchedule::new(s.tol, measures.scaled_error);
     let mut extrapolation = extrapolate::Extrapolation::new(n);
+    let mut stick = stick::StickSolve::default();
+    // the last measured sweep and error, for the sticking-set solve's slowness test
+    let mut last = (0usize, measures.scaled_error);
     let mut sweeps = 0;
     // whether `measures` are those of the current r
     let mut current = true;
@@ -350,6 +364,13 @@ pub fn solve_nsgs(problem: &ContactProblem<'_>, s: &NsgsSettings) -> Result<Cont
             if !measures.passes(s.tol) {
                 extrapolation.try_after_measure(problem, &mut r, &mut u, &mut measures, sweeps);
             }
+            if s.sticking
+                && !measures.passes(s.tol)
+                && stick::due(&stick, sweeps, last, measures.scaled_error)
+            {
+                stick.try_at(problem, &mut r, &mut u, &mut measures, sweeps, s.tol);
+            }
+            last = (sweeps, measures.scaled_error);
             if !measures.passes(s.tol) {
                 schedule.measured(sweeps, measures.scaled_error, change);
             }

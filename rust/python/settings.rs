@@ -160,6 +160,7 @@ pub(super) fn nsgs(
         relaxation,
         initial,
         order,
+        sticking: false,
     }
 }
 

@@ -52,6 +52,7 @@ pub(super) fn nsgs_sweeps(
         relaxation: 1.0,
         initial: Some(r.to_vec()),
         order: ContactOrder::Forward,
+        sticking: false,
     };
     let out = solve_nsgs(problem, &sweep)?;
     Ok(out
@@ -72,6 +73,7 @@ pub(super) fn exact_sweep(problem: &ContactProblem<'_>, r: &mut [f64], tol: f64)
         relaxation: 1.0,
         initial: None,
         order: ContactOrder::Forward,
+        sticking: false,
     };
     for i in 0..problem.nc {
         let o = i * dim;
