@@ -49,7 +49,8 @@ impl JointSystem {
                 // alone): a chord step, converging as fast to the rounding level
                 let same = isl.rows.len() == isl.n_eq && isl.moved.len() == isl.n_eq;
                 if !same {
-                    std::mem::swap(&mut isl.rows, &mut isl.moved);
+                    isl.rows.clear();
+                    isl.rows.extend_from_slice(&isl.moved);
                     isl.factor_rows(&self.slot_of, |b| frozen[b].minv);
                 }
                 isl.rhs.clear();
