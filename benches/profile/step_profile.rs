@@ -9,11 +9,14 @@
 //! cargo run --release --example step_profile -- pile-declared 100 1000
 //! cargo run --release --example step_profile -- tower 10 2000
 //! valgrind --tool=callgrind target/release/examples/step_profile box-pile 125 100
+//! valgrind --tool=callgrind target/release/examples/step_profile chain 20 1000
 //! ```
 //!
 //! `tower N` stacks N cubes of 0.2 m on the floor (box pairs declared), `box-pile N` drops N
 //! cubes of 0.1 m into a box of five half-spaces (box pairs by the broad phase), as in
-//! benches/peer_step.py.
+//! benches/peer_step.py. `chain N` hangs N rods of 5 cm (10 g) end to end by revolute joints
+//! about y, the first to the world at the origin, released horizontal (benches/peer_step.py's
+//! chain against MuJoCo's joint chain).
 //!
 //! NSGS's sweep order, relaxation and sweep limit can be changed for experiments through the
 //! environment: `ORDER=symmetric|backward|forward`, `RELAX=1.3`, `MAXIT=100`; `STICK=1` turns on
@@ -22,7 +25,8 @@
 //! are printed.
 use coulomb::geometry::Shape3;
 use coulomb::step::{
-    simulate, Body, BodyKind, HalfSpace, Pair, Scene, Shape, Solid, SolidShape, StepSettings,
+    simulate, simulate_joints, Body, BodyKind, HalfSpace, Joint, JointKind, Pair, Scene, Shape,
+    Solid, SolidShape, StepSettings,
 };
 
 const G: f64 = 9.81;
@@ -310,6 +314,35 @@ fn box_pile(count: usize) -> Result<Scene, Box<dyn std::error::Error>> {
     Ok(scene)
 }
 
+/// `links` rods (10 g, 5 cm, radius 5 mm) hinged end to end about y, the first to the world.
+fn chain(links: usize) -> (Scene, Vec<Joint>) {
+    let (m, length, radius) = (0.01, 0.05, 0.005);
+    let mut scene = empty_scene();
+    let mut joints = Vec::new();
+    for k in 0..links {
+        let side = m * (3.0 * radius * radius + length * length) / 12.0;
+        let ax = m * radius * radius / 2.0;
+        scene.bodies.push(Body {
+            kind: BodyKind::Spatial,
+            mass: m,
+            inertia: vec![ax, 0.0, 0.0, 0.0, side, 0.0, 0.0, 0.0, side],
+            q0: vec![(k as f64 + 0.5) * length, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0],
+            v0: vec![0.0; 6],
+            force: vec![0.0; 3],
+        });
+        joints.push(Joint {
+            kind: JointKind::Revolute,
+            a: k,
+            b: k.checked_sub(1),
+            anchor: vec![k as f64 * length, 0.0, 0.0],
+            axis: vec![0.0, 1.0, 0.0],
+            limits: None,
+            e: 0.0,
+        });
+    }
+    (scene, joints)
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
     let which = args.get(1).map_or("ramp", |s| s.as_str());
@@ -334,9 +367,22 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "pile-declared" => (pile(arg(2, 100), true), arg(3, 1000)),
         "tower" => (tower(arg(2, 10))?, arg(3, 2000)),
         "box-pile" => (box_pile(arg(2, 125))?, arg(3, 1000)),
+        "chain" => {
+            let (scene, joints) = chain(arg(2, 20));
+            let settings = StepSettings::new(1e-3, arg(3, 1000));
+            let start = std::time::Instant::now();
+            let tr = simulate_joints(&scene, &joints, &settings, 1)?;
+            let sec = start.elapsed().as_secs_f64();
+            println!(
+                "{} steps in {sec:.3} s, {:.1} us per step",
+                tr.steps.len(),
+                1e6 * sec / tr.steps.len() as f64
+            );
+            return Ok(());
+        }
         other => {
             return Err(format!(
-                "unknown scene {other:?}: ramp, resting, impact, pile, pile-declared, tower or box-pile"
+                "unknown scene {other:?}: ramp, resting, impact, pile, pile-declared, tower, box-pile or chain"
             )
             .into())
         }

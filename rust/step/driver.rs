@@ -83,11 +83,14 @@ pub(super) fn step<D: Driver>(d: &mut D, contacts: &mut Vec<ContactRecord>) -> R
     }
     let nc = d.active_len();
     let mut record = Stepper::blank_record(nc);
-    let mut v_next = d.start_velocities();
     if nc > 0 && free {
         d.free_answer(&mut record);
     } else if nc > 0 {
         d.solve(&mut record)?;
+    }
+    // after the solve: a scene's solve may have projected `v_free` again (module `settle`)
+    let mut v_next = d.start_velocities();
+    if nc > 0 && !free {
         d.apply(&mut v_next);
     }
     record.resumed |= d.constrain(&mut v_next);
@@ -238,7 +241,8 @@ impl Driver for Stepper {
         self.free_of_contacts(record);
     }
     fn solve(&mut self, record: &mut StepRecord) -> Result<()> {
-        self.solve_contacts(record)
+        self.solve_contacts(record)?;
+        self.settle(record)
     }
     fn start_velocities(&mut self) -> Vec<f64> {
         start_velocities(&mut self.v_next, &self.v_free, &mut self.gp)
@@ -268,7 +272,7 @@ impl Driver for Stepper {
         advance_clock(&mut self.v, &mut self.v_next, v_next, k, t, h);
         self.integrate_positions();
         if let Some(js) = self.joints.as_mut() {
-            js.project_positions(&self.bodies, &mut self.q);
+            js.project_positions(&self.bodies, &self.frozen, &mut self.q);
         }
     }
     fn project(&mut self, e_start: f64) -> Result<f64> {

@@ -93,6 +93,7 @@ impl Stepper {
         self.q1.clear();
         self.q1.resize(n, 0.0);
         self.mu.clear();
+        self.curvature.clear();
         self.poisson_impact = false;
         for i in 0..nc {
             // by reference: an active contact carries its G and M^{-1} G columns
@@ -108,7 +109,12 @@ impl Stepper {
                 }
             }
             // the gap's second-order remainder over the step on v_free (module `narrow`)
-            let curvature = self.gap_curvature(c, &self.geo_cache[c], &self.v_free);
+            let mut curvature = self.gap_curvature(c, &self.geo_cache[c], &self.v_free);
+            if self.trial_terms {
+                curvature = curvature.min(self.gap_curvature(c, &self.geo_cache[c], &self.v_trial));
+            }
+            self.curvature
+                .push(curvature_term(curvature, self.settings.h));
             contact_term(
                 &self.settings,
                 &mut self.active[i],

@@ -27,6 +27,8 @@ mod narrow;
 mod persistence;
 #[path = "record.rs"]
 mod record;
+#[path = "settle.rs"]
+mod settle;
 #[path = "solid_pairs.rs"]
 mod solid_pairs;
 #[path = "solve.rs"]
@@ -138,6 +140,16 @@ pub struct Stepper {
     geo_cache: Vec<Geometry>,
     speed_bounds: Vec<[f64; 2]>,
     qc: Vec<f64>,
+    /// each active contact's curvature term in `qc` (module `curvature`).
+    curvature: Vec<f64>,
+    /// the step's velocity from the current impulses (module `settle`), and whether the
+    /// search also reads it.
+    v_trial: Vec<f64>,
+    trial_search: bool,
+    /// the active contacts before the search ran again (module `settle`).
+    active_kept: Vec<Active>,
+    /// whether the contact terms also take the curvature on `v_trial` (module `settle`).
+    trial_terms: bool,
     q1: Vec<f64>,
     mu: Vec<f64>,
     /// whether this step's Poisson impact phase has work.
@@ -210,6 +222,11 @@ impl Stepper {
             geo_cache: Vec::new(),
             speed_bounds: vec![[0.0; 2]; scene.bodies.len()],
             qc: Vec::new(),
+            curvature: Vec::new(),
+            v_trial: Vec::new(),
+            trial_search: false,
+            active_kept: Vec::new(),
+            trial_terms: false,
             q1: Vec::new(),
             mu: Vec::new(),
             poisson_impact: false,
@@ -263,19 +280,9 @@ impl Stepper {
         // a bound on each body's point speeds (v_k and v_free): a candidate farther than
         // 2 h times its bound cannot close within the step, whatever its normal
         for (bi, b) in self.bodies.iter().enumerate() {
-            let mut sb = [0.0f64; 2];
-            for v in [&self.v, &self.v_free] {
-                let vb = &v[b.off_v..b.off_v + b.nv];
-                let norm = |x: &[f64]| x.iter().map(|y| y * y).sum::<f64>().sqrt();
-                let (lin, ang) = match b.kind {
-                    BodyKind::Particle => (norm(vb), 0.0),
-                    BodyKind::Planar => (norm(&vb[..2]), vb[2].abs()),
-                    BodyKind::Spatial => (norm(&vb[..3]), norm(&vb[3..6])),
-                };
-                sb[0] = sb[0].max(lin);
-                sb[1] = sb[1].max(ang);
-            }
-            self.speed_bounds[bi] = sb;
+            let [l0, a0] = settle::speed_bound(b, &self.v);
+            let [l1, a1] = settle::speed_bound(b, &self.v_free);
+            self.speed_bounds[bi] = [l0.max(l1), a0.max(a1)];
         }
         self.save_solid_state();
         if self.auto.is_some() {
@@ -343,10 +350,13 @@ impl Stepper {
             let (vn_k, vn_free) = if far {
                 (0.0, 0.0)
             } else {
-                (
-                    self.normal_velocity(geo, &self.v),
-                    self.normal_velocity(geo, &self.v_free),
-                )
+                let vn_free = self.normal_velocity(geo, &self.v_free);
+                let vn_trial = if self.trial_search {
+                    self.normal_velocity(geo, &self.v_trial)
+                } else {
+                    vn_free
+                };
+                (self.normal_velocity(geo, &self.v), vn_free.min(vn_trial))
             };
             let verdict = driver::search_verdict(&self.settings, geo.gap, vn_k, vn_free, pending);
             let (false, Some(closed)) = (far, verdict) else {

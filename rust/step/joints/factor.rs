@@ -1,93 +1,126 @@
-//! The rank-revealing factorization of a joint island's `A = J M^{-1} J^T`: Cholesky with
-//! full diagonal pivoting after equilibration to a unit diagonal (Higham, "Accuracy and
-//! Stability of Numerical Algorithms", 2002, ch. 10.3).
+//! The rank-revealing factorization of a joint island's `A = J M^{-1} J^T`: Cholesky in the
+//! envelope of A (Jennings' profile storage: row i holds its columns from the first row it
+//! couples to), after equilibration to a unit diagonal (Higham, "Accuracy and Stability of
+//! Numerical Algorithms", 2002, ch. 10), skipping the rows that depend on the earlier ones.
+//!
+//! Two rows of A couple only when they act on a common body, so the rows of a chain or a
+//! tree, taken joint by joint along it, have a narrow envelope: the factorization costs
+//! `O(m w^2)` for m rows of envelope width w (a chain's w is two joints' rows), not `O(m^3)`.
+//! Cholesky fills nothing outside the envelope (George and Liu, "Computer Solution of Large
+//! Sparse Positive Definite Systems", 1981, ch. 4).
 //!
 //! A closed loop (a four-bar linkage, a body held by two hinges on one axis) gives rows of J
-//! that depend on the others: A is then only positive semidefinite. Pivoting stops at the
-//! first remaining pivot below [`RANK_TOL`] of the equilibrated diagonal (1): the rows kept
-//! span J's row space to that tolerance, the others are dropped (their impulse is 0). Since
-//! `λ^T A λ = |M^{-1/2} J^T λ|^2`, A's null space is that of `J^T`, so for a right-hand side
-//! in A's range every solution gives the same `J^T λ`: the velocity correction is unique
-//! whatever rows are dropped, only the split of the impulse among redundant rows is not
-//! (an indeterminate reaction, as in statics).
+//! that depend on the others: A is then only positive semidefinite. A row whose pivot (the
+//! remaining diagonal of the equilibrated A, 1 for a row independent of the earlier ones) is
+//! below [`RANK_TOL`] is dropped: it depends on the kept rows to within `sqrt(RANK_TOL)` in
+//! angle, and its impulse is 0. Since `λ^T A λ = |M^{-1/2} J^T λ|^2`, A's null space is that
+//! of `J^T`, so for a right-hand side in A's range every solution gives the same `J^T λ`:
+//! the velocity correction is unique whatever rows are dropped, only the split of the
+//! impulse among redundant rows is not (an indeterminate reaction, as in statics).
 
-/// a remaining pivot below this (A scaled to a unit diagonal) ends the factorization: the
-/// rows left depend on the kept ones to within `sqrt(RANK_TOL)` (1e-5) in angle.
+/// a pivot below this (A scaled to a unit diagonal) drops its row: the row depends on the
+/// kept ones to within `sqrt(RANK_TOL)` (1e-5) in angle.
 pub(super) const RANK_TOL: f64 = 1e-10;
 
-/// The factored `A`, kept from step to step (no allocation once its size was seen).
+/// The factored `A` in envelope storage, kept from step to step (no allocation once its
+/// size was seen).
 #[derive(Clone, Debug, Default)]
 pub(super) struct Factor {
     m: usize,
-    /// the lower Cholesky factor of the pivoted, equilibrated A (`m x m`, row-major; the
-    /// leading `rank x rank` block is used).
+    /// row i's first column in the envelope.
+    first: Vec<usize>,
+    /// row i's entries `first[i]..=i` start at `start[i]` in `l`.
+    start: Vec<usize>,
+    /// A's lower triangle in the envelope, then its lower Cholesky factor (equilibrated).
     l: Vec<f64>,
-    /// `perm[k]` is the row of A at pivot position k.
-    perm: Vec<usize>,
     /// the equilibration `1 / sqrt(A_ii)` (0 for a zero row).
     scale: Vec<f64>,
+    /// whether row i was kept (its pivot above [`RANK_TOL`]).
+    kept: Vec<bool>,
     rank: usize,
     work: Vec<f64>,
 }
 
 impl Factor {
-    /// factors the symmetric positive semidefinite `a` (`m x m`, row-major; overwritten).
-    pub(super) fn factor(&mut self, a: &mut [f64], m: usize) {
-        self.m = m;
+    /// a zero A of `first.len()` rows, row i's envelope starting at column `first[i]`
+    /// (`first[i] <= i`); fill it with [`Self::add`], then [`Self::factor`].
+    pub(super) fn shape(&mut self, first: impl Iterator<Item = usize>) {
+        self.first.clear();
+        self.start.clear();
+        let mut len = 0;
+        for (i, f) in first.enumerate() {
+            let f = f.min(i);
+            self.first.push(f);
+            self.start.push(len);
+            len += i + 1 - f;
+        }
+        self.m = self.first.len();
+        self.l.clear();
+        self.l.resize(len, 0.0);
+    }
+
+    /// `A_ij += x` for `first[i] <= j <= i`.
+    #[inline]
+    pub(super) fn add(&mut self, i: usize, j: usize, x: f64) {
+        debug_assert!(j <= i && j >= self.first[i]);
+        self.l[self.start[i] + j - self.first[i]] += x;
+    }
+
+    /// row i's envelope `first[i]..=i` as a slice of `l`.
+    fn row(&self, i: usize) -> &[f64] {
+        &self.l[self.start[i]..self.start[i] + i + 1 - self.first[i]]
+    }
+
+    /// factors the symmetric positive semidefinite A filled in (in place).
+    pub(super) fn factor(&mut self) {
+        let m = self.m;
         self.scale.clear();
-        self.scale.extend((0..m).map(|i| {
-            let d = a[i * m + i];
-            if d > 0.0 && d.is_finite() {
+        for i in 0..m {
+            let d = self.l[self.start[i] + i - self.first[i]];
+            self.scale.push(if d > 0.0 && d.is_finite() {
                 1.0 / d.sqrt()
             } else {
                 0.0
-            }
-        }));
+            });
+        }
         for i in 0..m {
-            for j in 0..m {
-                a[i * m + j] *= self.scale[i] * self.scale[j];
+            let (f, s) = (self.first[i], self.start[i]);
+            for j in f..=i {
+                self.l[s + j - f] *= self.scale[i] * self.scale[j];
             }
         }
-        self.perm.clear();
-        self.perm.extend(0..m);
+        self.kept.clear();
+        self.kept.resize(m, false);
         let mut rank = 0;
-        for k in 0..m {
-            // the largest remaining diagonal entry
-            let mut p = k;
-            for i in k + 1..m {
-                if a[i * m + i] > a[p * m + p] {
-                    p = i;
+        for i in 0..m {
+            let (fi, si) = (self.first[i], self.start[i]);
+            for j in fi..i {
+                let at = si + j - fi;
+                if !self.kept[j] {
+                    self.l[at] = 0.0;
+                    continue;
                 }
+                // L_ij = (A_ij - Σ_k L_ik L_jk) / L_jj over the envelopes' overlap
+                let (fj, sj) = (self.first[j], self.start[j]);
+                let k0 = fi.max(fj);
+                let ri = &self.l[si + k0 - fi..at];
+                let rj = &self.l[sj + k0 - fj..sj + j - fj];
+                let dot: f64 = ri.iter().zip(rj).map(|(x, y)| x * y).sum();
+                let djj = self.l[sj + j - fj];
+                self.l[at] = (self.l[at] - dot) / djj;
             }
-            if a[p * m + p].is_nan() || a[p * m + p] <= RANK_TOL {
-                break;
+            let at = si + i - fi;
+            let sq: f64 = self.l[si..at].iter().map(|x| x * x).sum();
+            let d = self.l[at] - sq;
+            if d > RANK_TOL {
+                self.l[at] = d.sqrt();
+                self.kept[i] = true;
+                rank += 1;
+            } else {
+                self.l[at] = 0.0;
             }
-            if p != k {
-                self.perm.swap(k, p);
-                for c in 0..m {
-                    a.swap(k * m + c, p * m + c);
-                }
-                for r in 0..m {
-                    a.swap(r * m + k, r * m + p);
-                }
-            }
-            let d = a[k * m + k].sqrt();
-            a[k * m + k] = d;
-            for i in k + 1..m {
-                a[i * m + k] /= d;
-            }
-            // the whole trailing block (kept symmetric for the next pivots' swaps)
-            for i in k + 1..m {
-                let lik = a[i * m + k];
-                for j in k + 1..m {
-                    a[i * m + j] -= lik * a[j * m + k];
-                }
-            }
-            rank = k + 1;
         }
         self.rank = rank;
-        self.l.clear();
-        self.l.extend_from_slice(&a[..m * m]);
     }
 
     /// the number of independent rows found.
@@ -98,30 +131,38 @@ impl Factor {
     /// `x` with `A x = b` on the kept rows (0 on the dropped ones): the exact solution when b
     /// lies in A's range.
     pub(super) fn solve(&mut self, b: &[f64], x: &mut [f64]) {
-        let (m, r) = (self.m, self.rank);
-        self.work.clear();
-        self.work
-            .extend(self.perm.iter().map(|&i| b[i] * self.scale[i]));
-        let y = &mut self.work;
-        for k in 0..r {
-            let mut s = y[k];
-            for j in 0..k {
-                s -= self.l[k * m + j] * y[j];
+        let m = self.m;
+        let mut y = std::mem::take(&mut self.work);
+        y.clear();
+        y.extend(b[..m].iter().zip(&self.scale).map(|(b, s)| b * s));
+        // L y' = y
+        for i in 0..m {
+            if !self.kept[i] {
+                y[i] = 0.0;
+                continue;
             }
-            y[k] = s / self.l[k * m + k];
+            let row = self.row(i);
+            let f = self.first[i];
+            let dot: f64 = row[..i - f].iter().zip(&y[f..i]).map(|(l, y)| l * y).sum();
+            y[i] = (y[i] - dot) / row[i - f];
         }
-        for k in (0..r).rev() {
-            let mut s = y[k];
-            for j in k + 1..r {
-                s -= self.l[j * m + k] * y[j];
+        // L^T x' = y' (by columns of L^T, i.e. rows of L)
+        for i in (0..m).rev() {
+            if !self.kept[i] {
+                y[i] = 0.0;
+                continue;
             }
-            y[k] = s / self.l[k * m + k];
+            let (f, s) = (self.first[i], self.start[i]);
+            let xi = y[i] / self.l[s + i - f];
+            y[i] = xi;
+            for (yk, l) in y[f..i].iter_mut().zip(&self.l[s..s + i - f]) {
+                *yk -= l * xi;
+            }
         }
-        x[..m].fill(0.0);
-        for k in 0..r {
-            let i = self.perm[k];
-            x[i] = y[k] * self.scale[i];
+        for i in 0..m {
+            x[i] = y[i] * self.scale[i];
         }
+        self.work = y;
     }
 }
 
@@ -140,6 +181,35 @@ mod tests {
         a
     }
 
+    /// the factor of dense `a` with row i's envelope from `first[i]` (entries outside must
+    /// be 0).
+    fn factored(a: &[f64], first: &[usize]) -> Factor {
+        let m = first.len();
+        let mut f = Factor::default();
+        f.shape(first.iter().copied());
+        for i in 0..m {
+            for j in first[i]..=i {
+                f.add(i, j, a[i * m + j]);
+            }
+        }
+        f.factor();
+        f
+    }
+
+    fn check_solves(a: &[f64], f: &mut Factor, b: &[f64]) {
+        let m = b.len();
+        let mut x = vec![0.0; m];
+        f.solve(b, &mut x);
+        for r in 0..m {
+            let ax: f64 = (0..m).map(|c| a[r * m + c] * x[c]).sum();
+            assert!(
+                (ax - b[r]).abs() < 1e-9 * b[r].abs().max(1.0),
+                "{ax} vs {}",
+                b[r]
+            );
+        }
+    }
+
     #[test]
     fn a_full_rank_system_is_solved_exactly() {
         let j = vec![
@@ -148,20 +218,9 @@ mod tests {
             vec![3.0, 0.0, 0.1],
         ];
         let a = gram(&j);
-        let mut f = Factor::default();
-        f.factor(&mut a.clone(), 3);
+        let mut f = factored(&a, &[0, 0, 0]);
         assert_eq!(f.rank(), 3);
-        let b = [1.0, -2.0, 0.5];
-        let mut x = [0.0; 3];
-        f.solve(&b, &mut x);
-        for r in 0..3 {
-            let ax: f64 = (0..3).map(|c| a[r * 3 + c] * x[c]).sum();
-            assert!(
-                (ax - b[r]).abs() < 1e-9 * (1.0 + b[r].abs()),
-                "{ax} vs {}",
-                b[r]
-            );
-        }
+        check_solves(&a, &mut f, &[1.0, -2.0, 0.5]);
     }
 
     #[test]
@@ -174,23 +233,45 @@ mod tests {
             vec![2.0, 1.0, 0.0, 4.0],
         ];
         let a = gram(&j);
-        let mut f = Factor::default();
-        f.factor(&mut a.clone(), 4);
+        let mut f = factored(&a, &[0, 0, 0, 0]);
         assert_eq!(f.rank(), 2);
         // b = A y for some y lies in the range
         let y = [0.3, -1.0, 2.0, 0.7];
         let b: Vec<f64> = (0..4)
             .map(|r| (0..4).map(|c| a[r * 4 + c] * y[c]).sum())
             .collect();
-        let mut x = [0.0; 4];
-        f.solve(&b, &mut x);
-        for r in 0..4 {
-            let ax: f64 = (0..4).map(|c| a[r * 4 + c] * x[c]).sum();
-            assert!(
-                (ax - b[r]).abs() < 1e-9 * b[r].abs().max(1.0),
-                "{ax} vs {}",
-                b[r]
-            );
+        check_solves(&a, &mut f, &b);
+    }
+
+    #[test]
+    fn a_banded_system_is_solved_in_its_envelope() {
+        // a chain's rows: row r acts on unknowns r and r + 1, so A is tridiagonal; the last
+        // row closes a loop on unknowns 0 and 6 (its envelope reaches back to row 0)
+        let n = 7;
+        let mut j: Vec<Vec<f64>> = (0..n - 1)
+            .map(|r| {
+                let mut row = vec![0.0; n];
+                row[r] = 1.0 + r as f64;
+                row[r + 1] = -0.5;
+                row
+            })
+            .collect();
+        let mut last = vec![0.0; n];
+        last[0] = 1.0;
+        last[n - 1] = 2.0;
+        j.push(last);
+        let a = gram(&j);
+        let m = j.len();
+        let mut first: Vec<usize> = (0..m).map(|r| r.saturating_sub(1)).collect();
+        first[m - 1] = 0;
+        for r in 0..m {
+            for c in 0..first[r] {
+                assert_eq!(a[r * m + c], 0.0);
+            }
         }
+        let mut f = factored(&a, &first);
+        assert_eq!(f.rank(), m);
+        let b: Vec<f64> = (0..m).map(|r| (r as f64 - 2.5) * 0.3).collect();
+        check_solves(&a, &mut f, &b);
     }
 }

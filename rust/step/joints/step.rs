@@ -3,6 +3,8 @@
 //! `-B^T A^+ B` for W, the projection after the contact impulses and the limits' impact
 //! memory, and the position projection after the positions (see the parent module).
 
+#[path = "island.rs"]
+mod island;
 #[path = "position.rs"]
 mod position;
 
@@ -10,7 +12,7 @@ use super::factor::Factor;
 use super::rows::{Frame, JointData, Row, WORLD};
 use crate::contact::assembly::WAssembly;
 use crate::step::stepper::bodies::{displace_body, BodyInfo, Frozen};
-use crate::step::stepper::{dot6, row6, Active};
+use crate::step::stepper::{dot6, Active};
 
 /// A limit's condition this step.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -52,11 +54,16 @@ struct Island {
     target: Vec<f64>,
     n_eq: usize,
     active: Vec<usize>,
-    /// the equality rows' targets: their second-order remainder over the step.
+    /// the equality rows' targets: their second-order remainder over the step, and the
+    /// previous ones (scratch).
     eq_target: Vec<f64>,
+    prev_target: Vec<f64>,
     /// the equality rows at `q ⊕ h u` (scratch).
     moved: Vec<Row>,
-    a: Vec<f64>,
+    /// the rows acting on each body (by slot in `bodies`, module `island`) and a cursor.
+    body_start: Vec<usize>,
+    body_fill: Vec<usize>,
+    body_rows: Vec<usize>,
     factor: Factor,
     rhs: Vec<f64>,
     lam: Vec<f64>,
@@ -65,6 +72,8 @@ struct Island {
     /// the active contacts touching the island (increasing), `B = J M^{-1} G` and
     /// `Y = A^+ B` per contact (`rows x 3` each, row-major).
     contacts: Vec<usize>,
+    /// the position projection's displacement per body slot (6 each, scratch).
+    shift: Vec<f64>,
     bmat: Vec<f64>,
     ymat: Vec<f64>,
     col: Vec<f64>,
@@ -90,8 +99,9 @@ pub(in crate::step::stepper) struct JointSystem {
     data: Vec<JointData>,
     limits: Vec<Limit>,
     islands: Vec<Island>,
-    /// per body, its island or `usize::MAX`.
+    /// per body, its island or `usize::MAX`, and its place in the island's `bodies`.
     island_of: Vec<usize>,
+    slot_of: Vec<usize>,
     /// whether the position projection runs after each step.
     pub(in crate::step::stepper) projection: bool,
     /// `q ⊕ h u` (scratch).
@@ -104,100 +114,6 @@ fn root(parent: &mut [usize], mut i: usize) -> usize {
         i = parent[i];
     }
     i
-}
-
-/// `M^{-1} x` for a body's zero-padded column.
-fn mul6(minv: &[f64; 36], x: &[f64; 6]) -> [f64; 6] {
-    std::array::from_fn(|a| dot6(&row6(minv, a), x))
-}
-
-/// `x . v` over the body's velocities.
-fn dot_body(x: &[f64; 6], v: &[f64], b: &BodyInfo) -> f64 {
-    (0..b.nv).map(|k| x[k] * v[b.off_v + k]).sum()
-}
-
-impl Island {
-    /// `M^{-1} J^T` per row, A, and its factor.
-    fn factor_rows(&mut self, minv: impl Fn(usize) -> [f64; 36]) {
-        for r in &mut self.rows {
-            r.mja = mul6(&minv(r.a), &r.ja);
-            r.mjb = if r.b == WORLD {
-                [0.0; 6]
-            } else {
-                mul6(&minv(r.b), &r.jb)
-            };
-        }
-        let m = self.rows.len();
-        self.a.clear();
-        self.a.resize(m * m, 0.0);
-        for (i, r) in self.rows.iter().enumerate() {
-            for (j, s) in self.rows.iter().enumerate() {
-                let mut x = 0.0;
-                if r.a == s.a {
-                    x += dot6(&r.ja, &s.mja);
-                }
-                if r.a == s.b {
-                    x += dot6(&r.ja, &s.mjb);
-                }
-                if r.b != WORLD && r.b == s.a {
-                    x += dot6(&r.jb, &s.mja);
-                }
-                if r.b != WORLD && r.b == s.b {
-                    x += dot6(&r.jb, &s.mjb);
-                }
-                self.a[i * m + j] = x;
-            }
-        }
-        self.factor.factor(&mut self.a, m);
-    }
-
-    /// `J v` of row r.
-    fn rate(r: &Row, v: &[f64], bodies: &[BodyInfo]) -> f64 {
-        let mut s = dot_body(&r.ja, v, &bodies[r.a]);
-        if r.b != WORLD {
-            s += dot_body(&r.jb, v, &bodies[r.b]);
-        }
-        s
-    }
-
-    /// `v <- v + M^{-1} J^T λ` with `A λ = target - J v` (λ into `lam`), and `gp += J^T λ`.
-    fn project(&mut self, v: &mut [f64], bodies: &[BodyInfo], gp: Option<&mut [f64]>) {
-        let m = self.rows.len();
-        self.rhs.clear();
-        for (r, t) in self.rows.iter().zip(&self.target) {
-            self.rhs.push(t - Self::rate(r, v, bodies));
-        }
-        self.lam.clear();
-        self.lam.resize(m, 0.0);
-        self.factor.solve(&self.rhs, &mut self.lam);
-        apply(&self.rows, &self.lam, |r| (r.mja, r.mjb), v, bodies);
-        if let Some(gp) = gp {
-            apply(&self.rows, &self.lam, |r| (r.ja, r.jb), gp, bodies);
-        }
-    }
-}
-
-/// `out += Σ_r λ_r col(r)` on each row's bodies.
-fn apply(
-    rows: &[Row],
-    lam: &[f64],
-    col: impl Fn(&Row) -> ([f64; 6], [f64; 6]),
-    out: &mut [f64],
-    bodies: &[BodyInfo],
-) {
-    for (r, &l) in rows.iter().zip(lam) {
-        let (ca, cb) = col(r);
-        let b = &bodies[r.a];
-        for k in 0..b.nv {
-            out[b.off_v + k] += l * ca[k];
-        }
-        if r.b != WORLD {
-            let b = &bodies[r.b];
-            for k in 0..b.nv {
-                out[b.off_v + k] += l * cb[k];
-            }
-        }
-    }
 }
 
 impl JointSystem {
@@ -214,6 +130,7 @@ impl JointSystem {
             }
         }
         let mut island_of = vec![usize::MAX; nbodies];
+        let mut slot_of = vec![usize::MAX; nbodies];
         let mut islands: Vec<Island> = Vec::new();
         for b in 0..nbodies {
             if !jointed[b] {
@@ -225,6 +142,7 @@ impl JointSystem {
                 islands.push(Island::default());
             }
             island_of[b] = island_of[r];
+            slot_of[b] = islands[island_of[b]].bodies.len();
             islands[island_of[b]].bodies.push(b);
         }
         let mut limits = Vec::new();
@@ -257,6 +175,7 @@ impl JointSystem {
             limits,
             islands,
             island_of,
+            slot_of,
             projection: true,
             qs: Vec::new(),
         }
@@ -331,7 +250,7 @@ impl JointSystem {
             isl.eq_target.clear();
             isl.eq_target.resize(isl.n_eq, 0.0);
             isl.active.clear();
-            isl.factor_rows(|b| frozen[b].minv);
+            isl.factor_rows(&self.slot_of, |b| frozen[b].minv);
         }
         // each row's second-order remainder over the step on v_k: the targets
         // `-(C(q ⊕ h v_k) - C(q) - h J v_k) / h` (on v_k, not on the joint-only velocity:
@@ -420,7 +339,7 @@ impl JointSystem {
         for &l in &isl.active {
             isl.rows.push(self.limits[l].row);
         }
-        isl.factor_rows(|b| frozen[b].minv);
+        isl.factor_rows(&self.slot_of, |b| frozen[b].minv);
         self.reproject(isl, bodies, v_free);
     }
 
@@ -608,6 +527,47 @@ impl JointSystem {
         }
         self.islands = islands;
         resumed
+    }
+
+    /// the equality rows' targets again on the step's velocity `vel` (the remainders of
+    /// [`Self::free_velocity`], there on `v_k`): where one moves the joint by more than `tol`
+    /// over the step, the island's `v_free'` is projected again with them; true when one did.
+    #[allow(clippy::too_many_arguments)]
+    pub(in crate::step::stepper) fn retarget(
+        &mut self,
+        bodies: &[BodyInfo],
+        q: &[f64],
+        vel: &[f64],
+        v_free: &mut [f64],
+        h: f64,
+        tol: f64,
+    ) -> bool {
+        let mut islands = std::mem::take(&mut self.islands);
+        let mut changed = false;
+        self.qs.clear();
+        self.qs.extend_from_slice(q);
+        for isl in &mut islands {
+            isl.prev_target.clone_from(&isl.eq_target);
+            self.remainders(isl, bodies, q, vel, h);
+            let moved = (isl.eq_target.iter().zip(&isl.prev_target))
+                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            if moved * h > tol {
+                changed = true;
+                self.reproject(isl, bodies, v_free);
+            } else {
+                isl.eq_target.clone_from(&isl.prev_target);
+            }
+        }
+        self.islands = islands;
+        changed
+    }
+
+    /// `v` projected on every island's rows with the step's targets (a trial velocity; the
+    /// impulses and the limits' memory are left as they are).
+    pub(in crate::step::stepper) fn project_trial(&mut self, bodies: &[BodyInfo], v: &mut [f64]) {
+        for isl in &mut self.islands {
+            isl.project(v, bodies, None);
+        }
     }
 
     /// each island's size and rank at the last factorization.

@@ -1,0 +1,178 @@
+//! The step's predictions checked on the velocity the step will have.
+//!
+//! Two parts of a step's problem are built on `v_free` before the impulses are known: which
+//! contacts can close within the step (the search, Stewart 2000) and each contact's gap
+//! curvature term `min(c, 0) / h`, `c = g(q_k ⊕ h v) - g(q_k) - h J_n v` (module `law`).
+//! Where the impulses move a body that `v_free` leaves alone, both can be wrong: a contact's
+//! impulse carried along a chain by its joints (or through a stack by the contacts) swings a
+//! link down onto the floor at a speed neither `v_k` nor `v_free` shows, so its contact is
+//! left out and the link passes into the floor within the step; and a rod end struck at
+//! angle θ, turning at ω after the impact, sinks by about `(l/2) sin θ (h ω)^2 / 2` with the
+//! curvature taken on `v_free`. Without a drift correction the depth stays.
+//!
+//! The joints' rows carry the same kind of term (their second-order remainder, module
+//! `joints`), taken on `v_k`: at an impact a link's turn over the step differs from it by
+//! O(1), the joint opens by `O(h^2 ω^2 l)` and the position projection that closes it again
+//! moves the link, floor or not.
+//!
+//! So after the solve, `v_{k+1} = v_free + P G P` (the joints' projection included) is formed
+//! and the step's predictions checked on it (a fixed point on the step's own velocity, as
+//! for the nonlinear gap of Moreau's time-stepping, Acary and Brogliato 2008, sec. 10.1):
+//! when a joint's remainder on `v_{k+1}` moves it by more than the gap tolerance its target
+//! is replaced and `v_free'` projected again, and when a body moves faster than the search
+//! assumed the search runs again with `v_{k+1}` among its velocities; if either changed the
+//! problem, it is built (each curvature term the lower of those on `v_free` and `v_{k+1}`)
+//! and solved again; then
+//! each active contact's curvature term is evaluated on `v_{k+1}`, and where it would let the
+//! contact sink by more than the gap tolerance the term is lowered to it and the problem is
+//! solved again. Contacts only join and terms only fall, at most [`SETTLE_PASSES`] times.
+
+use super::bodies::BodyInfo;
+use super::law::{contact_solve, curvature_term, ContactSolve};
+use super::{BodyKind, Restitution, StepRecord, Stepper};
+use crate::error::Result;
+
+/// the solves again at most after the first (each adds a contact or lowers a term).
+pub(super) const SETTLE_PASSES: usize = 4;
+
+/// a bound on body b's point speeds in v: its linear and angular speeds.
+pub(super) fn speed_bound(b: &BodyInfo, v: &[f64]) -> [f64; 2] {
+    let vb = &v[b.off_v..b.off_v + b.nv];
+    let norm = |x: &[f64]| x.iter().map(|y| y * y).sum::<f64>().sqrt();
+    match b.kind {
+        BodyKind::Particle => [norm(vb), 0.0],
+        BodyKind::Planar => [norm(&vb[..2]), vb[2].abs()],
+        BodyKind::Spatial => [norm(&vb[..3]), norm(&vb[3..6])],
+    }
+}
+
+impl Stepper {
+    /// `v_free + M^{-1} G P` of the current impulses, projected on the joints' rows, into
+    /// `self.v_trial`.
+    fn trial_velocity(&mut self) {
+        let dim = self.dim;
+        let mut vt = std::mem::take(&mut self.v_trial);
+        vt.clear();
+        vt.extend_from_slice(&self.v_free);
+        for (i, a) in self.active.iter().enumerate() {
+            let p = &self.solve.impulse[i * dim..(i + 1) * dim];
+            for s in &a.sides[..a.nsides] {
+                let b = &self.bodies[s.body];
+                for k in 0..b.nv {
+                    let dv: f64 = (0..dim).map(|j| s.b[j][k] * p[j]).sum();
+                    vt[b.off_v + k] += dv;
+                }
+            }
+        }
+        if let Some(js) = self.joints.as_mut() {
+            js.project_trial(&self.bodies, &mut vt);
+        }
+        self.v_trial = vt;
+    }
+
+    /// the search again with `v_trial` among its velocities when some body moves faster in
+    /// it than the speed bounds assumed; true when a contact joined.
+    fn search_again(&mut self) -> bool {
+        let mut faster = false;
+        for (b, sb) in self.bodies.iter().zip(&mut self.speed_bounds) {
+            let [lin, ang] = speed_bound(b, &self.v_trial);
+            if lin > sb[0] || ang > sb[1] {
+                faster = true;
+                sb[0] = sb[0].max(lin);
+                sb[1] = sb[1].max(ang);
+            }
+        }
+        if !faster {
+            return false;
+        }
+        // the search only widens: with as many contacts it found the same ones, which keep
+        // the terms the solve gave them
+        self.active_kept.clone_from(&self.active);
+        self.trial_search = true;
+        self.search_contacts();
+        self.trial_search = false;
+        if self.active.len() > self.active_kept.len() {
+            return true;
+        }
+        std::mem::swap(&mut self.active, &mut self.active_kept);
+        false
+    }
+
+    /// each active contact's curvature term on `v_trial`, lowered where it falls by more
+    /// than the gap tolerance over the step; true when one was.
+    fn lower_curvature(&mut self) -> bool {
+        let (dim, h, tol) = (self.dim, self.settings.h, self.settings.gap_tolerance);
+        let mut lowered = false;
+        for (i, a) in self.active.iter().enumerate() {
+            let c = a.cand;
+            let rem = self.gap_curvature(c, &self.geo_cache[c], &self.v_trial);
+            let term = curvature_term(rem, h);
+            if (self.curvature[i] - term) * h > tol {
+                self.qc[i * dim] += term - self.curvature[i];
+                self.curvature[i] = term;
+                lowered = true;
+            }
+        }
+        lowered
+    }
+
+    /// after the contact solve: the search and the curvature terms checked on the step's
+    /// velocity, and the problem solved again while a contact joins or a term falls (module
+    /// docs). Scenes with joints and Newton's restitution only (Poisson's impact phase keeps
+    /// its own terms; scenes without joints are not yet checked).
+    pub(super) fn settle(&mut self, record: &mut StepRecord) -> Result<()> {
+        if self.settings.restitution == Restitution::Poisson || self.joints.is_none() {
+            return Ok(());
+        }
+        let (h, tol) = (self.settings.h, self.settings.gap_tolerance);
+        for _ in 0..SETTLE_PASSES {
+            self.trial_velocity();
+            let retargeted = match self.joints.as_mut() {
+                Some(js) => js.retarget(
+                    &self.bodies,
+                    &self.q,
+                    &self.v_trial,
+                    &mut self.v_free,
+                    h,
+                    tol,
+                ),
+                None => false,
+            };
+            if self.search_again() || retargeted {
+                record.active = self.active.len();
+                self.trial_terms = true;
+                let solved = self.solve_contacts(record);
+                self.trial_terms = false;
+                solved?;
+                continue;
+            }
+            if !self.lower_curvature() {
+                break;
+            }
+            self.solve_again(record)?;
+        }
+        Ok(())
+    }
+
+    /// the contact solve again on the current W and terms.
+    fn solve_again(&mut self, record: &mut StepRecord) -> Result<()> {
+        let candidates = &self.candidates;
+        contact_solve(
+            &ContactSolve {
+                settings: &self.settings,
+                dim: self.dim,
+                active: &self.active,
+                state: &self.state,
+                law_of: &|c| (candidates[c].mu, candidates[c].e),
+                q1: &self.q1,
+                mu: &self.mu,
+                poisson_impact: self.poisson_impact,
+            },
+            &mut self.delassus,
+            &mut self.qc,
+            &mut self.work,
+            &mut self.solve,
+            record,
+        )
+    }
+}
