@@ -207,8 +207,9 @@ def solve_batch(
             n = q.shape[0]
             a = _as_array(r0, f"initial[{i}]", None)
             if a.shape not in ((n // dim, dim), (n,)):
+                got = "a scalar" if np.ndim(r0) == 0 else f"shape {a.shape}"
                 raise ShapeError(f"problem {i}: initial must have shape ({n // dim}, {dim}) or "
-                                 f"({n},), got {a.shape}")
+                                 f"({n},), got {got}")
             a = np.ascontiguousarray(a.reshape(n))
             if not np.isfinite(a).all():
                 raise NonFiniteError(f"problem {i}: initial contains NaN or infinity")

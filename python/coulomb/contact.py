@@ -304,7 +304,8 @@ def solve(
     if initial is not None:
         r0 = _as_array(initial, "initial", None)
         if r0.shape not in ((nc, dim), (n,)):
-            raise ShapeError(f"initial must have shape ({nc}, {dim}) or ({n},), got {r0.shape}")
+            got = "a scalar" if np.ndim(initial) == 0 else f"shape {r0.shape}"
+            raise ShapeError(f"initial must have shape ({nc}, {dim}) or ({n},), got {got}")
         init = np.ascontiguousarray(r0.reshape(n))
         if not np.isfinite(init).all():
             raise NonFiniteError("initial contains NaN or infinity")

@@ -146,7 +146,7 @@ CASES: list[tuple[str, Callable[[], object], type, tuple[str, ...]]] = [
      ("eta",)),
     ("contact eta with nsgs", lambda: contact.solve(W2, Q2, 0.2, dim=2, eta=0.1), E, ("eta",)),
     ("contact initial scalar", lambda: contact.solve(W2, Q2, 0.2, dim=2, initial=1.0), S,
-     ("initial",)),
+     ("initial", "got a scalar")),
     ("contact initial ragged", lambda: contact.solve(W2, Q2, 0.2, dim=2, initial=[[1], [1, 2]]),
      S, ("initial",)),
     ("contact order unknown", lambda: contact.solve(W2, Q2, 0.2, dim=2, order="sideways"), E,

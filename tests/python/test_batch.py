@@ -239,6 +239,8 @@ def test_contact_validation_names_the_problem():
         contact.solve_batch(list(Ws), [*list(qs[:3]), np.ones(5)], list(mus), 3)
     with pytest.raises(InvalidParameterError, match="dim"):
         contact.solve_batch(Ws, qs, 0.5, 4)
+    with pytest.raises(ShapeError, match=r"problem 1: initial .* got a scalar"):
+        contact.solve_batch(Ws, qs, 0.5, 3, initial=[None, 1.0] + [None] * (len(qs) - 2))
     with pytest.raises(InvalidParameterError, match="order"):
         contact.solve_batch(Ws, qs, 0.5, 3, order=[1, 0])
 
