@@ -21,6 +21,12 @@ impl Stepper {
     /// contact terms, then the shared solve ([`contact_solve`]).
     pub(super) fn solve_contacts(&mut self, record: &mut StepRecord) -> Result<()> {
         self.assemble(record);
+        self.solve_assembled(record)
+    }
+
+    /// The shared contact solve ([`contact_solve`]) on the W and contact terms already
+    /// assembled; the settle stage calls it again after it changes the terms.
+    pub(super) fn solve_assembled(&mut self, record: &mut StepRecord) -> Result<()> {
         let candidates = &self.candidates;
         contact_solve(
             &ContactSolve {

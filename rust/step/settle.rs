@@ -28,7 +28,7 @@
 //! solved again. Contacts only join and terms only fall, at most [`SETTLE_PASSES`] times.
 
 use super::bodies::BodyInfo;
-use super::law::{contact_solve, curvature_term, ContactSolve};
+use super::law::curvature_term;
 use super::{BodyKind, Restitution, StepRecord, Stepper};
 use crate::error::Result;
 
@@ -149,30 +149,8 @@ impl Stepper {
             if !self.lower_curvature() {
                 break;
             }
-            self.solve_again(record)?;
+            self.solve_assembled(record)?;
         }
         Ok(())
-    }
-
-    /// the contact solve again on the current W and terms.
-    fn solve_again(&mut self, record: &mut StepRecord) -> Result<()> {
-        let candidates = &self.candidates;
-        contact_solve(
-            &ContactSolve {
-                settings: &self.settings,
-                dim: self.dim,
-                active: &self.active,
-                state: &self.state,
-                law_of: &|c| (candidates[c].mu, candidates[c].e),
-                q1: &self.q1,
-                mu: &self.mu,
-                poisson_impact: self.poisson_impact,
-            },
-            &mut self.delassus,
-            &mut self.qc,
-            &mut self.work,
-            &mut self.solve,
-            record,
-        )
     }
 }
