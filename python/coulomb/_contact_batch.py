@@ -24,7 +24,8 @@ class ContactBatchResult(BatchResult[ContactResult]):
     """The answers of :func:`solve_batch`: one :class:`ContactResult` per problem (``r[i]``,
     iteration, slices), each equal entry by entry to what :func:`solve` returns for the
     problem alone, and the fields over the batch: ``success``, ``status``, ``message``,
-    ``iterations``, ``error``, ``error_q``, ``scaled_error``, ``min_normal_impulse``,
+    ``iterations``, ``error``, ``error_q``, ``error_q_floor``, ``scaled_error``,
+    ``min_normal_impulse``,
     ``max_complementarity``, ``cone_violation``, ``dissipation_violation``, ``solve_time``
     (one entry per problem) and ``impulse``, ``velocity`` (shape ``(B, nc, dim)`` when every
     problem has nc contacts, else a list of ``(nc_i, dim)`` arrays).
@@ -32,7 +33,8 @@ class ContactBatchResult(BatchResult[ContactResult]):
 
     _STATUS = ("solved", "iteration_limit", "numerical_failure")
     _VECTORS = ("impulse", "velocity")
-    _SCALARS = ("iterations", "error", "error_q", "scaled_error", "min_normal_impulse",
+    _SCALARS = ("iterations", "error", "error_q", "error_q_floor", "scaled_error",
+                "min_normal_impulse",
                 "max_complementarity", "cone_violation", "dissipation_violation", "solve_time")
 
     def __init__(self, columns: Mapping[str, Any], wall_time: float, dim: int,
@@ -55,6 +57,7 @@ class ContactBatchResult(BatchResult[ContactResult]):
             "iterations": int(c["iterations"][i]),
             "error": float(c["error"][i]),
             "error_q": float(c["error_q"][i]),
+            "error_q_floor": float(c["error_q_floor"][i]),
             "scaled_error": float(c["scaled_error"][i]),
             "min_normal_impulse": float(c["min_normal_impulse"][i]),
             "max_complementarity": float(c["max_complementarity"][i]),

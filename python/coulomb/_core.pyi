@@ -84,6 +84,7 @@ class _ContactSolveDict(TypedDict):
     iterations: int
     error: float
     error_q: float
+    error_q_floor: float
     scaled_error: float
     min_normal_impulse: float
     max_complementarity: float
@@ -132,6 +133,7 @@ class _ContactBatchDict(TypedDict):
     iterations: _I64
     error: _F64
     error_q: _F64
+    error_q_floor: _F64
     scaled_error: _F64
     min_normal_impulse: _F64
     max_complementarity: _F64
@@ -178,6 +180,8 @@ class _StepSimulateDict(TypedDict):
     status: list[_StepStatusName]
     error: _F64
     scaled_error: _F64
+    error_q: _F64
+    error_q_floor: _F64
     iterations: _I64
     momentum_residual: _F64
     min_normal_impulse: _F64

@@ -2,20 +2,19 @@
 
 The stepper hands its records out in chunks of at most ``chunk`` kept states; each chunk is
 appended to resizable datasets and dropped, so the memory of a run does not grow with its
-length. The file holds one dataset per array of :class:`~coulomb.trajectory.Trajectory`, by
-the same names (``t``, ``q``, ``v``, ``kinetic_energy``, ``potential_energy``, ``min_gap``,
+length. The file holds one dataset per array of :class:`~coulomb.trajectory.Trajectory`, by the
+same names (``t``, ``q``, ``v``, ``kinetic_energy``, ``potential_energy``, ``min_gap``,
 ``negative_gaps``, the step checks ``active``, ``status``, ``error``, ``scaled_error``,
-``iterations``, ``momentum_residual``, ``min_normal_impulse``, ``cone_violation``,
-``complementarity``, ``resumed``, ``fallback``, ``projection``, and the contact records
-``contact_step``, ``contact_id``, ``contact_impulse``, ``contact_velocity``,
+``error_q``, ``error_q_floor``, ``iterations``, ``momentum_residual``, ``min_normal_impulse``,
+``cone_violation``, ``complementarity``, ``resumed``, ``fallback``, ``projection``, and the
+contact records ``contact_step``, ``contact_id``, ``contact_impulse``, ``contact_velocity``,
 ``contact_approach``, ``contact_gap``, ``contact_closed``; ``status`` an HDF5 enum of the
 status names, :data:`STATUS_CODES`), and attributes ``format`` (``"coulomb-trajectory"``),
 ``version``, ``dim``, ``h``, ``solver``, ``tol``, ``gap_tolerance``, ``record_every``,
 ``stopped`` (empty when every step ran), ``solve_time``, ``complete`` (false until the run
 ended, so a file of a run cut short says so) and ``states``, ``steps``, ``contacts`` (the rows
-of the whole chunks written). The datasets are stored in chunks of about
-64 KiB, which keeps HDF5's own memory flat too (a variable-length string per status made it
-grow with the run).
+of the whole chunks written). The datasets are stored in chunks of about 64 KiB, which keeps
+HDF5's own memory flat too (a variable-length string per status made it grow with the run).
 :meth:`Trajectory.load <coulomb.trajectory.Trajectory.load>` reads it back.
 """
 
@@ -45,10 +44,10 @@ STATUS_CODES = {"no_contact": 0, "solved": 1, "iteration_limit": 2, "numerical_f
 #: the per-state, per-step and per-contact arrays, in the core's names.
 ARRAYS = (
     "t", "q", "v", "kinetic_energy", "potential_energy", "min_gap", "negative_gaps", "active",
-    "status", "error", "scaled_error", "iterations", "momentum_residual", "min_normal_impulse",
-    "cone_violation", "complementarity", "resumed", "fallback", "projection", "contact_step",
-    "contact_id", "contact_impulse", "contact_velocity", "contact_approach", "contact_gap",
-    "contact_closed",
+    "status", "error", "scaled_error", "error_q", "error_q_floor", "iterations",
+    "momentum_residual", "min_normal_impulse", "cone_violation", "complementarity", "resumed",
+    "fallback", "projection", "contact_step", "contact_id", "contact_impulse", "contact_velocity",
+    "contact_approach", "contact_gap", "contact_closed",
 )
 
 #: which row count of the file (its attributes ``states``, ``steps``, ``contacts``) each array

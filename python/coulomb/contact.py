@@ -71,8 +71,12 @@ built by :func:`assemble` and the velocity after the impulses given by :func:`po
 Every method runs on the problem rescaled by powers of two (exact) so that q and W's diagonal
 are of size one whatever the units, and every answer is measured on the original data
 (W, q, mu). **Success has one rule for every method** (except the 3D polygon, above):
-``success`` is True exactly when ``scaled_error <= tol``, and the iterative methods stop on
-that same test.
+``success`` is True exactly when ``scaled_error <= tol`` **and**
+``error_q <= max(tol, error_q_floor)``, and the iterative methods stop on that same test
+(measuring ``error_q`` in your units even while they work in rescaled ones). The first keeps a
+light body's contact from hiding behind heavy ones and does not depend on units; the second is
+the figure peers (Siconos, FCLib) stop on, so an answer coulomb calls solved is solved by
+theirs too, down to its rounding level ``error_q_floor``.
 
 ``scaled_error``
     The unit-consistent measure. Per contact, ``rho_i = 1 / W_nn,i`` (impulse per unit
@@ -89,10 +93,16 @@ that same test.
     ``s - f^2/s``), so a sticking contact with mu up to 1e12 solved to rounding is solved in
     every unit system instead of turning ``mu`` times its rounding into an error. Multiplying
     impulse units by a and velocity units by b (``W -> (b/a) W``, ``q -> b q``) leaves it unchanged,
-    and so ``success`` and ``status``; ``error`` and ``error_q`` add velocities to impulses and
-    change with the units, so they are reported, never used for the verdict (at W of order 1e-5 they
-    accepted answers of a problem without solution; at W of order 1e8 an exact answer may miss
-    ``error_q <= tol``).
+    and so this half of the verdict; ``error`` and ``error_q`` add velocities to impulses and
+    change with the units, so neither decides alone (at W of order 1e-5 they accepted answers
+    of a problem without solution; at W of order 1e8 an exact answer may miss
+    ``error_q <= tol``, which ``error_q_floor`` allows for).
+
+``error_q_floor``
+    The rounding level of ``error_q`` at this answer,
+    ``4 (n + 3) eps (||r|| + ||(1 + mu_i) (|W| |r| + |q|)_i||) / ||q||``: the map's argument is
+    formed from ``u``, whose rounding is ``(n + 3) eps`` times its terms (Higham 2002, sec. 3.1),
+    ``mu`` multiplying the tangential part. An ``error_q`` up to it counts as 0.
 
 ``error``
     The natural-map residual on De Saxcé's form (Acary and Brogliato 2008; De Saxcé and Feng 1991),
@@ -153,8 +163,8 @@ class ContactResult(Result):
     velocity : ndarray, shape (nc, dim)
         ``u = W r + q`` recomputed from the original data.
     success : bool
-        True exactly when ``scaled_error <= tol`` (for ``"lemke"`` in 3D: when the polyhedral
-        LCP was solved).
+        True exactly when ``scaled_error <= tol`` and ``error_q <= max(tol, error_q_floor)``
+        (for ``"lemke"`` in 3D: when the polyhedral LCP was solved).
     status : str
         ``"solved"``, ``"iteration_limit"`` (the budget was spent: ``max_iter`` sweeps, or
         every restart of ``"prox"`` stalled) or ``"numerical_failure"``.
@@ -166,9 +176,12 @@ class ContactResult(Result):
         The natural-map residual divided by ``max(||q||, ||r||, ||u||)`` (see the module
         documentation).
     error_q : float
-        The same residual divided by ``||q||``.
+        The same residual divided by ``||q||``: half of the verdict.
+    error_q_floor : float
+        The rounding level of ``error_q`` at this answer (see the module documentation).
     scaled_error : float
-        The unit-consistent measure the verdict is taken on (see the module documentation).
+        The unit-consistent measure, the other half of the verdict (see the module
+        documentation).
     min_normal_impulse, max_complementarity, cone_violation, dissipation_violation : float
         The separate checks (see the module documentation).
     solve_time : float
@@ -183,6 +196,7 @@ class ContactResult(Result):
     iterations: int
     error: float
     error_q: float
+    error_q_floor: float
     scaled_error: float
     min_normal_impulse: float
     max_complementarity: float

@@ -55,15 +55,21 @@ def _load_power(scene: Scene | None, v: np.ndarray) -> np.ndarray:
     return np.asarray(v @ f, dtype=np.float64)
 
 
+#: the tolerance of a step's error_q half when the solver's tol is tighter (Rust
+#: ``step::solve::STEP_ERROR_Q_TOL``).
+_STEP_ERROR_Q_TOL = 1e-9
+
+
 class TrajectoryCheckError(CoulombError, AssertionError):
     """A trajectory failed :meth:`Trajectory.check` with ``strict=True``."""
 
 
-#: the arrays the stepper records, by the name the core gives them (its ``status``, ``error``
-#: and ``scaled_error`` are a step's, renamed ``solver_*`` here).
+#: the arrays the stepper records, by the name the core gives them (its ``status``, ``error``,
+#: ``scaled_error``, ``error_q`` and ``error_q_floor`` are a step's, renamed ``solver_*`` here).
 _CORE_NAMES = frozenset({
     "dim", "t", "q", "v", "kinetic_energy", "potential_energy", "load_power", "min_gap",
-    "negative_gaps", "active", "status", "error", "scaled_error", "iterations",
+    "negative_gaps", "active", "status", "error", "scaled_error", "error_q", "error_q_floor",
+    "iterations",
     "momentum_residual", "min_normal_impulse", "cone_violation", "complementarity", "resumed",
     "fallback", "projection", "contact_step", "contact_id", "contact_impulse",
     "contact_velocity", "contact_approach", "contact_gap", "contact_closed", "stopped",
@@ -118,8 +124,13 @@ class Trajectory:
     solver_error : ndarray, shape (N,)
         The literature's natural-map residual of step k's contact solve.
     solver_scaled_error : ndarray, shape (N,)
-        The unit-consistent residual the verdict is taken on (see :mod:`coulomb.contact`):
-        a step is solved when it is at most ``tol``.
+        The unit-consistent residual, half of the verdict (see :mod:`coulomb.contact`): a
+        solved step has it at most ``tol``.
+    solver_error_q : ndarray, shape (N,)
+        The literature's residual relative to ``||q||``, the verdict's other half: a solved
+        step has it at most ``max(tol, 1e-9, solver_error_q_floor)``.
+    solver_error_q_floor : ndarray, shape (N,)
+        The rounding level of ``solver_error_q`` at the step's answer.
     iterations : ndarray of int, shape (N,)
         Sweeps, Newton steps or pivots of step k's solve.
     momentum_residual : ndarray, shape (N,)
@@ -204,6 +215,8 @@ class Trajectory:
         "solve_time",
         "solver",
         "solver_error",
+        "solver_error_q",
+        "solver_error_q_floor",
         "solver_scaled_error",
         "solver_status",
         "status",
@@ -231,6 +244,8 @@ class Trajectory:
     solver_status: NDArray[np.object_]
     solver_error: NDArray[np.float64]
     solver_scaled_error: NDArray[np.float64]
+    solver_error_q: NDArray[np.float64]
+    solver_error_q_floor: NDArray[np.float64]
     iterations: NDArray[np.int64]
     momentum_residual: NDArray[np.float64]
     min_normal_impulse: NDArray[np.float64]
@@ -294,6 +309,12 @@ class Trajectory:
         tr.solver_status = statuses
         tr.solver_error = np.asarray(raw["error"])
         tr.solver_scaled_error = np.asarray(raw["scaled_error"])
+        # files streamed before error_q joined the verdict have neither column
+        n_steps = len(tr.solver_scaled_error)
+        tr.solver_error_q = (np.asarray(raw["error_q"]) if "error_q" in raw
+                             else np.zeros(n_steps))
+        tr.solver_error_q_floor = (np.asarray(raw["error_q_floor"]) if "error_q_floor" in raw
+                                   else np.zeros(n_steps))
         failed = sum(count for name, count in counts.items()
                      if kinds[name] not in (Status.SOLVED, Status.NO_CONTACT))
         if tr.stopped is not None:
@@ -326,8 +347,10 @@ class Trajectory:
             if rows["states"] == 0:
                 raise ProblemFormatError(f"{str(path)!r} holds no states (its run stopped "
                                          "before the first chunk was written)")
+            # error_q and error_q_floor joined the file after its first version
             raw: dict[str, Any] = {name: f[name][:rows[_stream.ROWS[name]]]
-                                   for name in _stream.ARRAYS}
+                                   for name in _stream.ARRAYS
+                                   if name in f or name not in ("error_q", "error_q_floor")}
             names = {code: name for name, code in _stream.STATUS_CODES.items()}
             raw["status"] = [names[int(c)] for c in raw["status"]]
             raw["dim"] = int(a["dim"])
@@ -386,6 +409,7 @@ class Trajectory:
             "momentum_residual": mx(self.momentum_residual),
             "solver_error": mx(self.solver_error),
             "solver_scaled_error": mx(self.solver_scaled_error),
+            "solver_error_q": mx(self.solver_error_q),
             "cone_violation": mx(self.cone_violation),
             "complementarity": mx(self.complementarity),
             "energy_gain": float(np.max(self.energy_gain(), initial=0.0)),
@@ -437,7 +461,10 @@ class Trajectory:
         complementarity, sticking or sliding) is judged by the rule and the measure of the
         step's own verdict: the step's ``solver_scaled_error`` (the unit-consistent residual of
         :mod:`coulomb.contact`, relative to the step's impulses) at most the solver's ``tol``
-        (``max(tol, 1e-9)`` for a step decided by the Lemke fallback). The raw figures
+        (``max(tol, 1e-9)`` for a step decided by the Lemke fallback) and its
+        ``solver_error_q`` at most ``max(tol, 1e-9, solver_error_q_floor)`` (a step holds the
+        literature's half at 1e-9 when its ``tol`` is tighter: on a stack ``error_q`` divides by
+        a ``||q||`` far below the terms the bottom impulses cancel). The raw figures
         (``min_normal_impulse``, ``cone_violation``, ``complementarity``) are reported in
         absolute units and not judged again with another scale, so the check and the solver
         cannot disagree. For the polyhedral cone in 3D (``solver="lemke"``) the verdict is
@@ -486,6 +513,16 @@ class Trajectory:
                 k = int(wrong[0])
                 v.append(f"{len(wrong)} steps reported solved whose scaled_error exceeds tol "
                          f"(first: step {k}, {readable(se[k])} > {readable(tol[k])})")
+            eq, floor = self.solver_error_q, self.solver_error_q_floor
+            # a step's error_q half has the tolerance max(tol, 1e-9) (the core's
+            # STEP_ERROR_Q_TOL: error_q follows stacked contacts less closely than 1e-12)
+            allowed = np.maximum(np.maximum(tol, _STEP_ERROR_Q_TOL), floor)
+            wrong = np.flatnonzero(solved & ~(eq <= allowed))
+            if len(wrong):
+                k = int(wrong[0])
+                v.append(f"{len(wrong)} steps reported solved whose error_q exceeds "
+                         f"max(tol, error_q_floor) (first: step {k}, {readable(eq[k])} > "
+                         f"{readable(allowed[k])})")
         res = self.momentum_residual
         if np.any(res > momentum_tol):
             v.append(f"momentum residual up to {readable(res.max())} > {readable(momentum_tol)}")

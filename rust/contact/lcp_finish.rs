@@ -107,7 +107,9 @@ fn finish_on(
             .flat_map(|&i| [problem.q[2 * i], problem.q[2 * i + 1]])
             .collect();
         let mu: Vec<f64> = set.iter().map(|&i| problem.mu[i]).collect();
-        let sub = ContactProblem::new(2, &w, &q, &mu)?;
+        let mut sub = ContactProblem::new(2, &w, &q, &mu)?;
+        sub.literature_rho = problem.literature_rho;
+        sub.error_q_tol = problem.error_q_tol;
         let mut settings = PolyhedralSettings::for_dim(2);
         settings.lemke.tol = tol;
         // the LCP has 4 unknowns per frictional contact (r_n, beta+, beta-, lambda); Lemke

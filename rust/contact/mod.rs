@@ -76,6 +76,14 @@ pub struct ContactProblem<'a> {
     /// anisotropic friction: `(mu_1, mu_2)` per contact (`2 nc` entries, 3D only), or `None`
     /// for isotropic friction.
     pub mu_pair: Option<&'a [f64]>,
+    /// the units of the literature's measures (`error`, `error_q`): 1 for a problem as the
+    /// caller gave it; for a problem rescaled by [`normalize`] (`W' = 2^-w W`), `2^w`, so that
+    /// those measures are the ones of the caller's data (see [`measures`]).
+    pub(crate) literature_rho: f64,
+    /// the tolerance of the verdict's `error_q` half when it is not the solver's `tol`
+    /// (the stepper's, whose `tol` on the unit-consistent half is tighter than `error_q` can
+    /// follow on stacked contacts; see [`measures::ContactMeasures::passes`]).
+    pub(crate) error_q_tol: Option<f64>,
 }
 
 fn check_q_mu(dim: usize, q: &[f64], mu: &[f64]) -> Result<()> {
@@ -131,6 +139,8 @@ impl<'a> ContactProblem<'a> {
             q,
             mu,
             mu_pair: None,
+            literature_rho: 1.0,
+            error_q_tol: None,
         })
     }
 
@@ -151,6 +161,8 @@ impl<'a> ContactProblem<'a> {
             q,
             mu,
             mu_pair: None,
+            literature_rho: 1.0,
+            error_q_tol: None,
         })
     }
 

@@ -14,9 +14,11 @@
 //! against a fixed constant (pivot and case-split thresholds, norms that would underflow or
 //! overflow: at 1e-200 a squared entry is 0, at 1e300 it is infinite) behaves as for data of
 //! size one. A method that is already unit-covariant gives bitwise the answer it would give
-//! unscaled, times `2^(v - w)`. The measures and the verdict are then taken on the original
-//! data: if the answer, scaled back, leaves the range of f64 or no longer passes, the status
-//! says so.
+//! unscaled, times `2^(v - w)`, except that the literature's `error_q`, half of the verdict,
+//! is not unit-free: the rescaled problem carries `literature_rho = 2^w` so that the method
+//! measures it in the caller's units and stops on the caller's verdict. The measures and the
+//! verdict are then taken on the original data: if the answer, scaled back, leaves the range
+//! of f64 or no longer passes, the status says so.
 
 use super::measures::{measure_into, ImpulseScale};
 use super::polyhedral::{solve_polyhedral, PolyhedralSettings};
@@ -123,6 +125,10 @@ pub fn solve(problem: &ContactProblem<'_>, method: &Method) -> Result<ContactSol
     if let Some(p) = problem.mu_pair {
         scaled = scaled.with_anisotropic_friction(p)?;
     }
+    // the literature's measures in the caller's units, so the method stops on the caller's
+    // verdict: its map there is 2^(v - w) (r' - P(r' - 2^w u'))
+    scaled.literature_rho = ldexp(1.0, w);
+    scaled.error_q_tol = problem.error_q_tol;
     let scale_initial = |x: &Option<Vec<f64>>| {
         x.as_ref()
             .map(|r| r.iter().map(|&y| ldexp(y, ir)).collect::<Vec<f64>>())
@@ -148,11 +154,13 @@ pub fn solve(problem: &ContactProblem<'_>, method: &Method) -> Result<ContactSol
     if sol.status == ContactStatus::Solved && exact_rule && !sol.measures.passes(tol) {
         sol.status = ContactStatus::NumericalFailure;
         sol.message = format!(
-            "{}; but on the original data (scaled back by 2^{}) scaled_error is {} > tol \
-             {}: the answer is out of f64's range there",
+            "{}; but on the original data (scaled back by 2^{}) scaled_error is {} and \
+             error_q {} (floor {}) against tol {}: the answer is out of f64's range there",
             sol.message,
             -ir,
             Readable(sol.measures.scaled_error),
+            Readable(sol.measures.error_q),
+            Readable(sol.measures.error_q_floor),
             Readable(tol)
         );
     }

@@ -307,6 +307,8 @@ pub fn solve_nsgs(problem: &ContactProblem<'_>, s: &NsgsSettings) -> Result<Cont
         Some(tiles) => {
             let mut p = ContactProblem::with_block_sparse(tiles, problem.q, problem.mu)?;
             p.mu_pair = problem.mu_pair;
+            p.literature_rho = problem.literature_rho;
+            p.error_q_tol = problem.error_q_tol;
             tiled_problem = p;
             &tiled_problem
         }

@@ -231,14 +231,15 @@ pub(super) struct ContactColumns {
     velocity: Vec<f64>,
     status: Vec<u8>,
     iterations: Vec<i64>,
-    measures: [Vec<f64>; 7],
+    measures: [Vec<f64>; 8],
     time: Vec<f64>,
     messages: Text,
 }
 
-const CONTACT_MEASURES: [&str; 7] = [
+const CONTACT_MEASURES: [&str; 8] = [
     "error",
     "error_q",
+    "error_q_floor",
     "scaled_error",
     "min_normal_impulse",
     "max_complementarity",
@@ -274,6 +275,7 @@ impl ContactColumns {
         let values = [
             m.error,
             m.error_q,
+            m.error_q_floor,
             m.scaled_error,
             m.min_normal_impulse,
             m.max_complementarity,

@@ -42,6 +42,7 @@ fn contact_dict<'py>(
     let m = s.measures;
     d.set_item(intern!(py, "error"), m.error)?;
     d.set_item(intern!(py, "error_q"), m.error_q)?;
+    d.set_item(intern!(py, "error_q_floor"), m.error_q_floor)?;
     d.set_item(intern!(py, "scaled_error"), m.scaled_error)?;
     d.set_item(intern!(py, "min_normal_impulse"), m.min_normal_impulse)?;
     d.set_item(intern!(py, "max_complementarity"), m.max_complementarity)?;

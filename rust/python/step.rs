@@ -417,6 +417,11 @@ pub(super) fn trajectory_dict<'py>(
         "scaled_error",
         PyArray1::from_vec(py, col_f(|r| r.scaled_error)),
     )?;
+    d.set_item("error_q", PyArray1::from_vec(py, col_f(|r| r.error_q)))?;
+    d.set_item(
+        "error_q_floor",
+        PyArray1::from_vec(py, col_f(|r| r.error_q_floor)),
+    )?;
     d.set_item(
         "iterations",
         PyArray1::from_vec(

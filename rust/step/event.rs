@@ -40,7 +40,7 @@ use super::solve::SolveBuffers;
 use super::{
     frame, Active, ContactRecord, Geometry, Restitution, StepRecord, StepSettings, Stepper,
 };
-use crate::contact::{solve_nsgs, ContactProblem, NsgsSettings};
+use crate::contact::{solve_nsgs, ContactMeasures, ContactProblem, NsgsSettings};
 use crate::error::Result;
 
 /// samples of the path per step before bisection.
@@ -69,8 +69,8 @@ pub(super) struct Hit {
     pub(super) approach: f64,
     /// the contact velocity after the impact.
     pub(super) velocity: [f64; 3],
-    pub(super) error: f64,
-    pub(super) scaled_error: f64,
+    /// the impact solve's measures (all 0 for Poisson's law, solved in closed form).
+    pub(super) measures: ContactMeasures,
     pub(super) iterations: usize,
     /// the momentum balance `M dv = G P` at the impact, relative to `|G P|`.
     pub(super) residual: f64,
@@ -79,8 +79,8 @@ pub(super) struct Hit {
 /// The impulse of one contact's impact (W its `dim x dim` Delassus block row-major, u its
 /// contact velocity before), shared by the scenes' and the models' located steps: Newton's
 /// law `0 <= P_n ⊥ u_n^+ + e min(u_n^-, 0) >= 0` with Coulomb friction by NSGS on the single
-/// contact, or Poisson's by Routh's method (module `poisson`); with the solve's error, scaled
-/// error and iterations.
+/// contact, or Poisson's by Routh's method (module `poisson`); with the solve's measures and
+/// iterations.
 pub(super) fn impact_law(
     settings: &StepSettings,
     dim: usize,
@@ -88,7 +88,7 @@ pub(super) fn impact_law(
     u: [f64; 3],
     mu: f64,
     e: f64,
-) -> Result<([f64; 3], (f64, f64), usize)> {
+) -> Result<([f64; 3], ContactMeasures, usize)> {
     match settings.restitution {
         Restitution::Poisson => {
             let mut w3 = [[0.0; 3]; 3];
@@ -97,13 +97,25 @@ pub(super) fn impact_law(
                     w3[a][c] = w[a * dim + c];
                 }
             }
-            Ok((super::routh(dim, &w3, u, mu, e, 0.0), (0.0, 0.0), 0))
+            let exact = ContactMeasures {
+                error: 0.0,
+                error_q: 0.0,
+                error_q_floor: 0.0,
+                error_q_tol: None,
+                scaled_error: 0.0,
+                min_normal_impulse: 0.0,
+                max_complementarity: 0.0,
+                cone_violation: 0.0,
+                dissipation_violation: 0.0,
+            };
+            Ok((super::routh(dim, &w3, u, mu, e, 0.0), exact, 0))
         }
         Restitution::Newton => {
             let mut q = u;
             q[0] += e * u[0].min(0.0);
             let mu = [mu];
-            let problem = ContactProblem::new(dim, &w[..dim * dim], &q[..dim], &mu)?;
+            let mut problem = ContactProblem::new(dim, &w[..dim * dim], &q[..dim], &mu)?;
+            problem.error_q_tol = Some(super::solve::STEP_ERROR_Q_TOL);
             let nsgs = NsgsSettings {
                 tol: 1e-14,
                 max_iter: 100,
@@ -112,11 +124,7 @@ pub(super) fn impact_law(
             let sol = solve_nsgs(&problem, &nsgs)?;
             let mut p = [0.0; 3];
             p[..dim].copy_from_slice(&sol.impulse);
-            Ok((
-                p,
-                (sol.measures.error, sol.measures.scaled_error),
-                sol.iterations,
-            ))
+            Ok((p, sol.measures, sol.iterations))
         }
     }
 }
@@ -185,8 +193,10 @@ pub(super) fn located_record(settings: &StepSettings, hit: &Hit, mu: f64, e: f64
     };
     let mut record = Stepper::blank_record(1);
     record.status = Some(crate::contact::ContactStatus::Solved);
-    record.error = hit.error;
-    record.scaled_error = hit.scaled_error;
+    record.error = hit.measures.error;
+    record.scaled_error = hit.measures.scaled_error;
+    record.error_q = hit.measures.error_q;
+    record.error_q_floor = hit.measures.error_q_floor;
     record.iterations = hit.iterations;
     record.momentum_residual = hit.residual;
     record.min_normal_impulse = hit.impulse[0];
@@ -414,7 +424,7 @@ impl Locating for Stepper {
             }
         }
         let approach = u[0].min(0.0);
-        let (impulse, (error, scaled_error), iterations) =
+        let (impulse, measures, iterations) =
             impact_law(&self.settings, dim, &w, u, cand.mu, cand.e)?;
         // v+ = q'(s*) + M^{-1} G P, and the momentum balance M dv = G P at q(s*)
         let mut residual: f64 = 0.0;
@@ -449,8 +459,7 @@ impl Locating for Stepper {
             impulse,
             approach,
             velocity,
-            error,
-            scaled_error,
+            measures,
             iterations,
             residual: if scale > 0.0 {
                 residual / scale

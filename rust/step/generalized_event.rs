@@ -113,8 +113,7 @@ impl<S: GeneralizedSystem> Locating for GeneralizedStepper<S> {
             }
         }
         let approach = u[0].min(0.0);
-        let (impulse, (error, scaled_error), iterations) =
-            impact_law(&self.settings, dim, &w, u, mu, e)?;
+        let (impulse, measures, iterations) = impact_law(&self.settings, dim, &w, u, mu, e)?;
         // v+ = q'(s*) + M^{-1} J^T P, and the momentum balance M dv = J^T P at q(s*)
         let (mut residual, mut scale) = (0.0f64, 0.0f64);
         for k in 0..nv {
@@ -140,8 +139,7 @@ impl<S: GeneralizedSystem> Locating for GeneralizedStepper<S> {
             impulse,
             approach,
             velocity,
-            error,
-            scaled_error,
+            measures,
             iterations,
             residual: if scale > 0.0 {
                 residual / scale

@@ -413,6 +413,8 @@ pub(super) fn solve_phases(
     record.status = Some(out.status);
     record.error = out.measures.error;
     record.scaled_error = out.measures.scaled_error;
+    record.error_q = out.measures.error_q;
+    record.error_q_floor = out.measures.error_q_floor;
     record.iterations = out.iterations;
     record.min_normal_impulse = out.measures.min_normal_impulse;
     record.cone_violation = out.measures.cone_violation;
@@ -518,10 +520,11 @@ pub(super) fn poisson_phase(
             }
         })
         .collect();
-    let after = match problem.storage() {
+    let mut after = match problem.storage() {
         Delassus::Dense(w) => ContactProblem::new(dim, w, &uc, problem.mu)?,
         Delassus::BlockSparse(w) => ContactProblem::with_block_sparse(w, &uc, problem.mu)?,
     };
+    after.error_q_tol = problem.error_q_tol;
     let mut rest = vec![0.0; nc * dim];
     restitution_with_friction(&after, &normal, &mut rest);
     for ((p, c), r) in p_impact.iter_mut().zip(&solve.impulse).zip(&rest) {

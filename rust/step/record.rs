@@ -21,6 +21,11 @@ pub struct StepRecord {
     /// the contact solver's unit-consistent error, the measure its verdict (`status`) is
     /// taken on ([`crate::contact::ContactMeasures::passes`]); 0 without contacts.
     pub scaled_error: f64,
+    /// the contact solver's `error_q` (the literature's residual relative to `||q||`), the
+    /// verdict's other half: it must be at most `max(tol, error_q_floor)`; 0 without contacts.
+    pub error_q: f64,
+    /// the rounding level of `error_q` ([`crate::contact::ContactMeasures::error_q_floor`]).
+    pub error_q_floor: f64,
     /// the contact solver's sweeps or pivots.
     pub iterations: usize,
     /// `||M (v_{k+1} - v_free) - G P||` divided by `max(||G P||, ||M v_free||, ||M v_{k+1}||)`
@@ -447,6 +452,10 @@ impl StepRecord {
         self.active = self.active.max(earlier.active);
         self.error = self.error.max(earlier.error);
         self.scaled_error = self.scaled_error.max(earlier.scaled_error);
+        // both the largest: every folded step with error_q <= max(tol, its floor) keeps the
+        // fold within max(tol, the largest floor), and a step that failed keeps its status
+        self.error_q = self.error_q.max(earlier.error_q);
+        self.error_q_floor = self.error_q_floor.max(earlier.error_q_floor);
         self.iterations = self.iterations.max(earlier.iterations);
         self.momentum_residual = self.momentum_residual.max(earlier.momentum_residual);
         self.min_normal_impulse = self.min_normal_impulse.min(earlier.min_normal_impulse);
@@ -469,6 +478,8 @@ mod tests {
             status: Some(status),
             error: x,
             scaled_error: x,
+            error_q: x,
+            error_q_floor: x,
             iterations: 1,
             momentum_residual: x,
             min_normal_impulse: x,
@@ -490,6 +501,8 @@ mod tests {
             // steps shows the worst step's scaled error, not the last one's
             assert_eq!(rec.scaled_error, worst);
             assert_eq!(rec.error, worst);
+            assert_eq!(rec.error_q, worst);
+            assert_eq!(rec.error_q_floor, worst);
             assert_eq!(rec.momentum_residual, worst);
             assert_eq!(rec.cone_violation, worst);
             assert_eq!(rec.complementarity, worst);

@@ -304,6 +304,8 @@ impl Stepper {
             status: None,
             error: 0.0,
             scaled_error: 0.0,
+            error_q: 0.0,
+            error_q_floor: 0.0,
             iterations: 0,
             momentum_residual: 0.0,
             min_normal_impulse: 0.0,

@@ -96,8 +96,10 @@ def test_reported_error_matches_independent_residual(seed, dim):
         assert r.scaled_error == pytest.approx(
             contact_scaled_error(W, q, mu, dim, r.impulse), rel=1e-9, abs=1e-15
         )
-        # the one rule: success means the unit-consistent measure passes tol
-        assert r.success == (r.scaled_error <= 1e-10)
+        # the one rule: success means the unit-consistent measure passes tol and the
+        # literature's error_q passes max(tol, its rounding floor)
+        assert r.success == (r.scaled_error <= 1e-10
+                             and err_q <= max(1e-10, r.error_q_floor) * (1 + 1e-9))
     assert r.success, r.message
     # at the solution every contact pushes, stays in its cone and dissipates
     assert r.min_normal_impulse >= 0.0

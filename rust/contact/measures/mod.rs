@@ -4,12 +4,22 @@
 //!
 //! - `error`: De Saxce's natural map `||r - P_K(r - (u + mu ||u_t|| n))||` divided by
 //!   `max(||q||, ||r||, ||u||)`, and `error_q`: the same map divided by `||q||` (Acary et al.'s
-//!   FCLib figure). Both add a velocity to an impulse inside the projection, so their value, and
-//!   any verdict taken on them, changes when the units change: with `W -> (b/a) W`,
-//!   `q -> b q` (impulses `r -> a r`, velocities `u -> b u`) the map mixes `a r` with `b u`.
-//!   Scaling W by 1e-4 made them accept wrong answers; an answer of a problem with W of order
-//!   1e8 (light bodies) may be exact to rounding and still miss `error_q <= 1e-8`. They are
-//!   reported for comparison with peers, never used for the verdict.
+//!   FCLib figure). Both add a velocity to an impulse inside the projection, so their value
+//!   changes when the units change: with `W -> (b/a) W`, `q -> b q` (impulses `r -> a r`,
+//!   velocities `u -> b u`) the map mixes `a r` with `b u`. Alone, a verdict on them accepts
+//!   wrong answers (scaling W by 1e-4 did), so `error_q` is the second half of the verdict,
+//!   never all of it.
+//! - `error_q_floor`: the level `error_q` cannot go below at an answer exact to rounding. The
+//!   map's argument `r - (u + mu ||u_t|| n)` is formed from `u`, whose rounding is `(n + 3) eps`
+//!   times its terms `t = |W| |r| + |q|` (Higham 2002, sec. 3.1), with `mu` multiplying the
+//!   tangential part, and from `r`:
+//!
+//!   ```text
+//!   error_q_floor = 4 (n + 3) eps ( ||r|| + || (1 + mu_i) t_i ||_i ) / ||q||
+//!   ```
+//!
+//!   An answer of a problem with W of order 1e8 (light bodies) or a huge mu may be exact to
+//!   rounding and still miss `error_q <= 1e-8`; it passes the floor.
 //! - `scaled_error`, the verdict's measure. Per contact, `rho_i = 1 / W_nn,i` (impulse per
 //!   unit velocity: the normal impulse that cancels a unit normal velocity of contact i alone;
 //!   a contact whose `W_nn,i` is not positive, or below 1e-12 times the mean positive one, takes
@@ -49,9 +59,14 @@
 //!   invariant. A contact with `r_i = 0` and `t_i = 0` has `u_i = 0` exactly and counts 0.
 //!
 //! Success everywhere (NSGS, the robust mode, the exact 2D polyhedral LCP, each stepper step)
-//! means `scaled_error <= tol` ([`ContactMeasures::passes`]), the solvers stop on that same
-//! test, and the rule matches the LCP's (`crate::lcp`, whose verdict also needs its scale-free
-//! measure). Norms are accumulated with a running scale (LAPACK's `dnrm2` scheme), so data of
+//! means `scaled_error <= tol` **and** `error_q <= max(tol, error_q_floor)`
+//! ([`ContactMeasures::passes`]); the solvers stop on that same test, and the rule matches the
+//! LCP's (`crate::lcp`, whose verdict needs both its literature error and its scale-free
+//! measure). The unit-consistent measure keeps a light body's contact from hiding behind the
+//! heavy ones' impulses; `error_q` is the figure peers stop on (Siconos, FCLib), so an answer
+//! coulomb calls solved is solved by their measure too. A solver working in rescaled units
+//! ([`super::normalize`]) measures `error_q` in the caller's units (the problem's
+//! `literature_rho`), so it stops on the caller's verdict. Norms are accumulated with a running scale (LAPACK's `dnrm2` scheme), so data of
 //! size 1e-200 or 1e300 neither underflows to an error of 0 nor overflows to infinity.
 
 use super::projection::{project_cone, project_ellipse, tangent_norm};
@@ -62,9 +77,9 @@ use crate::error::{CoulombError, Result};
 ///
 /// The verdict (`success`, [`Self::passes`]) is `scaled_error <= tol`, the one measure here
 /// that is invariant when impulse units and velocity units are changed independently
-/// (`W -> (b/a) W`, `q -> b q`, `r -> a r`); `error` and `error_q` are the literature's
-/// figures, reported so that answers compare with peers (see the [module notes](self) for why
-/// they cannot decide success).
+/// (`W -> (b/a) W`, `q -> b q`, `r -> a r`), together with the literature's
+/// `error_q <= max(tol, error_q_floor)`; `error` is reported so that answers compare with
+/// peers (see the [module notes](self)).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ContactMeasures {
     /// the natural-map residual on De Saxce's form,
@@ -76,6 +91,13 @@ pub struct ContactMeasures {
     /// the same residual divided by `||q||` (by 1 when `||q|| < 1e-300`), as Acary et al.
     /// report it.
     pub error_q: f64,
+    /// the rounding level of `error_q` at this answer,
+    /// `4 (n + 3) eps (||r|| + ||(1 + mu_i) t_i||) / ||q||` with `t = |W| |r| + |q|` (see the
+    /// [module notes](self)): `error_q` up to this counts as 0.
+    pub error_q_floor: f64,
+    /// the tolerance of the `error_q` half when the problem sets its own (the stepper's
+    /// steps), `None` for the solver's `tol`.
+    pub error_q_tol: Option<f64>,
     /// the unit-consistent error that decides success: with `rho_i` the impulse per unit
     /// velocity of contact i taken from W (`1 / W_nn,i`), the worst contact's larger of De
     /// Saxce's natural map and Alart-Curnier's, both in impulse units, relative to the
@@ -94,10 +116,13 @@ pub struct ContactMeasures {
 }
 
 impl ContactMeasures {
-    /// The one success rule of every contact method: `scaled_error <= tol` (false for NaN).
+    /// The one success rule of every contact method: `scaled_error <= tol` and
+    /// `error_q <= max(tol, error_q_floor)` (false for NaN); where the problem sets its own
+    /// tolerance for the `error_q` half, the larger of the two is that half's.
     #[inline]
     pub fn passes(&self, tol: f64) -> bool {
-        self.scaled_error <= tol
+        let tol_q = self.error_q_tol.map_or(tol, |t| t.max(tol));
+        self.scaled_error <= tol && (self.error_q <= tol_q || self.error_q <= self.error_q_floor)
     }
 }
 
@@ -347,6 +372,9 @@ pub(crate) fn measure_into(
         1.0
     };
     let scales = ImpulseScale::of(problem, free);
+    let lr = problem.literature_rho;
+    // ||(1 + mu_i) t_i||, the terms of the literature map's argument (its rounding floor)
+    let mut tq = Norm2::default();
     let mut res = Norm2::default();
     let mut scaled: f64 = 0.0;
     let mut min_n = if problem.nc == 0 { 0.0 } else { f64::INFINITY };
@@ -370,7 +398,13 @@ pub(crate) fn measure_into(
             terms[k] += qi[k].abs();
         }
         let ui = &u[o..o + dim];
-        // the literature's map (velocities added to impulses as they are)
+        // the literature's map (velocities added to impulses as they are, in the caller's
+        // units: lr = 1 unless the problem was rescaled)
+        let mut lu = [0.0; 3];
+        for k in 0..dim {
+            lu[k] = lr * ui[k];
+            tq.add((1.0 + mu) * terms[k]);
+        }
         let (e1, viol) = match problem.anisotropy(i) {
             None => {
                 let c = mu * ri[0];
@@ -381,9 +415,9 @@ pub(crate) fn measure_into(
                 } else {
                     tangent_norm(&ri[1..]) - c
                 };
-                (de_saxce_residual(ri, ui, mu, 0.0), viol)
+                (de_saxce_residual(ri, &lu[..dim], mu, 0.0), viol)
             }
-            Some(pair) => anisotropic_residual(pair, ri, ui, 0.0),
+            Some(pair) => anisotropic_residual(pair, ri, &lu[..dim], 0.0),
         };
         res.add_all(&e1[..dim]);
         // the unit-consistent maps, relative to the contact's own impulse scale
@@ -414,12 +448,17 @@ pub(crate) fn measure_into(
         }
     }
     let res = res.value();
-    let denom = qnorm.max(rnorm).max(unorm);
+    // in the caller's units the map is res / lr, r is r / lr, u and q are as they are here
+    // (lr = 2^w is exact); with lr = 1 every figure is the one of the data as given
+    let denom = qnorm.max(rnorm / lr).max(unorm);
     let denom = if denom < TINY { 1.0 } else { denom };
     let denom_q = if qnorm < TINY { 1.0 } else { qnorm };
+    let floor = 4.0 * (problem.size() as f64 + 3.0) * f64::EPSILON * (rnorm / lr + tq.value());
     ContactMeasures {
-        error: res / denom,
-        error_q: res / denom_q,
+        error: res / lr / denom,
+        error_q: res / lr / denom_q,
+        error_q_floor: floor / denom_q,
+        error_q_tol: problem.error_q_tol,
         scaled_error: scaled,
         min_normal_impulse: min_n,
         max_complementarity: comp,

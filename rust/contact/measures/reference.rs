@@ -72,6 +72,9 @@ pub(crate) fn measure_reference(
         1.0
     };
     let scales = ImpulseScale::of(problem, free);
+    let lr = problem.literature_rho;
+    // ||(1 + mu_i) t_i||, the terms of the literature map's argument (its rounding floor)
+    let mut tq = Norm2::default();
     let mut res = Norm2::default();
     let mut scaled: f64 = 0.0;
     let mut min_n = if problem.nc == 0 { 0.0 } else { f64::INFINITY };
@@ -89,13 +92,19 @@ pub(crate) fn measure_reference(
             terms[k] += qi[k].abs();
         }
         let ui = &u[o..o + dim];
-        // the literature's map (velocities added to impulses as they are)
+        // the literature's map (velocities added to impulses as they are, in the caller's
+        // units)
+        let mut lu = [0.0; 3];
+        for k in 0..dim {
+            lu[k] = lr * ui[k];
+            tq.add((1.0 + mu) * terms[k]);
+        }
         let (e1, viol) = match problem.anisotropy(i) {
             None => (
-                de_saxce_residual(ri, ui, mu, 0.0),
+                de_saxce_residual(ri, &lu[..dim], mu, 0.0),
                 tangent_norm(&ri[1..]) - mu * ri[0],
             ),
-            Some(pair) => anisotropic_residual(pair, ri, ui, 0.0),
+            Some(pair) => anisotropic_residual(pair, ri, &lu[..dim], 0.0),
         };
         res.add_all(&e1[..dim]);
         // the unit-consistent maps, relative to the contact's own impulse scale
@@ -126,12 +135,17 @@ pub(crate) fn measure_reference(
         }
     }
     let res = res.value();
-    let denom = qnorm.max(rnorm).max(unorm);
+    // in the caller's units the map is res / lr, r is r / lr, u and q are as they are here
+    // (lr = 2^w is exact); with lr = 1 every figure is the one of the data as given
+    let denom = qnorm.max(rnorm / lr).max(unorm);
     let denom = if denom < TINY { 1.0 } else { denom };
     let denom_q = if qnorm < TINY { 1.0 } else { qnorm };
+    let floor = 4.0 * (problem.size() as f64 + 3.0) * f64::EPSILON * (rnorm / lr + tq.value());
     ContactMeasures {
-        error: res / denom,
-        error_q: res / denom_q,
+        error: res / lr / denom,
+        error_q: res / lr / denom_q,
+        error_q_floor: floor / denom_q,
+        error_q_tol: problem.error_q_tol,
         scaled_error: scaled,
         min_normal_impulse: min_n,
         max_complementarity: comp,

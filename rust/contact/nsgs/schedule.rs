@@ -19,7 +19,8 @@
 //!   stalls is measured a few times per hundred sweeps;
 //! - after the last sweep (`max_iter`, an interrupt, or a non-finite change).
 //!
-//! A solve therefore stops at the first measured sweep whose `scaled_error <= tol`: the same
+//! A solve therefore stops at the first measured sweep that passes the verdict's rule
+//! (`scaled_error <= tol` and `error_q <= max(tol, error_q_floor)`): the same
 //! honest verdict, possibly a few sweeps after the first sweep that would have passed.
 
 /// the first sweeps, each followed by a measure.

@@ -66,7 +66,8 @@
 //!
 //! The stopping test is the success rule of every contact method,
 //! [`super::ContactMeasures::passes`]: the unit-consistent `scaled_error <= tol` (default
-//! 1e-8; see [`super::measures`]); `error_q` and `error` are reported too.
+//! 1e-8; see [`super::measures`]) and the literature's `error_q <= max(tol, error_q_floor)`;
+//! `error` is reported too.
 
 mod jacobian;
 mod newton;
