@@ -100,9 +100,10 @@ theirs too, down to its rounding level ``error_q_floor``.
 
 ``error_q_floor``
     The rounding level of ``error_q`` at this answer,
-    ``4 (n + 3) eps (||r|| + ||(1 + mu_i) (|W| |r| + |q|)_i||) / ||q||``: the map's argument is
-    formed from ``u``, whose rounding is ``(n + 3) eps`` times its terms (Higham 2002, sec. 3.1),
-    ``mu`` multiplying the tangential part. An ``error_q`` up to it counts as 0.
+    ``eps (4 ||r|| + ||(1 + mu_i) (k_i + 2) (|W| |r| + |q|)_i||) / ||q||`` with ``k_i`` the
+    stored products of contact i's rows of ``W r``: the map's argument is formed from ``u``,
+    whose rounding is at most ``(k_i + 2) eps`` times its terms (Higham 2002, sec. 3.1), ``mu``
+    multiplying the tangential part. An ``error_q`` up to it counts as 0.
 
 ``error``
     The natural-map residual on De Saxcé's form (Acary and Brogliato 2008; De Saxcé and Feng 1991),

@@ -428,12 +428,21 @@ class Trajectory:
         ``h f . (v_{k+1} - v_k)`` when that is positive (the loads' share of a sticking or
         pivoting contact whose Jacobian turns with the step). A step that gives back a
         rebound (``resumed``) is judged across it and the step that closed the contact (the
-        landing step takes the approach energy, the rebound step returns it)."""
+        landing step takes the approach energy, the rebound step returns it); in a run of
+        such steps (a rebound step that lands another contact, or a resting contact whose gap
+        term pushes every other step) each is judged against the highest energy since the
+        run's landing step began, so a rebound already judged is not counted again as a gain
+        of the next step."""
         e, w = self.total_energy, 0.5 * self.h * self.load_power
         gain = np.diff(e) - np.abs(np.diff(w))
+        start = 0  # the state before the landing step of the current run of rebounds
         for k in np.flatnonzero(self.resumed):
-            if k >= 1:
-                gain[k] = e[k + 1] - e[k - 1] - abs(w[k + 1] - w[k - 1])
+            if k < 1:
+                continue
+            if not self.resumed[k - 1]:
+                start = k - 1
+            ref = int(start + np.argmax(e[start:k + 1]))
+            gain[k] = e[k + 1] - e[ref] - abs(w[k + 1] - w[ref])
         return gain
 
     def _energy_tolerance(self, energy_tol: float) -> float:

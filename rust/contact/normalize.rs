@@ -27,7 +27,6 @@ use super::{
     solve_nsgs, BlockCsr, ContactProblem, ContactSolution, ContactStatus, Delassus, NsgsSettings,
 };
 use crate::error::{CoulombError, Result};
-use crate::readable::Readable;
 
 /// Which contact method [`solve`] runs, with its settings.
 #[derive(Clone, Debug)]
@@ -154,14 +153,11 @@ pub fn solve(problem: &ContactProblem<'_>, method: &Method) -> Result<ContactSol
     if sol.status == ContactStatus::Solved && exact_rule && !sol.measures.passes(tol) {
         sol.status = ContactStatus::NumericalFailure;
         sol.message = format!(
-            "{}; but on the original data (scaled back by 2^{}) scaled_error is {} and \
-             error_q {} (floor {}) against tol {}: the answer is out of f64's range there",
+            "{}; but on the original data (scaled back by 2^{}) {}: the answer is out of \
+             f64's range there",
             sol.message,
             -ir,
-            Readable(sol.measures.scaled_error),
-            Readable(sol.measures.error_q),
-            Readable(sol.measures.error_q_floor),
-            Readable(tol)
+            sol.measures.shortfall(tol)
         );
     }
     Ok(sol)

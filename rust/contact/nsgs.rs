@@ -400,21 +400,19 @@ pub fn solve_nsgs(problem: &ContactProblem<'_>, s: &NsgsSettings) -> Result<Cont
         (
             ContactStatus::NumericalFailure,
             format!(
-                "contact {i} has no normal stiffness (W_nn = {} <= 0) and scaled_error stays \
-                 at {} > tol {} after {sweeps} sweeps",
+                "contact {i} has no normal stiffness (W_nn = {} <= 0) and the answer stays \
+                 at {} after {sweeps} sweeps",
                 Readable(blocks[i].a),
-                Readable(measures.scaled_error),
-                Readable(s.tol)
+                measures.shortfall(s.tol)
             ),
         )
     } else {
         (
             ContactStatus::IterationLimit,
             format!(
-                "stopped at max_iter = {} with scaled_error {} > tol {}",
+                "stopped at max_iter = {} with {}",
                 s.max_iter,
-                Readable(measures.scaled_error),
-                Readable(s.tol)
+                measures.shortfall(s.tol)
             ),
         )
     };

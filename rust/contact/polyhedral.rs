@@ -500,11 +500,10 @@ pub fn solve_polyhedral_lcp(
             ContactStatus::NumericalFailure,
             format!(
                 "{what} solved by Lemke in {} pivots (LCP error {}), but the impulses miss \
-                 the tolerance on the contact problem (scaled_error {} > tol {}){refused}",
+                 the tolerance on the contact problem ({}){refused}",
                 ls.pivots,
                 Readable(lm.error),
-                Readable(measures.scaled_error),
-                Readable(settings.lemke.tol)
+                measures.shortfall(settings.lemke.tol)
             ),
         ),
         LcpStatus::Solved => (

@@ -10,12 +10,15 @@
 //!   wrong answers (scaling W by 1e-4 did), so `error_q` is the second half of the verdict,
 //!   never all of it.
 //! - `error_q_floor`: the level `error_q` cannot go below at an answer exact to rounding. The
-//!   map's argument `r - (u + mu ||u_t|| n)` is formed from `u`, whose rounding is `(n + 3) eps`
-//!   times its terms `t = |W| |r| + |q|` (Higham 2002, sec. 3.1), with `mu` multiplying the
-//!   tangential part, and from `r`:
+//!   map's argument `r - (u + mu ||u_t|| n)` is formed from `u`, whose component i is a sum of
+//!   the `k_i` stored products of its row of `W r` and `q_i`: its rounding is at most
+//!   `(k_i + 2) eps` times its terms `t_i = (|W| |r| + |q|)_i` (Higham 2002, sec. 3.1, to first
+//!   order, with r's own rounding), `mu_i` multiplying the tangential part; the projection is
+//!   nonexpansive, and `r - P(.)` adds the rounding of r and of the projection's arithmetic
+//!   (a few units of `||r||`):
 //!
 //!   ```text
-//!   error_q_floor = 4 (n + 3) eps ( ||r|| + || (1 + mu_i) t_i ||_i ) / ||q||
+//!   error_q_floor = eps ( 4 ||r|| + || (1 + mu_i) (k_i + 2) t_i ||_i ) / ||q||
 //!   ```
 //!
 //!   An answer of a problem with W of order 1e8 (light bodies) or a huge mu may be exact to
@@ -72,6 +75,7 @@
 use super::projection::{project_cone, project_ellipse, tangent_norm};
 use super::{ContactProblem, Delassus};
 use crate::error::{CoulombError, Result};
+use crate::readable::Readable;
 
 /// How far impulses r are from solving the problem, from the original W, q, mu.
 ///
@@ -92,8 +96,9 @@ pub struct ContactMeasures {
     /// report it.
     pub error_q: f64,
     /// the rounding level of `error_q` at this answer,
-    /// `4 (n + 3) eps (||r|| + ||(1 + mu_i) t_i||) / ||q||` with `t = |W| |r| + |q|` (see the
-    /// [module notes](self)): `error_q` up to this counts as 0.
+    /// `eps (4 ||r|| + ||(1 + mu_i) (k_i + 2) t_i||) / ||q||` with `t = |W| |r| + |q|` and
+    /// `k_i` the stored products of contact i's rows (see the [module notes](self)): `error_q`
+    /// up to this counts as 0.
     pub error_q_floor: f64,
     /// the tolerance of the `error_q` half when the problem sets its own (the stepper's
     /// steps), `None` for the solver's `tol`.
@@ -123,6 +128,47 @@ impl ContactMeasures {
     pub fn passes(&self, tol: f64) -> bool {
         let tol_q = self.error_q_tol.map_or(tol, |t| t.max(tol));
         self.scaled_error <= tol && (self.error_q <= tol_q || self.error_q <= self.error_q_floor)
+    }
+
+    /// What keeps these measures from passing `tol`, for a status message: `"scaled_error a >
+    /// tol t"`, or, when that half passes, `"error_q b > max(tol t, floor f) (scaled_error a)"`
+    /// (displayed where it is written, without a string of its own).
+    pub fn shortfall(&self, tol: f64) -> Shortfall {
+        Shortfall {
+            measures: *self,
+            tol,
+        }
+    }
+}
+
+/// The half of the verdict that an answer misses ([`ContactMeasures::shortfall`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Shortfall {
+    measures: ContactMeasures,
+    tol: f64,
+}
+
+impl std::fmt::Display for Shortfall {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let (m, tol) = (&self.measures, self.tol);
+        if m.scaled_error <= tol {
+            let tol_q = m.error_q_tol.map_or(tol, |t| t.max(tol));
+            write!(
+                f,
+                "error_q {} > max(tol {}, floor {}) (scaled_error {})",
+                Readable(m.error_q),
+                Readable(tol_q),
+                Readable(m.error_q_floor),
+                Readable(m.scaled_error)
+            )
+        } else {
+            write!(
+                f,
+                "scaled_error {} > tol {}",
+                Readable(m.scaled_error),
+                Readable(tol)
+            )
+        }
     }
 }
 
@@ -345,6 +391,16 @@ pub(crate) fn rounding_floor(n: usize, terms: &[f64]) -> f64 {
     (n as f64 + 3.0) * f64::EPSILON * norm2(terms)
 }
 
+/// the number of stored products in contact i's rows of `W r`: every column of a dense W,
+/// `dim` per stored block of a block-sparse one.
+#[inline]
+pub(crate) fn term_count(problem: &ContactProblem<'_>, i: usize) -> usize {
+    match problem.storage() {
+        Delassus::Dense(_) => problem.size(),
+        Delassus::BlockSparse(s) => problem.dim * s.row_cols(i).len(),
+    }
+}
+
 /// The slip `s = ||u_t||` De Saxce's map counts when u_t is formed to within `floor`:
 /// 0 up to the floor, then `s - floor^2 / s`, continuous and increasing, and equal to s to
 /// rounding once s is well above the floor (so an exact answer still measures exactly 0).
@@ -373,7 +429,7 @@ pub(crate) fn measure_into(
     };
     let scales = ImpulseScale::of(problem, free);
     let lr = problem.literature_rho;
-    // ||(1 + mu_i) t_i||, the terms of the literature map's argument (its rounding floor)
+    // ||(1 + mu_i) (k_i + 2) t_i||, the rounding of the literature map's argument
     let mut tq = Norm2::default();
     let mut res = Norm2::default();
     let mut scaled: f64 = 0.0;
@@ -401,9 +457,12 @@ pub(crate) fn measure_into(
         // the literature's map (velocities added to impulses as they are, in the caller's
         // units: lr = 1 unless the problem was rescaled)
         let mut lu = [0.0; 3];
+        // u_i's rounding: (k + 2) eps of its terms for a sum of the row's k stored products, q
+        // and r's own rounding (Higham 2002, sec. 3.1), mu times it in the tangential part
+        let grow = (1.0 + mu) * (term_count(problem, i) as f64 + 2.0);
         for k in 0..dim {
             lu[k] = lr * ui[k];
-            tq.add((1.0 + mu) * terms[k]);
+            tq.add(grow * terms[k]);
         }
         let (e1, viol) = match problem.anisotropy(i) {
             None => {
@@ -453,7 +512,7 @@ pub(crate) fn measure_into(
     let denom = qnorm.max(rnorm / lr).max(unorm);
     let denom = if denom < TINY { 1.0 } else { denom };
     let denom_q = if qnorm < TINY { 1.0 } else { qnorm };
-    let floor = 4.0 * (problem.size() as f64 + 3.0) * f64::EPSILON * (rnorm / lr + tq.value());
+    let floor = f64::EPSILON * (4.0 * rnorm / lr + tq.value());
     ContactMeasures {
         error: res / lr / denom,
         error_q: res / lr / denom_q,

@@ -4,8 +4,8 @@
 use super::super::projection::{project_ellipse, tangent_norm};
 use super::super::ContactProblem;
 use super::{
-    anisotropic_residual, counted_slip, norm2, project_cone, rounding_floor, ContactMeasures,
-    ImpulseScale, Norm2, TINY,
+    anisotropic_residual, counted_slip, norm2, project_cone, rounding_floor, term_count,
+    ContactMeasures, ImpulseScale, Norm2, TINY,
 };
 
 /// The two natural maps of one contact in impulse units (see the module notes): De Saxce's
@@ -73,7 +73,7 @@ pub(crate) fn measure_reference(
     };
     let scales = ImpulseScale::of(problem, free);
     let lr = problem.literature_rho;
-    // ||(1 + mu_i) t_i||, the terms of the literature map's argument (its rounding floor)
+    // ||(1 + mu_i) (k_i + 2) t_i||, the rounding of the literature map's argument
     let mut tq = Norm2::default();
     let mut res = Norm2::default();
     let mut scaled: f64 = 0.0;
@@ -95,9 +95,12 @@ pub(crate) fn measure_reference(
         // the literature's map (velocities added to impulses as they are, in the caller's
         // units)
         let mut lu = [0.0; 3];
+        // u_i's rounding: (k + 2) eps of its terms for a sum of the row's k stored products, q
+        // and r's own rounding (Higham 2002, sec. 3.1), mu times it in the tangential part
+        let grow = (1.0 + mu) * (term_count(problem, i) as f64 + 2.0);
         for k in 0..dim {
             lu[k] = lr * ui[k];
-            tq.add((1.0 + mu) * terms[k]);
+            tq.add(grow * terms[k]);
         }
         let (e1, viol) = match problem.anisotropy(i) {
             None => (
@@ -140,7 +143,7 @@ pub(crate) fn measure_reference(
     let denom = qnorm.max(rnorm / lr).max(unorm);
     let denom = if denom < TINY { 1.0 } else { denom };
     let denom_q = if qnorm < TINY { 1.0 } else { qnorm };
-    let floor = 4.0 * (problem.size() as f64 + 3.0) * f64::EPSILON * (rnorm / lr + tq.value());
+    let floor = f64::EPSILON * (4.0 * rnorm / lr + tq.value());
     ContactMeasures {
         error: res / lr / denom,
         error_q: res / lr / denom_q,

@@ -177,20 +177,18 @@ impl Run {
                 format!(
                     "stalled after {iterations} Newton steps and {restarts} restarts: no step \
                      decreases the natural-map residual even with the proximal parameter at \
-                     {} (scaled_error {} > tol {})",
+                     {} ({})",
                     Readable(eta),
-                    Readable(measures.scaled_error),
-                    Readable(s.tol)
+                    measures.shortfall(s.tol)
                 ),
             )
         } else {
             (
                 ContactStatus::IterationLimit,
                 format!(
-                    "stopped at max_iter = {} with scaled_error {} > tol {}",
+                    "stopped at max_iter = {} with {}",
                     s.max_iter,
-                    Readable(measures.scaled_error),
-                    Readable(s.tol)
+                    measures.shortfall(s.tol)
                 ),
             )
         }
