@@ -267,3 +267,34 @@ def test_the_robust_mode_leaves_a_stall_that_nsgs_sweeps_cannot_leave_in_every_u
     r = solve(p, "prox")
     assert r.success, (ka, kb, r.message)
     assert law_violation(p.W, p.q, p.mu, 3, r.impulse) <= FALSE, r.message
+
+
+def _box_stack_3d(ratio: float, heavy_on_top: bool):
+    """A cube on a cube on the floor (Scene, 3D), one `ratio` times heavier than the other."""
+    from coulomb import Box, HalfSpace, RigidBody3D, Scene
+
+    sc = Scene(dim=3)
+    m_top, m_bottom = (ratio, 1.0) if heavy_on_top else (1.0, ratio)
+    a, c = 0.1, 0.05  # half-sides
+    bottom = sc.add(RigidBody3D(mass=m_bottom, inertia=m_bottom * 2 * a * a / 3 * np.eye(3),
+                                position=(0.0, 0.0, a)))
+    top = sc.add(RigidBody3D(mass=m_top, inertia=m_top * 2 * c * c / 3 * np.eye(3),
+                             position=(0.02, 0.01, 2 * a + c)))
+    sb, st_ = sc.attach(bottom, Box((a, a, a))), sc.attach(top, Box((c, c, c)))
+    sc.contact(sb, sc.add(HalfSpace((0, 0, 0), (0, 0, 1))), mu=0.5)
+    sc.contact(st_, sb, mu=0.5)
+    return sc
+
+
+def test_a_3d_stack_with_a_light_cube_on_a_1e6_kg_cube_is_solved_at_every_step():
+    # the light cube's contacts are judged at their own scale; every step solved and check()
+    # quiet. (The heavy cube on the light one is not: NSGS solves its steps to scaled_error
+    # 1.5e-14, but error_q, whose heavy impulses of 1e4 N s are divided by ||q|| ~ 1e-2 m/s,
+    # stays at 5.6e-8 against a rounding floor of 5.4e-8 and the step's 1e-9: honest
+    # iteration_limit statuses, which check() reports as well.)
+    tr = _box_stack_3d(1e6, False).simulate(0.5, 1e-3)
+    c = tr.check()
+    assert tr.success and c.ok, (tr.message, c.violations)
+    assert np.max(tr.solver_scaled_error) <= max(tr.tol, 1e-9)
+    assert np.all(tr.solver_error_q <= np.maximum(1e-9, tr.solver_error_q_floor))
+    assert float(np.min(tr.min_gap)) > -1e-9
