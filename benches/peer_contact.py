@@ -5,11 +5,11 @@ system Python has ``siconos.numerics`` (Debian ``python3-siconos``), in the same
 
 Every answer is judged the same way: ``error_q = ||F_nat(r)|| / ||q||`` recomputed here in
 numpy from the returned impulses (../shared/data/fclib/SOURCE.md, "Error measure"); a run
-succeeds when ``error_q <= tol``. Each solver stops on its own measure: coulomb's NSGS on
-``error`` (divided by max(||q||, ||r||, ||u||)), coulomb's prox on ``error_q``, Siconos on its
-``fc3d_compute_error`` (like coulomb's ``error``). Times are wall-clock seconds of one solve
-(coulomb: ``solve_time`` of the Rust core; Siconos: around ``fc3d_driver``, dense W unless
-scipy.sparse is accepted). Siconos is run for 3D problems only.
+succeeds when ``error_q <= tol``. Each solver stops on its own verdict: coulomb's NSGS and
+prox when ``scaled_error <= tol`` and ``error_q <= max(tol, error_q_floor)`` (the rule of
+``ContactResult.success``), Siconos on its own ``fc3d_compute_error``. Times are wall-clock
+seconds of one solve (coulomb: ``solve_time`` of the Rust core; Siconos: around
+``fc3d_driver``, dense W unless scipy.sparse is accepted). Siconos is run for 3D problems only.
 
 Writes a Markdown table into BENCHMARKS.md between ``<!-- contact-peers:begin -->`` and
 ``<!-- contact-peers:end -->`` and a Dolan-More performance profile to

@@ -680,3 +680,39 @@ fn oblique_spheres_impact_is_located_at_every_step_size() {
         }
     }
 }
+
+/// A landing with no approach owes Newton's law no rebound: a particle at rest 1e-6 m above
+/// the floor lands within its first step (gravity closes `g h^2 > 1e-6`) at approach 0, so
+/// the step after it is not a rebound (`resumed` false), while the same particle dropped at
+/// 1 m/s owes one (given: `-e v_n^-`); with e = 0 nothing is owed. Poisson's law restitutes
+/// the landing's compression, which the gap term made positive in both cases. 2D and 3D.
+#[test]
+fn only_a_rebound_owed_marks_a_step_resumed() {
+    let h = 1e-3;
+    let newton = Restitution::Newton;
+    let poisson = Restitution::Poisson;
+    let cases = [
+        (newton, 0.0, 0.5, false),
+        (newton, -1.0, 0.5, true),
+        (newton, -1.0, 0.0, false),
+        (poisson, 0.0, 0.5, true),
+        (poisson, -1.0, 0.5, true),
+        (poisson, -1.0, 0.0, false),
+    ];
+    for dim in [2, 3] {
+        for (law, vy, e, owed) in cases {
+            let mut scene = ball(dim, e);
+            scene.bodies[0].q0[dim - 1] = 1e-6 - vy * 0.5 * h;
+            scene.bodies[0].v0[dim - 1] = vy;
+            let tr = simulate(&scene, &with_law(law, h, 3)).expect("valid scene");
+            let land = tr.contacts.iter().find(|c| c.impulse[0] > 0.0);
+            let land = land.expect("the first step lands");
+            assert!(!land.closed && land.step == 0, "{law:?} {dim} {vy} {e}");
+            assert_eq!(tr.steps[1].resumed, owed, "{law:?} {dim} {vy} {e}");
+            if law == newton && owed {
+                let vn = tr.v[2 * tr.nv + dim - 1];
+                assert!((vn - e).abs() < 1e-9, "{dim}: {vn}");
+            }
+        }
+    }
+}

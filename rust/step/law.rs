@@ -158,7 +158,14 @@ pub(super) fn normal_term(
     let h = settings.h;
     if a.closed {
         let vminus = st.impact.approach_with(a.vn_k);
-        if st.impact.pending {
+        // a rebound is owed only where the landing had an approach (Newton) or a compression
+        // (Poisson) to give back, and some of it is given (e > 0): a resting contact whose gap
+        // term pushed at zero approach owes none, so its steps are not judged as rebounds
+        let owed = match settings.restitution {
+            Restitution::Poisson => st.impact.compression > 0.0,
+            _ => st.impact.approach < 0.0,
+        };
+        if st.impact.pending && owed && e > 0.0 {
             record.resumed = true;
         }
         a.approach = vminus;

@@ -39,7 +39,8 @@ pub struct StepRecord {
     pub complementarity: f64,
     /// a closed contact used the approach velocity remembered from the step that closed it
     /// (that step stopped the approach with the gap term; this one gives the rebound back), so
-    /// energy is judged across the two steps.
+    /// energy is judged across the two steps. Only a rebound owed is counted: the landing had
+    /// an approach `v_n^- < 0` (Newton's law) or a compression (Poisson's), and `e > 0`.
     pub resumed: bool,
     /// NSGS missed its tolerance and the polyhedral Lemke's answer, better on the exact-disk
     /// error, was used instead (see [`super::StepSettings::fallback`]).
