@@ -440,7 +440,9 @@ class Scene:
             When NSGS misses its tolerance (it can stall on singular, strongly coupled W),
             also solve by the polyhedral Lemke (up to 32 contacts) or the robust mode
             (proximal Newton, above; NSGS then gets 100 sweeps first) and keep the answer with
-            the smaller exact-disk error (such steps are marked in ``fallback``).
+            the smaller exact-disk error (such steps are marked in ``fallback``); such a step
+            is solved if that error is within ``max(tol, 1e-9)`` (a polygonal cone's answer
+            is not refined further).
         drift : {"none", "bias", "projection"}
             The position-drift correction (a velocity-level step does not enforce
             ``g(q_{k+1}) >= 0`` exactly): none; a velocity bias, a closed contact with ``g < 0``

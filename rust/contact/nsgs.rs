@@ -73,7 +73,7 @@ pub struct NsgsSettings {
     pub order: ContactOrder,
     /// when the sweeps slow down, also try the exact solve on the contacts' current cases
     /// (the sticking-set solve of redundant face contacts, see the module notes); off by
-    /// default.
+    /// default here, on in the stepper's NSGS ([`crate::step::StepSettings::new`]).
     pub sticking: bool,
 }
 

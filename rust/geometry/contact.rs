@@ -24,6 +24,9 @@
 //! (shapes scaled once per pair and kept in the cache; a power of two scales exactly), which
 //! makes the answer scale equivariant up to the rounding of the data.
 //!
+//! Two faces in 3D (of polyhedra, or a face and an edge) are clipped by module `clip`, along
+//! the face's own normal near touch, so that no corner they share to rounding is lost.
+//!
 //! In 3D parry appends GJK's closest pair, with unknown features, to the clipped polygon
 //! points; it lies among them, so it is dropped unless it is deeper than all of them (a
 //! redundant point would make the contact Delassus matrix singular). For the same reason a
@@ -244,10 +247,10 @@ const SAME_NORMAL_DUP: f64 = 1e-6;
 /// Below this cosine between parry's normal and a face's (an angle of 1.4e-3), the face is not
 /// the contact's; the face's normal is taken only for a manifold within [`NEAR`] of touching,
 /// so that a closest pair whose normal is not the face's moves by at most `1e-6 g <= 1e-9 L`.
-const SAME_NORMAL: f64 = 0.999_999;
+pub(super) const SAME_NORMAL: f64 = 0.999_999;
 
 /// The gap (relative to the query's unit) within which a face contact takes the face's normal.
-const NEAR: f64 = 1e-3;
+pub(super) const NEAR: f64 = 1e-3;
 
 macro_rules! contacts_impl {
     ($(#[$doc:meta])* $name:ident, $raw:ident, $shape:ty, $iso:ident, $vec:ident, $point:ident,

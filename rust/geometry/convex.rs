@@ -12,7 +12,7 @@
 //!   polytope and a ball of radius `r`: GJK (EPA when the polytopes overlap) gives the
 //!   closest points `p_1`, `p_2` and the unit direction `n_1` from `A` to `B` of the polytopes;
 //!   the support features of `A` along `n_1` and of `B` along `-n_1` are clipped against each
-//!   other, each point's distance `(p_2 - p_1) · n_1 - r_A - r_B`; in 3D GJK's own pair is
+//!   other (in 3D by polygon clipping where one is a face, module `clip`), each point's distance `(p_2 - p_1) · n_1 - r_A - r_B`; in 3D GJK's own pair is
 //!   added (the caller drops it where it is redundant), in 2D only when the clip gave none;
 //! - a shape against the half-space `{x : m · x <= 0}`: the support feature of the shape along
 //!   `-m`, each vertex `v` kept when `m · v - r <= prediction`, its partner `v - (m · v) m` on
@@ -27,7 +27,7 @@ use parry2d_f64::query::ContactManifold as Manifold2;
 use parry3d_f64::query::ContactManifold as Manifold3;
 
 macro_rules! convex_impl {
-    ($ws:ident, $query:ident, $parry:ident, $manifold:ty, $dim3:expr) => {
+    ($ws:ident, $query:ident, $parry:ident, $manifold:ty, $dim3:expr, $faces:path) => {
         /// GJK's simplex and EPA's buffers of one pair, kept from query to query.
         pub(super) struct $ws {
             simplex: $parry::query::gjk::VoronoiSimplex,
@@ -140,16 +140,20 @@ macro_rules! convex_impl {
                     let mut f2 = $parry::shape::PolygonalFeature::default();
                     pfm_a.local_support_feature(&n1, &mut f1);
                     pfm_b.local_support_feature(&n2, &mut f2);
-                    $parry::shape::PolygonalFeature::contacts(
-                        pos12,
-                        &pos12.inverse(),
-                        &n1,
-                        &n2,
-                        &f1,
-                        &f2,
-                        m,
-                        false,
-                    );
+                    let near = (p2_1 - p1).dot(&n1) - ra - rb <= super::contact::NEAR;
+                    let axis = $faces(pos12, &n1, near, &f1, &f2, m).unwrap_or_else(|| {
+                        $parry::shape::PolygonalFeature::contacts(
+                            pos12,
+                            &pos12.inverse(),
+                            &n1,
+                            &n2,
+                            &f1,
+                            &f2,
+                            m,
+                            false,
+                        );
+                        n1
+                    });
                     if $dim3 || m.points.is_empty() {
                         let unknown = $parry::shape::PackedFeatureId::UNKNOWN;
                         m.points.push($parry::query::TrackedContact::new(
@@ -160,6 +164,7 @@ macro_rules! convex_impl {
                             (p2_1 - p1).dot(&n1),
                         ));
                     }
+                    let (n1, n2) = (axis, pos12.inverse_transform_unit_vector(&-axis));
                     if ra != 0.0 || rb != 0.0 {
                         for p in &mut m.points {
                             p.local_p1 += *n1 * ra;
@@ -178,5 +183,31 @@ macro_rules! convex_impl {
     };
 }
 
-convex_impl!(Convex3, convex3, parry3d_f64, Manifold3<(), ()>, true);
-convex_impl!(Convex2, convex2, parry2d_f64, Manifold2<(), ()>, false);
+convex_impl!(
+    Convex3,
+    convex3,
+    parry3d_f64,
+    Manifold3<(), ()>,
+    true,
+    super::clip::face_contacts
+);
+convex_impl!(
+    Convex2,
+    convex2,
+    parry2d_f64,
+    Manifold2<(), ()>,
+    false,
+    parry_contacts2
+);
+
+/// In 2D a face is a segment, and parry's segment clipping is kept.
+fn parry_contacts2(
+    _: &nalgebra::Isometry2<f64>,
+    _: &Unit<nalgebra::Vector2<f64>>,
+    _: bool,
+    _: &parry2d_f64::shape::PolygonalFeature,
+    _: &parry2d_f64::shape::PolygonalFeature,
+    _: &mut Manifold2<(), ()>,
+) -> Option<Unit<nalgebra::Vector2<f64>>> {
+    None
+}

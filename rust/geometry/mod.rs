@@ -25,8 +25,10 @@
 //! Where parry's answer is not the contact this crate needs, [`contact`] corrects it and says
 //! how: exact recomputation instead of parry's incremental manifold update, a second query
 //! pulled apart when shapes touch within rounding (GJK-EPA's wrong depth there), queries in a
-//! power-of-two unit near the shapes' size (parry's absolute tolerances), and GJK's redundant
-//! extra point dropped; boxes are polyhedra (see [`Shape3::cuboid`]). With a cylinder or a
+//! power-of-two unit near the shapes' size (parry's absolute tolerances), GJK's redundant
+//! extra point dropped, and two faces in 3D clipped as polygons along the face's own normal
+//! (module `clip`: parry's separate corner and crossing tests could both refuse a corner that
+//! two equal faces share to rounding); boxes are polyhedra (see [`Shape3::cuboid`]). With a cylinder or a
 //! cone, parry builds the manifold from polygonal features picked by a GJK normal of limited
 //! accuracy: its deepest gap moves under swap, rigid motion or scaling by up to about 1e-5 of
 //! the shapes' size and its normal by about 1e-3 (the tests measure this); with spheres,
@@ -38,6 +40,7 @@
 //! parry sees them (parry asserts on some of these).
 
 pub mod broad;
+mod clip;
 pub mod contact;
 mod convex;
 pub mod shape2;

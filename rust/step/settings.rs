@@ -101,13 +101,16 @@ pub struct StepSettings {
 }
 
 impl StepSettings {
-    /// NSGS with tolerance 1e-12 (Lemke fallback), gap tolerance 1e-9 m, warm start.
+    /// NSGS with tolerance 1e-12 and the sticking-set solve (exact impulses on redundant
+    /// face contacts; [`NsgsSettings::sticking`]), Lemke fallback, gap tolerance 1e-9 m, warm
+    /// start.
     pub fn new(h: f64, steps: usize) -> Self {
         Self {
             h,
             steps,
             solver: StepSolver::Nsgs(NsgsSettings {
                 tol: 1e-12,
+                sticking: true,
                 ..NsgsSettings::default()
             }),
             gap_tolerance: 1e-9,

@@ -62,8 +62,11 @@ def test_a_box_on_a_box_decelerates_at_mu_g_in_any_units(dim: int, mu: float,
     stop = v0 / (mu * G)
     tr = box_on_box(dim, mu, v0, scale).simulate(t_end=stop + 0.1, h=h)
     # a face's four contact rows outnumber the three motions they stop (W singular), where
-    # NSGS's error can stall at 1.4e-12 on a rare step (then honestly not a success)
-    assert np.max(tr.solver_scaled_error) < 1e-11
+    # NSGS's error can stall at 1.4e-12 on a rare step (then honestly not a success); a step
+    # that NSGS missed is solved by the fallback if within max(tol, 1e-9) (the polyhedral
+    # Lemke's answer at 3.9e-11 on this scene's first step at one unit, by rounding)
+    assert np.max(tr.solver_scaled_error[~tr.fallback], initial=0.0) < 1e-11
+    assert np.max(tr.solver_scaled_error[tr.fallback], initial=0.0) <= 1e-9
     vx = tr.v[:, (3 if dim == 2 else 6)] / scale
     want = np.maximum(v0 - mu * G * tr.t, 0.0)
     assert np.max(np.abs(vx - want)) < 1e-9 * v0

@@ -1,0 +1,254 @@
+//! Face contacts of two convex polyhedra by polygon clipping (Sutherland-Hodgman), in place of
+//! parry's vertex-in-face and edge-crossing tests.
+//!
+//! Two faces touching along the contact normal `n` meet in the intersection of their
+//! projections on the plane normal to `n`. Its corners are the corners of either face that lie
+//! in the other, and the crossings of their edges. parry finds each kind by a separate test
+//! (a corner strictly inside, a crossing strictly within both edges), so where corners of the
+//! two faces coincide to rounding (two equal boxes stacked, one turned about the normal by an
+//! ulp) each test can refuse the same corner and the contact loses it: a box then stands on
+//! three of its four corners, and its impulses and the tower's drift depend on rounding.
+//!
+//! Here the subject face is clipped in turn by the side planes of the clip face (each plane
+//! through an edge of the clip face and containing `n`). Clipping a convex polygon by
+//! half-spaces keeps their intersection whatever the rounding: a corner refused by one plane
+//! is found as the end of an edge clipped by it, so no corner of the contact polygon can go
+//! missing. A point within [`ON_PLANE`] of the face's size from a side plane counts as on it
+//! (kept, not cut): two edges collinear to rounding then give their corners, not a crossing at
+//! whatever place along the edge the rounding changes sign. Points a twist of more than that
+//! leaves apart (an octagon whose short edges are 1e-10 long) are merged by the caller's
+//! `SAME_POINT` rule.
+//!
+//! The normal along which the faces are clipped, and the gaps measured, is a face's own where
+//! it is within `SAME_NORMAL` of the direction GJK found and the faces are within `NEAR` of
+//! touching (the second shape's face first, as the caller does for points that share a face):
+//! GJK's direction is accurate near touch only to about 1e-7, and where every point is a
+//! crossing of edges no point names the face for the caller to take its normal from.
+//!
+//! Each point keeps the features it lies on, as parry labels them: a corner of the subject
+//! inside the clip face `(clip face, subject vertex)`, a corner of the clip face inside the
+//! subject `(clip vertex, subject face)`, and a crossing `(clip edge, subject edge)`; so contact
+//! identities persist across steps as before.
+
+use nalgebra::{Isometry3, Point3, Unit, Vector3};
+use parry3d_f64::query::{ContactManifold, TrackedContact};
+use parry3d_f64::shape::{PackedFeatureId, PolygonalFeature};
+
+use super::contact::SAME_NORMAL;
+
+/// An edge of the polygon being clipped: an edge of the subject face or a piece of a clip
+/// plane (by index in its feature).
+#[derive(Clone, Copy, Debug)]
+enum Along {
+    Subject(usize),
+    Clip(usize),
+}
+
+/// A vertex of the polygon being clipped: its point (in the first shape's frame), its features
+/// on the clip and subject faces, and the edge that leaves it.
+#[derive(Clone, Copy, Debug)]
+struct Vertex {
+    p: Point3<f64>,
+    on_clip: PackedFeatureId,
+    on_subject: PackedFeatureId,
+    next: Along,
+}
+
+/// A point closer than this times the clip face's diameter to a side plane is on it.
+const ON_PLANE: f64 = 1e-12;
+
+/// At most 4 subject corners, and each of at most 4 clip planes adds at most one corner to a
+/// convex polygon.
+const MAX: usize = 12;
+
+/// A fixed-capacity polygon: no allocation per query.
+#[derive(Clone, Copy)]
+struct Polygon {
+    v: [Vertex; MAX],
+    n: usize,
+}
+
+impl Polygon {
+    fn new() -> Self {
+        let empty = Vertex {
+            p: Point3::origin(),
+            on_clip: PackedFeatureId::UNKNOWN,
+            on_subject: PackedFeatureId::UNKNOWN,
+            next: Along::Subject(0),
+        };
+        Self {
+            v: [empty; MAX],
+            n: 0,
+        }
+    }
+
+    fn push(&mut self, v: Vertex) {
+        if self.n < MAX {
+            self.v[self.n] = v;
+            self.n += 1;
+        }
+    }
+}
+
+/// A face feature's corners and labels in the first shape's frame.
+struct Face<'a> {
+    p: [Point3<f64>; 4],
+    n: usize,
+    f: &'a PolygonalFeature,
+}
+
+impl Face<'_> {
+    /// the id of the edge from corner `i` to the next (a segment has one edge).
+    fn edge(&self, i: usize) -> PackedFeatureId {
+        self.f.eids[if self.n == 2 { 0 } else { i }]
+    }
+}
+
+/// The contact points of features `f1` (of the first shape) and `f2` (of the second, at
+/// `pos12` in the first's frame) along the unit normal `gjk` (first shape's frame, from the
+/// first shape to the second) or a face's normal near it (module docs), `near` when the shapes
+/// are within `NEAR` of touching; pushed into `m` with parry's conventions (`local_p1`,
+/// `local_p2` in each shape's frame, `dist = (p2 - p1) · n`). Returns the normal `n` used, or
+/// `None`, pushing nothing, where clipping does not apply (a vertex, two edges, or a face seen
+/// edge-on): the caller then uses parry's own contacts.
+pub(super) fn face_contacts(
+    pos12: &Isometry3<f64>,
+    gjk: &Unit<Vector3<f64>>,
+    near: bool,
+    f1: &PolygonalFeature,
+    f2: &PolygonalFeature,
+    m: &mut ContactManifold<(), ()>,
+) -> Option<Unit<Vector3<f64>>> {
+    let (n1, n2) = (f1.num_vertices, f2.num_vertices);
+    if n1 < 2 || n2 < 2 || (n1 == 2 && n2 == 2) || n1 > 4 || n2 > 4 {
+        return None;
+    }
+    let first = Face {
+        p: f1.vertices,
+        n: n1,
+        f: f1,
+    };
+    let second = Face {
+        p: f2.vertices.map(|v| pos12 * v),
+        n: n2,
+        f: f2,
+    };
+    let face_normal = |f: &Face<'_>| {
+        let n = (f.n >= 3)
+            .then(|| (f.p[1] - f.p[0]).cross(&(f.p[2] - f.p[0])))
+            .and_then(|n| Unit::try_new(n, 0.0))?;
+        let n = if n.dot(gjk) < 0.0 { -n } else { n };
+        (near && n.dot(gjk) > SAME_NORMAL).then_some(n)
+    };
+    let axis = face_normal(&second)
+        .or_else(|| face_normal(&first))
+        .unwrap_or(*gjk);
+    // the face with an area clips the other
+    let swapped = n1 < 3;
+    let (clip, subject) = if swapped {
+        (&second, &first)
+    } else {
+        (&first, &second)
+    };
+    // the clip face's plane, along which each clipped point is projected
+    let c = &clip.p;
+    let normal = (c[1] - c[0]).cross(&(c[2] - c[0]));
+    let along = axis.dot(&normal);
+    if along.abs() <= 1e-9 * normal.norm() || !along.is_finite() {
+        return None;
+    }
+    let poly = clip_polygon(clip, subject, &axis);
+    for v in &poly.v[..poly.n] {
+        let t = (c[0] - v.p).dot(&normal) / along;
+        let on_clip = v.p + axis.into_inner() * t;
+        let (p1, p2_1, fid1, fid2, dist) = if swapped {
+            (v.p, on_clip, v.on_subject, v.on_clip, t)
+        } else {
+            (on_clip, v.p, v.on_clip, v.on_subject, -t)
+        };
+        m.points.push(TrackedContact::new(
+            p1,
+            pos12.inverse_transform_point(&p2_1),
+            fid1,
+            fid2,
+            dist,
+        ));
+    }
+    Some(axis)
+}
+
+/// The subject polygon clipped by the prism over the clip face along `axis` (module docs).
+fn clip_polygon(clip: &Face<'_>, subject: &Face<'_>, axis: &Unit<Vector3<f64>>) -> Polygon {
+    let mut poly = Polygon::new();
+    for i in 0..subject.n {
+        poly.push(Vertex {
+            p: subject.p[i],
+            on_clip: clip.f.fid,
+            on_subject: subject.f.vids[i],
+            next: Along::Subject(i),
+        });
+    }
+    let inv_n = 1.0 / clip.n as f64;
+    let centre = clip.p[..clip.n]
+        .iter()
+        .fold(Vector3::zeros(), |s, p| s + p.coords * inv_n);
+    let diameter = (0..clip.n)
+        .flat_map(|i| (0..i).map(move |j| (i, j)))
+        .map(|(i, j)| (clip.p[i] - clip.p[j]).norm())
+        .fold(0.0, f64::max);
+    for k in 0..clip.n {
+        let a = clip.p[k];
+        let b = clip.p[(k + 1) % clip.n];
+        // the side plane's inward normal
+        let mut side = (b - a).cross(axis);
+        if side.dot(&(centre - a.coords)) < 0.0 {
+            side = -side;
+        }
+        let slack = ON_PLANE * diameter * side.norm();
+        let depth = |p: &Point3<f64>| (p - a).dot(&side);
+        let mut out = Polygon::new();
+        for i in 0..poly.n {
+            let cur = poly.v[i];
+            let nxt = poly.v[(i + 1) % poly.n];
+            let (dc, dn) = (depth(&cur.p), depth(&nxt.p));
+            let (cur_in, nxt_in) = (dc >= -slack, dn >= -slack);
+            if cur_in {
+                out.push(cur);
+            }
+            if cur_in != nxt_in {
+                // where the edge meets the plane, within the edge
+                let t = (dc / (dc - dn)).clamp(0.0, 1.0);
+                let p = cur.p + (nxt.p - cur.p) * t;
+                let (on_clip, on_subject) = match cur.next {
+                    Along::Subject(j) => (clip.edge(k), subject.edge(j)),
+                    Along::Clip(l) => (corner_between(clip, l, k), subject.f.fid),
+                };
+                // leaving, the polygon follows the clip plane; entering, the same edge
+                let next = if cur_in { Along::Clip(k) } else { cur.next };
+                out.push(Vertex {
+                    p,
+                    on_clip,
+                    on_subject,
+                    next,
+                });
+            }
+        }
+        poly = out;
+        if poly.n == 0 {
+            break;
+        }
+    }
+    poly
+}
+
+/// The clip face's corner shared by its edges `l` and `k` (unknown if they are not adjacent,
+/// which a convex clip does not produce).
+fn corner_between(clip: &Face<'_>, l: usize, k: usize) -> PackedFeatureId {
+    if (l + 1) % clip.n == k {
+        clip.f.vids[k]
+    } else if (k + 1) % clip.n == l {
+        clip.f.vids[l]
+    } else {
+        PackedFeatureId::UNKNOWN
+    }
+}
