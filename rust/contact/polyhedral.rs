@@ -67,7 +67,9 @@
 //! means that the polyhedral LCP was solved by Lemke's rule (its literature error and its
 //! unit-free error within the tolerance); the LCP's own error is in the message. In 2D the
 //! polygon is exact and success is the rule of every contact method,
-//! [`super::ContactMeasures::passes`] on the impulses.
+//! [`super::ContactMeasures::passes`] on the impulses. In either dimension, impulses that pass
+//! that rule are a solution even where Lemke's own certificate failed (a badly scaled LCP,
+//! bodies of very different masses).
 
 use super::{measure_into, ContactProblem, ContactSolution, ContactStatus};
 use crate::error::{CoulombError, Result};
@@ -514,6 +516,19 @@ pub fn solve_polyhedral_lcp(
                 ls.pivots,
                 Readable(lm.error),
                 Readable(measures.scaled_error)
+            ),
+        ),
+        // whatever Lemke's own certificate (a residual test on the LCP, in its scaling),
+        // impulses that pass the exact rule on the original problem solve it
+        _ if measures.passes(settings.lemke.tol) => (
+            ContactStatus::Solved,
+            format!(
+                "{what}: Lemke {} ({}), but its impulses pass the tolerance on the contact \
+                 problem (scaled_error {}, error_q {})",
+                ls.status,
+                ls.message,
+                Readable(measures.scaled_error),
+                Readable(measures.error_q)
             ),
         ),
         LcpStatus::PivotLimit => (
