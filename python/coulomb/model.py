@@ -580,13 +580,15 @@ class Scene:
                               restitution, record_every, locate_impacts)
         chunk = _validate.count("chunk", chunk)
         spec = self._spec()
-        with _stream.open_file(path) as f:
+        with _stream.open_file(path) as f, _stream.CtrlC() as ctrl_c:
             f.attrs.update(format=_stream.FORMAT, version=_stream.VERSION, dim=self.dim,
                            h=args["h"], solver=args["solver"], tol=args["tol"],
                            gap_tolerance=args["gap_tolerance"],
                            record_every=args["record_every"], complete=False)
-            writer = _stream.Writer(f)
+            writer = _stream.Writer(f, ctrl_c)
             raw = _core.step_stream(spec, write=writer, chunk=chunk, **args)
+            # a Ctrl-C whose KeyboardInterrupt was swallowed in a callback (see CtrlC)
+            ctrl_c.check()
             stopped = raw["stopped"]
             f.attrs.update(stopped=stopped or "", solve_time=raw["solve_time"], complete=True)
             states = int(f["t"].shape[0]) if "t" in f else 0

@@ -172,3 +172,35 @@ def test_ctrl_c_leaves_the_chunks_written_and_the_file_marked_incomplete(tmp_pat
     assert back.status == coulomb.Status.STOPPED and not back.success
     assert "interrupted" in back.stopped
     np.testing.assert_array_equal(np.diff(back.t) > 0, True)
+
+
+# the swallowed KeyboardInterrupt is reported as unraisable: that is the case under test
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
+def test_a_ctrl_c_swallowed_in_a_weakref_callback_still_stops_the_stream():
+    # Python runs signal handlers between bytecodes; inside a weakref callback (h5py's
+    # objects die in them while a chunk is written) the KeyboardInterrupt is printed and
+    # ignored, and the run went on. The stream records Ctrl-C and raises it at the next chunk.
+    import os
+    import signal
+    import weakref
+
+    from coulomb import _stream
+
+    class Thing:
+        pass
+
+    def callback(_: object) -> None:
+        os.kill(os.getpid(), signal.SIGINT)
+        for _k in range(1000):  # bytecodes: the handler runs here, its exception is ignored
+            pass
+
+    with _stream.CtrlC() as ctrl_c:
+        thing = Thing()
+        ref = weakref.ref(thing, callback)
+        del thing  # the callback runs now and swallows the KeyboardInterrupt
+        assert ref() is None
+        assert ctrl_c.seen
+        with pytest.raises(KeyboardInterrupt):
+            ctrl_c.check()
+    # the default handler is back
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
