@@ -85,8 +85,9 @@ impl Stepper {
         if !faster {
             return false;
         }
-        // the search only widens: with as many contacts it found the same ones, which keep
-        // the terms the solve gave them
+        // the search only widens (a contact kept from the last solve stays, even where a
+        // joint's retarget since changed `v_free`): with as many contacts it found the same
+        // ones, which keep the terms the solve gave them
         self.active_kept.clone_from(&self.active);
         self.trial_search = true;
         self.search_contacts();

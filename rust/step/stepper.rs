@@ -346,9 +346,17 @@ impl Stepper {
                 let [lin, ang] = self.speed_bounds[body];
                 reach += lin + ang * norm3(r);
             }
-            // a contact owed a rebound stays active whatever its gap (module impact)
+            // a contact owed a rebound stays active whatever its gap (module impact); the
+            // search again on the step's velocity (module settle) only adds contacts, since
+            // `v_free` may have changed in between (a joint retargeted) and must not
+            // release one the solve relied on
             let pending = self.state[c].impact.pending;
-            let far = geo.gap > tol_gap + 2.0 * h * reach && !pending;
+            let kept = self.trial_search
+                && self
+                    .active_kept
+                    .binary_search_by_key(&c, |a| a.cand)
+                    .is_ok();
+            let far = geo.gap > tol_gap + 2.0 * h * reach && !pending && !kept;
             let (vn_k, vn_free) = if far {
                 (0.0, 0.0)
             } else {
@@ -360,7 +368,11 @@ impl Stepper {
                 };
                 (self.normal_velocity(geo, &self.v), vn_free.min(vn_trial))
             };
-            let verdict = driver::search_verdict(&self.settings, geo.gap, vn_k, vn_free, pending);
+            let mut verdict =
+                driver::search_verdict(&self.settings, geo.gap, vn_k, vn_free, pending);
+            if kept && verdict.is_none() {
+                verdict = Some(geo.gap <= tol_gap || pending);
+            }
             let (false, Some(closed)) = (far, verdict) else {
                 self.state[c] = CandState::default();
                 continue;
