@@ -495,50 +495,32 @@ pub fn solve_polyhedral_lcp(
         lcp.directions.len(),
         lcp.n
     );
-    let (status, message) = match ls.status {
-        // 2D: the polygon is the interval, the LCP is the problem, and the success rule of
-        // every contact method applies to the impulses
-        LcpStatus::Solved if problem.dim == 2 && !measures.passes(settings.lemke.tol) => (
-            ContactStatus::NumericalFailure,
-            format!(
-                "{what} solved by Lemke in {} pivots (LCP error {}), but the impulses miss \
-                 the tolerance on the contact problem ({}){refused}",
-                ls.pivots,
-                Readable(lm.error),
-                measures.shortfall(settings.lemke.tol)
-            ),
+    let verdict = LemkeVerdict::of(problem.dim, ls.status, &measures, settings.lemke.tol);
+    let status = verdict.status_of(ls.status);
+    let message = match verdict {
+        LemkeVerdict::MissesTheInterval => format!(
+            "{what} solved by Lemke in {} pivots (LCP error {}), but the impulses miss \
+             the tolerance on the contact problem ({}){refused}",
+            ls.pivots,
+            Readable(lm.error),
+            measures.shortfall(settings.lemke.tol)
         ),
-        LcpStatus::Solved => (
-            ContactStatus::Solved,
-            format!(
-                "{what} solved by Lemke in {} pivots{note} (LCP error {}; against the exact \
-                 disk scaled_error {})",
-                ls.pivots,
-                Readable(lm.error),
-                Readable(measures.scaled_error)
-            ),
+        LemkeVerdict::Solved => format!(
+            "{what} solved by Lemke in {} pivots{note} (LCP error {}; against the exact \
+             disk scaled_error {})",
+            ls.pivots,
+            Readable(lm.error),
+            Readable(measures.scaled_error)
         ),
-        // whatever Lemke's own certificate (a residual test on the LCP, in its scaling),
-        // impulses that pass the exact rule on the original problem solve it
-        _ if measures.passes(settings.lemke.tol) => (
-            ContactStatus::Solved,
-            format!(
-                "{what}: Lemke {} ({}), but its impulses pass the tolerance on the contact \
-                 problem (scaled_error {}, error_q {})",
-                ls.status,
-                ls.message,
-                Readable(measures.scaled_error),
-                Readable(measures.error_q)
-            ),
+        LemkeVerdict::PassesTheRule => format!(
+            "{what}: Lemke {} ({}), but its impulses pass the tolerance on the contact \
+             problem (scaled_error {}, error_q {})",
+            ls.status,
+            ls.message,
+            Readable(measures.scaled_error),
+            Readable(measures.error_q)
         ),
-        LcpStatus::PivotLimit => (
-            ContactStatus::IterationLimit,
-            format!("{what}: Lemke {}: {}{refused}", ls.status, ls.message),
-        ),
-        _ => (
-            ContactStatus::NumericalFailure,
-            format!("{what}: Lemke {}: {}{refused}", ls.status, ls.message),
-        ),
+        LemkeVerdict::Failed => format!("{what}: Lemke {}: {}{refused}", ls.status, ls.message),
     };
     let sol = ContactSolution {
         impulse: r,
@@ -549,6 +531,51 @@ pub fn solve_polyhedral_lcp(
         measures,
     };
     Ok((sol, lcp, ls))
+}
+
+/// Lemke's verdict on a friction-contact problem, shared by [`solve_polyhedral`] and the
+/// stepper's Lemke: from Lemke's status on the polyhedral LCP and the impulses' measures on
+/// the contact problem (`measures`, the exact disk), against `tol`.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub(crate) enum LemkeVerdict {
+    /// 2D: the polygon is the interval, so the LCP is the problem and the success rule of
+    /// every contact method applies to the impulses; Lemke solved the LCP but they miss it.
+    MissesTheInterval,
+    /// Lemke solved the LCP (in 3D the polygon's answer, whatever it misses of the disk).
+    Solved,
+    /// Lemke's own certificate (a residual test on the LCP, in its scaling) failed, but the
+    /// impulses pass the exact rule on the original problem.
+    PassesTheRule,
+    /// Lemke failed and the impulses miss the rule: its pivot limit or a numerical failure.
+    Failed,
+}
+
+impl LemkeVerdict {
+    /// the verdict of Lemke's `status` with impulses measuring `measures` in `dim`.
+    pub(crate) fn of(
+        dim: usize,
+        status: LcpStatus,
+        measures: &super::ContactMeasures,
+        tol: f64,
+    ) -> Self {
+        let passes = measures.passes(tol);
+        match status {
+            LcpStatus::Solved if dim == 2 && !passes => Self::MissesTheInterval,
+            LcpStatus::Solved => Self::Solved,
+            _ if passes => Self::PassesTheRule,
+            _ => Self::Failed,
+        }
+    }
+
+    /// the contact status of the verdict, Lemke's pivot limit being an iteration limit.
+    pub(crate) fn status_of(self, lemke: LcpStatus) -> ContactStatus {
+        match self {
+            Self::Solved | Self::PassesTheRule => ContactStatus::Solved,
+            Self::MissesTheInterval => ContactStatus::NumericalFailure,
+            Self::Failed if lemke == LcpStatus::PivotLimit => ContactStatus::IterationLimit,
+            Self::Failed => ContactStatus::NumericalFailure,
+        }
+    }
 }
 
 /// Solves the friction-contact problem on the polyhedral cone by Lemke's method (see the

@@ -96,3 +96,52 @@ fn bad_facets_are_refused() {
     }
     assert!(PolyhedralLcp::new(&p, 6).is_ok());
 }
+
+/// Lemke's verdict (shared by `contact::solve` and the stepper) on the seed's inelastic step,
+/// `W = I / 2`, `q = (-3, 1)`, mu 0.2, whose answer is r = (6, -1.2): the exact answer passes
+/// in both dims whatever Lemke said; a wrong answer after a solved LCP is a numerical failure
+/// in 2D (the interval is the problem) but Lemke's own solved status in 3D (the polygon's
+/// answer); after a failed LCP it is Lemke's pivot limit or a numerical failure.
+#[test]
+fn lemke_verdict_follows_the_exact_rule_in_2d_and_the_polygon_in_3d() {
+    let w = [0.5, 0.0, 0.0, 0.5];
+    let q = [-3.0, 1.0];
+    let p = ContactProblem::new(2, &w, &q, &[0.2]).unwrap();
+    let mut u = vec![0.0; 2];
+    let exact = measure_into(&p, &[6.0, -1.2], &mut u);
+    let wrong = measure_into(&p, &[6.0, 0.0], &mut u);
+    assert!(exact.passes(1e-12) && !wrong.passes(1e-3));
+    let verdict = |dim, status, m: &super::super::ContactMeasures| {
+        let v = LemkeVerdict::of(dim, status, m, 1e-12);
+        (v, v.status_of(status))
+    };
+    for dim in [2, 3] {
+        for status in [
+            LcpStatus::Solved,
+            LcpStatus::PivotLimit,
+            LcpStatus::NumericalFailure,
+        ] {
+            let (_, s) = verdict(dim, status, &exact);
+            assert_eq!(s, ContactStatus::Solved, "{dim} {status:?}");
+        }
+    }
+    assert_eq!(
+        verdict(2, LcpStatus::Solved, &wrong),
+        (
+            LemkeVerdict::MissesTheInterval,
+            ContactStatus::NumericalFailure
+        )
+    );
+    assert_eq!(
+        verdict(3, LcpStatus::Solved, &wrong),
+        (LemkeVerdict::Solved, ContactStatus::Solved)
+    );
+    assert_eq!(
+        verdict(2, LcpStatus::PivotLimit, &wrong).1,
+        ContactStatus::IterationLimit
+    );
+    assert_eq!(
+        verdict(3, LcpStatus::NumericalFailure, &wrong).1,
+        ContactStatus::NumericalFailure
+    );
+}

@@ -3,7 +3,7 @@
 //! (warm-started from the previous basis), over a dense or block-sparse W.
 
 use super::{StepRecord, StepSettings, StepSolver};
-use crate::contact::polyhedral::PolyhedralLcp;
+use crate::contact::polyhedral::{LemkeVerdict, PolyhedralLcp};
 use crate::contact::{
     measure_into,
     prox::{solve_prox, ProxSettings},
@@ -11,7 +11,7 @@ use crate::contact::{
     NsgsSettings, PolyhedralSettings,
 };
 use crate::error::Result;
-use crate::lcp::{solve_lemke_with, LcpRef, LcpStatus, LemkeWorkspace};
+use crate::lcp::{solve_lemke_with, LcpRef, LemkeWorkspace};
 
 /// from this many active contacts on, a step's W is assembled in block CSR (its NSGS sweep then
 /// costs O(nnz) instead of O(nc^2)).
@@ -149,14 +149,8 @@ pub(super) fn solve_polyhedral_warm(
             }
         }
     }
-    let status = match ls.status {
-        LcpStatus::Solved => ContactStatus::Solved,
-        // whatever Lemke's own certificate (a residual test on the LCP, in its scaling),
-        // impulses that pass the exact rule on the step's problem solve it
-        _ if measures.passes(s.lemke.tol) => ContactStatus::Solved,
-        LcpStatus::PivotLimit => ContactStatus::IterationLimit,
-        _ => ContactStatus::NumericalFailure,
-    };
+    let status =
+        LemkeVerdict::of(problem.dim, ls.status, &measures, s.lemke.tol).status_of(ls.status);
     Ok(Outcome {
         status,
         iterations: ls.pivots,
