@@ -24,7 +24,8 @@
 //! iterated Tikhonov regularisation (Engl, Hanke and Neubauer 1996, section 5.1):
 //! `(S + δ I) y_{k+1} = c + δ y_k` from `y_0 = 0` stays in the range of S and converges to its
 //! least-norm solution at the ratio `δ / (λ + δ)` per iteration on an eigenvalue λ of S, on
-//! one sparse Cholesky factor of `S + δ I` (faer's, with a fill-reducing ordering).
+//! one Cholesky factor of `S + δ I` (faer's: dense up to [`DENSE_MAX`] rows, sparse with a
+//! fill-reducing ordering above).
 //!
 //! The sticking set starts as every pushing contact with isotropic friction. A contact whose
 //! answer stops pushing or leaves its cone is then fixed (at the sweeps' impulse if they left
@@ -321,8 +322,7 @@ impl StickSolve {
                 lower.push(Triplet::new(t.row, t.col, 1.0 + DELTA));
             }
         }
-        let mat = SparseColMat::<usize, f64>::try_new_from_triplets(m, m, &lower).ok()?;
-        let llt = mat.sp_cholesky(Side::Lower).ok()?;
+        let llt = Factor::new(m, &lower)?;
         for (ck, s) in c.iter_mut().zip(&scale) {
             *ck *= s;
         }
@@ -332,7 +332,7 @@ impl StickSolve {
             for ((b, &ck), &yk) in rhs.iter_mut().zip(&c).zip(&y) {
                 *b = ck + DELTA * yk;
             }
-            llt.solve_in_place(faer::MatMut::from_column_major_slice_mut(&mut rhs, m, 1));
+            llt.solve_in_place(&mut rhs);
             let mut step: f64 = 0.0;
             let mut size: f64 = 0.0;
             for (yk, &b) in y.iter_mut().zip(&rhs) {
@@ -351,6 +351,43 @@ impl StickSolve {
             *yk *= s;
         }
         Some(y)
+    }
+}
+
+/// the size up to which the sticking set's matrix is factored dense: a few hundred rows
+/// factor faster dense than through a sparse symbolic analysis (a 10-box tower's 120 rows:
+/// the sparse path's ordering and triplet sort cost about 2 M instructions per solve).
+const DENSE_MAX: usize = 256;
+
+/// The Cholesky factor of `S + δ I` (module notes), dense or sparse by size.
+enum Factor {
+    Dense(faer::linalg::solvers::Llt<f64>),
+    Sparse(faer::sparse::linalg::solvers::Llt<usize, f64>),
+}
+
+impl Factor {
+    /// the factor of the `m x m` matrix whose lower triangle is `lower` (duplicates add up),
+    /// `None` when it is not numerically positive definite.
+    fn new(m: usize, lower: &[Triplet<usize, usize, f64>]) -> Option<Self> {
+        if m <= DENSE_MAX {
+            let mut a = faer::Mat::<f64>::zeros(m, m);
+            for t in lower {
+                a[(t.row, t.col)] += t.val;
+            }
+            return a.llt(Side::Lower).ok().map(Self::Dense);
+        }
+        let mat = SparseColMat::<usize, f64>::try_new_from_triplets(m, m, lower).ok()?;
+        mat.sp_cholesky(Side::Lower).ok().map(Self::Sparse)
+    }
+
+    /// `x <- (S + δ I)^-1 x`.
+    fn solve_in_place(&self, x: &mut [f64]) {
+        let m = x.len();
+        let x = faer::MatMut::from_column_major_slice_mut(x, m, 1);
+        match self {
+            Self::Dense(f) => f.solve_in_place(x),
+            Self::Sparse(f) => f.solve_in_place(x),
+        }
     }
 }
 
