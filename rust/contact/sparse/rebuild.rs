@@ -31,12 +31,12 @@ impl BlockCsr {
         scratch: &mut TileScratch,
     ) -> Result<()> {
         check_dims(dim, dim * nc)?;
-        // one pass over the values; the error (naming the entry) only when one is not finite
-        let finite = tiles.iter().all(|(_, _, t)| {
-            t[..dim]
-                .iter()
-                .all(|row| row[..dim].iter().all(|v| v.is_finite()))
-        });
+        // one pass over the values (v * 0 is 0 exactly when v is finite; all nine entries
+        // are read, a fixed-size branch-free loop), the error naming the entry only when one
+        // is not finite (a tile's entries beyond `dim` are not W's: they are checked again)
+        let finite = tiles
+            .iter()
+            .all(|(_, _, t)| t.iter().flatten().fold(0.0, |a, v| a + v * 0.0) == 0.0);
         if !finite {
             for (_, _, t) in tiles {
                 for row in &t[..dim] {
@@ -162,5 +162,18 @@ mod tests {
         }
         let bad = [(0, 0, [[f64::NAN; 3]; 3])];
         assert!(csr.rebuild_from_tiles(2, 1, &bad, &mut scratch).is_err());
+        // one non-finite entry inside `dim` is refused, one outside it (not W's) is not
+        for v in [f64::INFINITY, f64::NEG_INFINITY, f64::NAN] {
+            let mut t = [[1.0; 3]; 3];
+            t[1][0] = v;
+            assert!(csr
+                .rebuild_from_tiles(2, 1, &[(0, 0, t)], &mut scratch)
+                .is_err());
+            let mut t = [[1.0; 3]; 3];
+            t[2][1] = v;
+            assert!(csr
+                .rebuild_from_tiles(2, 1, &[(0, 0, t)], &mut scratch)
+                .is_ok());
+        }
     }
 }
