@@ -496,7 +496,7 @@ pub fn solve_polyhedral_lcp(
         lcp.n
     );
     let verdict = LemkeVerdict::of(problem.dim, ls.status, &measures, settings.lemke.tol);
-    let status = verdict.status_of(ls.status);
+    let status = verdict.status();
     let message = match verdict {
         LemkeVerdict::MissesTheInterval => format!(
             "{what} solved by Lemke in {} pivots (LCP error {}), but the impulses miss \
@@ -520,7 +520,9 @@ pub fn solve_polyhedral_lcp(
             Readable(measures.scaled_error),
             Readable(measures.error_q)
         ),
-        LemkeVerdict::Failed => format!("{what}: Lemke {}: {}{refused}", ls.status, ls.message),
+        LemkeVerdict::PivotLimit | LemkeVerdict::Failed => {
+            format!("{what}: Lemke {}: {}{refused}", ls.status, ls.message)
+        }
     };
     let sol = ContactSolution {
         impulse: r,
@@ -546,7 +548,9 @@ pub(crate) enum LemkeVerdict {
     /// Lemke's own certificate (a residual test on the LCP, in its scaling) failed, but the
     /// impulses pass the exact rule on the original problem.
     PassesTheRule,
-    /// Lemke failed and the impulses miss the rule: its pivot limit or a numerical failure.
+    /// Lemke stopped at its pivot limit and the impulses miss the rule.
+    PivotLimit,
+    /// Lemke failed otherwise (a numerical failure) and the impulses miss the rule.
     Failed,
 }
 
@@ -563,17 +567,17 @@ impl LemkeVerdict {
             LcpStatus::Solved if dim == 2 && !passes => Self::MissesTheInterval,
             LcpStatus::Solved => Self::Solved,
             _ if passes => Self::PassesTheRule,
+            LcpStatus::PivotLimit => Self::PivotLimit,
             _ => Self::Failed,
         }
     }
 
-    /// the contact status of the verdict, Lemke's pivot limit being an iteration limit.
-    pub(crate) fn status_of(self, lemke: LcpStatus) -> ContactStatus {
+    /// the contact status of the verdict.
+    pub(crate) fn status(self) -> ContactStatus {
         match self {
             Self::Solved | Self::PassesTheRule => ContactStatus::Solved,
-            Self::MissesTheInterval => ContactStatus::NumericalFailure,
-            Self::Failed if lemke == LcpStatus::PivotLimit => ContactStatus::IterationLimit,
-            Self::Failed => ContactStatus::NumericalFailure,
+            Self::PivotLimit => ContactStatus::IterationLimit,
+            Self::MissesTheInterval | Self::Failed => ContactStatus::NumericalFailure,
         }
     }
 }

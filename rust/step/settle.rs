@@ -89,6 +89,8 @@ impl Stepper {
         // joint's retarget since changed `v_free`): with as many contacts it found the same
         // ones, which keep the terms the solve gave them
         self.active_kept.clone_from(&self.active);
+        // the search keeps these by binary search: the search builds them in candidate order
+        debug_assert!(self.active_kept.windows(2).all(|w| w[0].cand < w[1].cand));
         self.trial_search = true;
         self.search_contacts();
         self.trial_search = false;

@@ -149,8 +149,7 @@ pub(super) fn solve_polyhedral_warm(
             }
         }
     }
-    let status =
-        LemkeVerdict::of(problem.dim, ls.status, &measures, s.lemke.tol).status_of(ls.status);
+    let status = LemkeVerdict::of(problem.dim, ls.status, &measures, s.lemke.tol).status();
     Ok(Outcome {
         status,
         iterations: ls.pivots,
