@@ -84,7 +84,8 @@ class LcpResult(Result):
     polished : bool
         Whether re-solving the final basis's principal system improved the answer.
     restarts : int
-        Extra covering vectors Lemke tried after a ray termination.
+        Extra covering vectors Lemke tried after a ray termination or a terminal basis
+        whose answer failed ``tol``.
     solutions : ndarray, shape (k, n)
         Every distinct solution (enumeration only).
     solve_time : float
@@ -190,7 +191,8 @@ def solve(
         Re-solve the final basis's principal system on the original data; keep it if better
         (default True).
     restarts : int
-        After a ray termination, how many other covering vectors Lemke tries (only when
+        After a ray termination, or a terminal basis whose answer fails ``tol`` (rounding
+        on a degenerate path), how many other covering vectors Lemke tries (only when
         ``covering_vector`` is not given): an int in [0, 1000], default 2.
     max_iter : int
         PGS sweep limit, an int in [1, 10^9] (default 10,000).

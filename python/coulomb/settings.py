@@ -65,7 +65,8 @@ class LemkeSettings:
     polish : bool
         Re-solve the final basis's principal system and keep it if better (default True).
     restarts : int
-        Other covering vectors tried after a ray termination, in [0, 1000] (default 2).
+        Other covering vectors tried after a ray termination or a terminal basis whose
+        answer fails ``tol``, in [0, 1000] (default 2).
     engine : {"auto", "tableau", "product_form"}
         How the basis inverse is kept (default ``"auto"``).
     """

@@ -16,6 +16,7 @@
 //! Every answer is checked against the *original* M and q with the error measures the
 //! literature reports (`||min(z, w)||_2 / max(1, ||q||_2)`), so figures compare with peers.
 
+mod cycle;
 pub mod enumerate;
 pub(crate) mod kernel;
 pub mod lemke;
@@ -151,7 +152,8 @@ pub struct LcpSolution {
     /// whether the final polish (re-solving the principal system of the final basis) improved
     /// the answer and was kept.
     pub polished: bool,
-    /// covering vectors tried by Lemke (1 unless a ray termination triggered a restart).
+    /// extra covering vectors tried by Lemke (0 unless a ray termination or a failing
+    /// terminal basis triggered a restart).
     pub restarts: usize,
     /// every distinct solution (enumeration only; empty otherwise).
     pub solutions: Vec<Vec<f64>>,

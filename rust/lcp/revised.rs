@@ -21,6 +21,7 @@
 //! When the file holds `cap` etas (long, degenerate paths) it is folded into an explicit
 //! dense `B_0^{-1}` (each η applied to it as a rank-one update) and a new file starts.
 
+use super::cycle::CycleWatch;
 use super::kernel::{self, axpy, Isa};
 use super::scaling::Equilibration;
 use super::ties;
@@ -35,6 +36,9 @@ pub(super) enum PathEnd {
     Ray,
     /// the pivot limit was reached.
     Limit,
+    /// the path returned to a state it had passed (rounding at degenerate ties; see
+    /// [`super::cycle`]).
+    Cycle,
     /// the arithmetic broke down (non-finite or no admissible pivot).
     NonFinite,
 }
@@ -535,6 +539,8 @@ impl RevisedLemke {
             return (PathEnd::NonFinite, 1);
         }
         let mut pivots = 1;
+        let mut watch = CycleWatch::new();
+        watch.pivot(z0, leaving, pivots);
         loop {
             if leaving == z0 {
                 return (PathEnd::Terminal, pivots);
@@ -558,6 +564,9 @@ impl RevisedLemke {
             pivots += 1;
             if !self.pivot(r, entering) {
                 return (PathEnd::NonFinite, pivots);
+            }
+            if watch.pivot(entering, leaving, pivots) {
+                return (PathEnd::Cycle, pivots);
             }
         }
     }

@@ -30,6 +30,7 @@
 use super::bodies::BodyInfo;
 use super::law::curvature_term;
 use super::{BodyKind, Restitution, StepRecord, Stepper};
+use crate::contact::ContactStatus;
 use crate::error::Result;
 
 /// the solves again at most after the first (each adds a contact or lowers a term).
@@ -129,6 +130,12 @@ impl Stepper {
         }
         let (h, tol) = (self.settings.h, self.settings.gap_tolerance);
         for _ in 0..SETTLE_PASSES {
+            // an answer that failed is no velocity to check predictions on: a joint
+            // retargeted on it can carry its error into `v_free`, and a later solve of that
+            // problem would report the step solved; the step keeps the failure instead
+            if record.status.is_some_and(|s| s != ContactStatus::Solved) {
+                break;
+            }
             self.trial_velocity();
             let retargeted = match self.joints.as_mut() {
                 Some(js) => js.retarget(

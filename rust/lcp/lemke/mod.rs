@@ -62,7 +62,8 @@ pub struct LemkeSettings {
     pub warm_start: Option<Vec<usize>>,
     /// re-solve the final basis's principal system and keep it if better.
     pub polish: bool,
-    /// after a ray termination, how many other covering vectors to try (only when
+    /// after a ray termination, or a terminal basis whose answer fails `tol` (rounding on a
+    /// degenerate path), how many other covering vectors to try (only when
     /// `covering_vector` is `None`). A secondary ray proves infeasibility only for
     /// copositive-plus M; for other matrices a different path may still find a solution.
     pub restarts: usize,
@@ -105,6 +106,8 @@ enum Ending {
     Terminal,
     Ray,
     Limit,
+    /// the path came back to a state it had passed ([`super::cycle`]).
+    Cycle,
     NonFinite,
 }
 
@@ -254,6 +257,7 @@ fn follow_path(
             PathEnd::Terminal => Ending::Terminal,
             PathEnd::Ray => Ending::Ray,
             PathEnd::Limit => Ending::Limit,
+            PathEnd::Cycle => Ending::Cycle,
             PathEnd::NonFinite => Ending::NonFinite,
         };
         path.pivots = k;
@@ -345,7 +349,7 @@ fn verdict(
 ) -> bool {
     let m = out.measures;
     match ending {
-        Ending::Ray | Ending::Limit if passes(&m, tol) => {
+        Ending::Ray | Ending::Limit | Ending::Cycle if passes(&m, tol) => {
             out.status = LcpStatus::Solved;
             out.message = format!(
                 "solved in {} pivots (error {}{}; the path ended on {}, but the answer \
@@ -353,10 +357,10 @@ fn verdict(
                 out.pivots,
                 Readable(m.error),
                 if polished { ", polished" } else { "" },
-                if ending == Ending::Ray {
-                    "a ray"
-                } else {
-                    "the pivot limit"
+                match ending {
+                    Ending::Ray => "a ray",
+                    Ending::Cycle => "a cycle",
+                    _ => "the pivot limit",
                 }
             );
             return true;
@@ -371,16 +375,28 @@ fn verdict(
             );
             return true;
         }
+        // a rounding casualty of degenerate pivots (a wrong leaving row on a singular W,
+        // for example): another covering vector takes another path, so not final
         Ending::Terminal => {
             out.status = LcpStatus::NumericalFailure;
             out.message = format!(
                 "z0 left the basis but the answer fails tol {}: error {}, \
-                 scaled error {} (ill-conditioned basis)",
+                 scaled error {} (ill-conditioned basis; {} covering vector(s) tried)",
                 Readable(tol),
                 Readable(m.error),
-                Readable(m.scaled_error)
+                Readable(m.scaled_error),
+                attempt + 1
             );
-            return true;
+        }
+        Ending::Cycle => {
+            out.status = LcpStatus::NumericalFailure;
+            out.message = format!(
+                "the path cycled (rounding at degenerate ties) after {} pivots, with {} \
+                 covering vector(s) tried: error {}",
+                out.pivots,
+                attempt + 1,
+                Readable(m.error)
+            );
         }
         Ending::Ray => {
             out.status = LcpStatus::RayTermination;
@@ -476,6 +492,9 @@ pub fn solve_lemke_with(
     let mut z = vec![0.0; n];
     let mut basis = Vec::with_capacity(n);
     let mut abandoned = 0;
+    // the best answer of a path that ended on a basis failing tol or cycled: reported over
+    // a later path's ray or limit, which would otherwise claim more than rounding allows
+    let mut failed_terminal: Option<LcpSolution> = None;
     for attempt in 0..tries {
         if attempt > 0 && crate::interrupt::poll(n * n) {
             break;
@@ -497,6 +516,17 @@ pub fn solve_lemke_with(
         if verdict(&mut out, ending, polished, tol, max_pivots, attempt) {
             return Ok(with_fallback_note(out, abandoned));
         }
+        let keep = matches!(ending, Ending::Terminal | Ending::Cycle)
+            && failed_terminal
+                .as_ref()
+                .is_none_or(|f| better(&out.measures, &f.measures));
+        if keep {
+            failed_terminal = Some(out.clone());
+        }
+    }
+    if let Some(mut f) = failed_terminal {
+        (f.pivots, f.restarts) = (out.pivots, out.restarts);
+        out = f;
     }
     Ok(with_fallback_note(out, abandoned))
 }

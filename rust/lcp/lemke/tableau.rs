@@ -3,6 +3,7 @@
 //! lexicographic ratio test over its rows, and one step of iterative refinement of a terminal
 //! answer through the inverse it holds.
 
+use super::super::cycle::CycleWatch;
 use super::super::kernel::{self, axpy, Isa};
 use super::super::revised::RevisedLemke;
 use super::super::scaling::Equilibration;
@@ -341,6 +342,8 @@ impl LemkeWorkspace {
             return (Ending::NonFinite, 1);
         }
         let mut pivots = 1;
+        let mut watch = CycleWatch::new();
+        watch.pivot(z0, leaving, pivots);
         loop {
             if leaving == z0 {
                 return (Ending::Terminal, pivots);
@@ -364,6 +367,9 @@ impl LemkeWorkspace {
             pivots += 1;
             if !self.pivot(r, s) {
                 return (Ending::NonFinite, pivots);
+            }
+            if watch.pivot(entering, leaving, pivots) {
+                return (Ending::Cycle, pivots);
             }
         }
     }
