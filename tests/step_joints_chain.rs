@@ -120,15 +120,13 @@ fn lowest_gap(dim: usize, st: &Stepper, n: usize, r: f64) -> f64 {
 /// drops the chain and checks every step: no link below the floor by more than `sink` (m;
 /// before the step checked its predictions on its own velocity, 1.6e-4 m), the joints closed, each closed contact's law (`P_n >= 0`, `v_n >= 0`,
 /// `|P_t| <= mu P_n`, and a contact that pushed keeps its gap), the contact problem solved
-/// to within `err` (scaled), the momentum balanced; and the chain at rest at the end. The
-/// cone is checked to `cone` times the step's largest impulse beyond rounding (Lemke's
-/// answers are exact to its LCP tolerance, NSGS's projected onto the cone).
+/// to within `err` (scaled), the momentum balanced; and the chain at rest at the end.
 fn drop_and_check(
     dim: usize,
     n: usize,
     steps: usize,
     settings: &StepSettings,
-    [sink, err, cone]: [f64; 3],
+    [sink, err]: [f64; 2],
 ) {
     let (sc, joints, r) = dropped_chain(dim, n, 0.4);
     let mut st = Stepper::with_joints(&sc, &joints, settings).unwrap();
@@ -160,7 +158,6 @@ fn drop_and_check(
         // each closed contact: P_n >= 0, no approach, inside the cone; and the position
         // form of complementarity: a contact that pushed holds its gap over the step (its
         // velocity condition carries the curvature term, not recorded)
-        let pmax = (contacts.iter().flat_map(|c| &c.impulse)).fold(0.0f64, |m, x| m.max(x.abs()));
         for c in contacts.iter().filter(|c| c.closed) {
             touched = true;
             let (pn, vn) = (c.impulse[0], c.velocity[0]);
@@ -168,7 +165,7 @@ fn drop_and_check(
             assert!(pn >= -1e-15, "dim {dim} step {k}: P_n = {pn:.3e}");
             assert!(vn >= -10.0 * err, "dim {dim} step {k}: v_n = {vn:.3e}");
             assert!(
-                pt <= 0.3 * pn * (1.0 + 1e-9) + 1e-15 + cone * pmax,
+                pt <= 0.3 * pn * (1.0 + 1e-9) + 1e-15,
                 "dim {dim} step {k}: outside the cone ({pt:.3e} against P_n {pn:.3e})"
             );
         }
@@ -212,22 +209,25 @@ fn drop_and_check(
 
 #[test]
 fn a_chain_dropped_on_the_floor_never_sinks_into_it_with_nsgs() {
-    drop_and_check(2, 12, 900, &StepSettings::new(1e-3, 0), [1e-8, 1e-10, 0.0]);
+    // every step within the step's own tolerance, 1e-12: at rest the joints' rounding-sized
+    // targets once made the sticking contacts inconsistent with the joints at that level,
+    // and the 2D chain ended two steps at 1.4e-12 (the 3D one fell back to Lemke 397 times)
+    drop_and_check(2, 12, 900, &StepSettings::new(1e-3, 0), [1e-8, 1e-12]);
     // in 3D a link ended 9e-5 m into the floor at step 268 while the search on the step's
     // velocity swapped two contacts for two others and was taken as unchanged
-    drop_and_check(3, 12, 900, &StepSettings::new(1e-3, 0), [1e-9, 1e-10, 0.0]);
+    drop_and_check(3, 12, 900, &StepSettings::new(1e-3, 0), [1e-9, 1e-12]);
 }
 
 #[test]
 fn a_chain_dropped_on_the_floor_never_sinks_into_it_with_lemke() {
     let mut settings = StepSettings::new(1e-3, 0);
     settings.solver = StepSolver::Lemke(PolyhedralSettings::for_dim(2));
-    drop_and_check(2, 6, 700, &settings, [1e-7, 1e-8, 1e-12]);
+    drop_and_check(2, 6, 700, &settings, [1e-7, 1e-8]);
     // in 3D (8 facets) the contacts' LCPs are degenerate (a singular W, contacts in
     // symmetric pairs). Step 288 of 6 links once ended with a link 5.2e-4 m into the floor
     // and was reported solved: its first Lemke path ended on a failing basis, the joints
     // were retargeted on that answer's velocity (3e4 rad/s), and a later solve of the
     // corrupted problem passed. Then a path that cycled to the pivot limit (step 330)
     settings.solver = StepSolver::Lemke(PolyhedralSettings::for_dim(3));
-    drop_and_check(3, 12, 900, &settings, [1e-7, 1e-8, 1e-8]);
+    drop_and_check(3, 12, 900, &settings, [1e-7, 1e-8]);
 }

@@ -122,6 +122,8 @@ pub struct PolyhedralLcp {
     lambda: Vec<Option<usize>>,
     /// per contact, the unit `c_i` of its λ column and last row (see the module notes).
     unit: Vec<f64>,
+    /// per contact, mu (the bound of `1^T β`).
+    mu: Vec<f64>,
 }
 
 impl PolyhedralLcp {
@@ -224,6 +226,7 @@ impl PolyhedralLcp {
             beta,
             lambda,
             unit,
+            mu: problem.mu.to_vec(),
         })
     }
 
@@ -265,17 +268,27 @@ impl PolyhedralLcp {
     }
 
     /// the contact impulses `r_i = (r_n, D_i β_i)` (`dim nc` entries) of an LCP answer z.
+    ///
+    /// The answer is taken into the polygon exactly: Lemke's z meets `z >= 0` and
+    /// `1^T β <= mu r_n` only to rounding (a β of 1e-14 beside `r_n = 0`: friction with no
+    /// normal impulse), so negative entries count as 0 and β is scaled down to `mu r_n` where
+    /// it exceeds it, a change at the LCP's rounding level.
     pub fn impulses(&self, z: &[f64]) -> Vec<f64> {
         let dim = self.dim;
         let nc = self.beta.len();
         let mut r = vec![0.0; dim * nc];
         for i in 0..nc {
-            r[i * dim] = z[i];
+            let rn = z[i].max(0.0);
+            r[i * dim] = rn;
+            let sum: f64 = self.beta_range(i).map(|k| z[k].max(0.0)).sum();
+            let bound = self.mu[i] * rn;
+            let shrink = if sum > bound { bound / sum } else { 1.0 };
             for (k, zk) in self.beta_range(i).enumerate() {
                 let d = self.directions[k];
                 let e = self.scale[i];
+                let b = z[zk].max(0.0) * shrink;
                 for t in 0..dim - 1 {
-                    r[i * dim + 1 + t] += e[t] * d[t] * z[zk];
+                    r[i * dim + 1 + t] += e[t] * d[t] * b;
                 }
             }
         }

@@ -259,6 +259,7 @@ impl JointSystem {
         self.qs.extend_from_slice(q);
         for isl in &mut islands {
             self.remainders(isl, bodies, q, v, h);
+            isl.drop_small_targets(h, gap_tol);
         }
         for isl in &mut islands {
             for &l in &isl.limits {
@@ -286,6 +287,7 @@ impl JointSystem {
                 // a stop changes the velocity by O(1) (a rebound): the remainder on the
                 // velocity the step will have
                 self.remainders(isl, bodies, q, v_free, h);
+                isl.drop_small_targets(h, gap_tol);
                 self.reproject(isl, bodies, v_free);
             }
         }
