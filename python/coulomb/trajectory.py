@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from . import _trajectory_checks as _checks
 from ._extras import require
 from ._readable import readable
 from ._result import Result
@@ -55,9 +56,6 @@ def _load_power(scene: Scene | None, v: np.ndarray) -> np.ndarray:
     return np.asarray(v @ f, dtype=np.float64)
 
 
-#: the tolerance of a step's error_q half when the solver's tol is tighter (Rust
-#: ``step::solve::STEP_ERROR_Q_TOL``).
-_STEP_ERROR_Q_TOL = 1e-9
 
 
 class TrajectoryCheckError(CoulombError, AssertionError):
@@ -382,7 +380,7 @@ class Trajectory:
         n = len(self.t) - 1
         statuses, counts = np.unique(self.solver_status, return_counts=True)
         st = ", ".join(f"{s}: {c}" for s, c in zip(statuses, counts, strict=True))
-        worst = self._worst()
+        worst = _checks.worst(self)
         lines = [
             f"Trajectory({n} steps of h = {self.h:.3g} s to t = {self.t[-1]:.6g} s, "
             f"solver {self.solver!r}",
@@ -400,20 +398,6 @@ class Trajectory:
     __str__ = __repr__
 
     # -- checks ----------------------------------------------------------------------------
-
-    def _worst(self) -> dict[str, float]:
-        def mx(a: np.ndarray) -> float:
-            return float(np.max(a)) if len(a) else 0.0
-
-        return {
-            "momentum_residual": mx(self.momentum_residual),
-            "solver_error": mx(self.solver_error),
-            "solver_scaled_error": mx(self.solver_scaled_error),
-            "solver_error_q": mx(self.solver_error_q),
-            "cone_violation": mx(self.cone_violation),
-            "complementarity": mx(self.complementarity),
-            "energy_gain": float(np.max(self.energy_gain(), initial=0.0)),
-        }
 
     def step_energy(self) -> np.ndarray:
         """The energy the impulse step keeps, ``E_h = T + V + (h/2) f . v`` per state (J; see
@@ -433,28 +417,7 @@ class Trajectory:
         term pushes every other step) each is judged against the highest energy since the
         run's landing step began, so a rebound already judged is not counted again as a gain
         of the next step."""
-        e, w = self.total_energy, 0.5 * self.h * self.load_power
-        gain = np.diff(e) - np.abs(np.diff(w))
-        start = 0  # the state before the landing step of the current run of rebounds
-        for k in np.flatnonzero(self.resumed):
-            if k < 1:
-                continue
-            if not self.resumed[k - 1]:
-                start = k - 1
-            ref = int(start + np.argmax(e[start:k + 1]))
-            gain[k] = e[k + 1] - e[ref] - abs(w[k + 1] - w[ref])
-        return gain
-
-    def _energy_tolerance(self, energy_tol: float) -> float:
-        """``energy_tol`` times the trajectory's energy scale, the largest
-        ``|T| + |V| + |(h/2) f . v|`` over its states (the terms ``E_h`` is summed from, so
-        the rounding of ``E_h`` and of the contact solves' residuals is in proportion):
-        unit-consistent, with no absolute floor."""
-        t, p = self.kinetic_energy, self.potential_energy
-        w = 0.5 * self.h * self.load_power
-        if len(t) == 0:
-            return 0.0
-        return energy_tol * float(np.max(np.abs(t) + np.abs(p) + np.abs(w)))
+        return _checks.energy_gain(self)
 
     def check(
         self,
@@ -499,63 +462,11 @@ class Trajectory:
         ``restitution="poisson"`` never gains for one frictional contact. With
         ``strict=True`` a violation raises :class:`TrajectoryCheckError`.
         """
-        v: list[str] = []
-        if self.stopped is not None:
-            v.append(f"stopped early: {self.stopped}")
-        for name in ("q", "v", "contact_impulse"):
-            if not np.all(np.isfinite(getattr(self, name))):
-                v.append(f"{name} has non-finite values")
-        status = self.solver_status
-        bad = [(k, s) for k, s in enumerate(status) if s not in ("solved", "no_contact")]
-        if bad:
-            k, s = bad[0]
-            v.append(f"{len(bad)} contact solves did not succeed (first: step {k}, {s}, "
-                     f"scaled_error {readable(self.solver_scaled_error[k])})")
-        # the verdict's own rule on the recorded measure (see the docstring)
-        exact = self.solver != "lemke" or self._planar()
-        if exact:
-            tol = np.where(self.fallback, max(self.tol, 1e-9), self.tol)
-            se = self.solver_scaled_error
-            solved = np.array([s == "solved" for s in status], dtype=bool)
-            wrong = np.flatnonzero(solved & ~(se <= tol))
-            if len(wrong):
-                k = int(wrong[0])
-                v.append(f"{len(wrong)} steps reported solved whose scaled_error exceeds tol "
-                         f"(first: step {k}, {readable(se[k])} > {readable(tol[k])})")
-            eq, floor = self.solver_error_q, self.solver_error_q_floor
-            # a step's error_q half has the tolerance max(tol, 1e-9) (the core's
-            # STEP_ERROR_Q_TOL: error_q follows stacked contacts less closely than 1e-12)
-            allowed = np.maximum(np.maximum(tol, _STEP_ERROR_Q_TOL), floor)
-            wrong = np.flatnonzero(solved & ~(eq <= allowed))
-            if len(wrong):
-                k = int(wrong[0])
-                v.append(f"{len(wrong)} steps reported solved whose error_q exceeds "
-                         f"max(tol, error_q_floor) (first: step {k}, {readable(eq[k])} > "
-                         f"{readable(allowed[k])})")
-        res = self.momentum_residual
-        if np.any(res > momentum_tol):
-            v.append(f"momentum residual up to {readable(res.max())} > {readable(momentum_tol)}")
-        if gap_tol is None:
-            gap_tol = self.gap_tolerance
-        gaps = self.min_gap
-        if np.any(gaps < -gap_tol):
-            k = int(np.argmin(gaps))
-            v.append(f"penetration: min gap {gaps[k]:.3e} m at t = {self.t[k]:.6g} s "
-                     f"({int(np.sum(gaps < -gap_tol))} states)")
-        etol = self._energy_tolerance(energy_tol)
-        gain = self.energy_gain()
-        if np.any(gain > etol):
-            k = int(np.argmax(gain))
-            v.append(f"energy gained in {int(np.sum(gain > etol))} steps, up to "
-                     f"{gain[k]:.3e} J (step {k}, t = {self.t[k]:.6g} s)")
-        out = Result(ok=not v, violations=v, **self._worst())
-        if strict and v:
-            raise TrajectoryCheckError("; ".join(v))
+        out = _checks.check(self, momentum_tol=momentum_tol, energy_tol=energy_tol,
+                            gap_tol=gap_tol)
+        if strict and not out.ok:
+            raise TrajectoryCheckError("; ".join(out.violations))
         return out
-
-    def _planar(self) -> bool:
-        """Whether the contacts are planar (dim 2), where the polyhedral cone is exact."""
-        return self.dim == 2
 
     # -- plots -----------------------------------------------------------------------------
 
