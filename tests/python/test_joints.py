@@ -282,3 +282,66 @@ def test_a_welded_pair_falls_as_one_body_at_every_scale(dim: int, scale: float,
         assert abs(z + 9.81 * h * h * n * (n + 1) / 2) < 1e-9 * max(scale, 1.0), (body, z)
     rel = tr.q[:, layout[1][0]][:, :dim] - tr.q[:, layout[0][0]][:, :dim]
     assert np.max(np.abs(rel - rel[0])) < 1e-12 * scale
+
+
+def dropped_chain(dim: int, n: int, tilt: float = 0.4) -> coulomb.Scene:
+    """``n`` rods (10 g, 5 cm, radius 4 mm) hinged end to end, tilted by ``tilt`` in the
+    vertical plane, the lowest end 0.3 m up; mu 0.3, e 0 against the floor."""
+    m, length, radius, z_low = 0.01, 0.05, 0.004, 0.3
+    c, s = math.cos(tilt), math.sin(tilt)
+    up = dim - 1
+    scene = coulomb.Scene(dim=dim, gravity=tuple(-G if k == up else 0.0 for k in range(dim)))
+    floor = scene.add(coulomb.HalfSpace(point=(0.0,) * dim,
+                                        normal=tuple(float(k == up) for k in range(dim))))
+    end = tuple(length / 2 if k == 0 else 0.0 for k in range(dim))
+    links: list[coulomb.model.Body] = []
+    for k in range(n):
+        x, z = (k + 0.5) * length * c, z_low + (k + 0.5) * length * s
+        if dim == 2:
+            link = scene.add(coulomb.RigidBody2D(mass=m, inertia=m * length**2 / 12,
+                                                 position=(x, z), angle=tilt))
+        else:
+            side = m * (3 * radius**2 + length**2) / 12
+            link = scene.add(coulomb.RigidBody3D(
+                mass=m, inertia=np.diag([m * radius**2 / 2, side, side]),
+                position=(x, 0.0, z), orientation=quat_about_minus_y(tilt)))
+        rod = scene.attach(link, coulomb.Segment(a=tuple(-e for e in end), b=end,
+                                                 radius=radius))
+        scene.contact(rod, floor, mu=0.3)
+        if links:
+            a = (k * length * c, z_low + k * length * s)
+            anchor = a if dim == 2 else (a[0], 0.0, a[1])
+            scene.add(coulomb.Revolute(link, links[-1], anchor=anchor,
+                                       axis=None if dim == 2 else (0, 1, 0)))
+        links.append(link)
+    return scene
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("solver", ["nsgs", "lemke"])
+def test_a_dropped_chain_comes_to_rest_flat_with_every_step_solved(dim: int, solver: str
+                                                                    ) -> None:
+    # every step solved to the step's tolerance, the checks clean, the links flat on the
+    # floor at the end (NSGS once stopped at 1.4e-12 against 1e-12 on the resting chain, and
+    # a 3D Lemke step once reported solved with a link 5e-4 m into the floor)
+    n = 8
+    tr = dropped_chain(dim, n).simulate(t_end=0.9, h=1e-3, solver=solver)
+    status = np.asarray(tr.solver_status)
+    missed = np.flatnonzero((status != "solved") & (status != "no_contact"))
+    if solver == "nsgs":
+        assert tr.success, tr.message
+        report = tr.check()
+        assert report.ok, report.violations
+    else:
+        # Lemke's polished answer on a degenerate basis (a W of low rank, contacts in
+        # symmetric pairs) can miss the contact rule by a few times its 1e-9: reported so,
+        # about one step in 900 on these chains; never a wrong answer called solved
+        assert len(missed) <= 2, (missed, tr.solver_scaled_error[missed])
+        assert np.all(tr.solver_scaled_error[missed] < 1e-8)
+        report = tr.check()
+        assert all("did not succeed" in v for v in report.violations), report.violations
+    assert np.min(tr.min_gap) > -1e-7
+    nq = 3 if dim == 2 else 7
+    up = tr.q[-1, 1::3] if dim == 2 else tr.q[-1, 2::nq]
+    assert np.max(np.abs(up - 0.004)) < 1e-7, up - 0.004
+    assert tr.kinetic_energy[-1] < 1e-20
