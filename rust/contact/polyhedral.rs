@@ -71,7 +71,7 @@
 //! that rule are a solution even where Lemke's own certificate failed (a badly scaled LCP,
 //! bodies of very different masses).
 
-use super::{measure_into, ContactProblem, ContactSolution, ContactStatus};
+use super::{measure_into, ContactProblem, ContactSolution};
 use crate::error::{CoulombError, Result};
 use crate::lcp::{
     measure as measure_lcp, solve_lemke, LcpRef, LcpSolution, LcpStatus, LemkeEngine,
@@ -548,53 +548,6 @@ pub fn solve_polyhedral_lcp(
     Ok((sol, lcp, ls))
 }
 
-/// Lemke's verdict on a friction-contact problem, shared by [`solve_polyhedral`] and the
-/// stepper's Lemke: from Lemke's status on the polyhedral LCP and the impulses' measures on
-/// the contact problem (`measures`, the exact disk), against `tol`.
-#[derive(Clone, Copy, PartialEq, Eq, Debug)]
-pub(crate) enum LemkeVerdict {
-    /// 2D: the polygon is the interval, so the LCP is the problem and the success rule of
-    /// every contact method applies to the impulses; Lemke solved the LCP but they miss it.
-    MissesTheInterval,
-    /// Lemke solved the LCP (in 3D the polygon's answer, whatever it misses of the disk).
-    Solved,
-    /// Lemke's own certificate (a residual test on the LCP, in its scaling) failed, but the
-    /// impulses pass the exact rule on the original problem.
-    PassesTheRule,
-    /// Lemke stopped at its pivot limit and the impulses miss the rule.
-    PivotLimit,
-    /// Lemke failed otherwise (a numerical failure) and the impulses miss the rule.
-    Failed,
-}
-
-impl LemkeVerdict {
-    /// the verdict of Lemke's `status` with impulses measuring `measures` in `dim`.
-    pub(crate) fn of(
-        dim: usize,
-        status: LcpStatus,
-        measures: &super::ContactMeasures,
-        tol: f64,
-    ) -> Self {
-        let passes = measures.passes(tol);
-        match status {
-            LcpStatus::Solved if dim == 2 && !passes => Self::MissesTheInterval,
-            LcpStatus::Solved => Self::Solved,
-            _ if passes => Self::PassesTheRule,
-            LcpStatus::PivotLimit => Self::PivotLimit,
-            _ => Self::Failed,
-        }
-    }
-
-    /// the contact status of the verdict.
-    pub(crate) fn status(self) -> ContactStatus {
-        match self {
-            Self::Solved | Self::PassesTheRule => ContactStatus::Solved,
-            Self::PivotLimit => ContactStatus::IterationLimit,
-            Self::MissesTheInterval | Self::Failed => ContactStatus::NumericalFailure,
-        }
-    }
-}
-
 /// Solves the friction-contact problem on the polyhedral cone by Lemke's method (see the
 /// module notes). `iterations` counts Lemke's pivots; success means the LCP was solved.
 pub fn solve_polyhedral(
@@ -606,6 +559,9 @@ pub fn solve_polyhedral(
 
 #[path = "polyhedral_large_mu.rs"]
 mod large_mu;
+#[path = "polyhedral_verdict.rs"]
+mod verdict;
+pub(crate) use verdict::LemkeVerdict;
 
 #[cfg(test)]
 #[path = "polyhedral_tests.rs"]

@@ -1,6 +1,7 @@
 //! Unit tests of `polyhedral.rs`.
 
 use super::*;
+use crate::contact::ContactStatus;
 
 #[test]
 fn the_chapter_lcp_is_assembled_as_on_the_slide() {

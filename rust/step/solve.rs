@@ -11,6 +11,7 @@ use crate::contact::{
     NsgsSettings, PolyhedralSettings,
 };
 use crate::error::Result;
+use crate::lcp::lemke::spread;
 use crate::lcp::{solve_lemke_with, LcpRef, LcpStatus, LemkeWorkspace};
 
 /// from this many active contacts on, a step's W is assembled in block CSR (its NSGS sweep then
@@ -136,13 +137,10 @@ pub(super) fn solve_polyhedral_warm(
             if ls.status != LcpStatus::Solved || measures.passes(s.lemke.tol) {
                 break;
             }
-            let phi = 0.618_033_988_749_895 * attempt as f64;
+            let mut cover = vec![0.0; lcp.n];
+            spread(attempt, &mut cover);
             settings.warm_start = None;
-            settings.covering_vector = Some(
-                (0..lcp.n)
-                    .map(|i| 0.5 + ((i as f64 + 1.0) * phi).fract())
-                    .collect(),
-            );
+            settings.covering_vector = Some(cover);
             let other = solve_lemke_with(lw, &lref, &settings)?;
             let r = lcp.impulses(&other.z);
             let mut u = vec![0.0; problem.size()];

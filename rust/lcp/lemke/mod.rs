@@ -37,14 +37,15 @@
 
 mod answer;
 mod tableau;
+mod verdict;
 
 use super::revised::{PathEnd, RevisedLemke};
 use super::scaling::Equilibration;
 use super::{check_tol, passes, LcpRef, LcpSolution, LcpStatus, WarmStart};
 use crate::error::{check_finite, CoulombError, Result};
-use crate::readable::Readable;
 use answer::{better, candidate, principal, with_fallback_note, Candidate};
 pub use tableau::LemkeWorkspace;
+use verdict::verdict;
 
 /// Settings of [`solve_lemke`].
 #[derive(Clone, Debug)]
@@ -178,6 +179,15 @@ pub fn solve_lemke(lcp: &LcpRef<'_>, settings: &LemkeSettings) -> Result<LcpSolu
     solve_lemke_with(&mut ws, lcp, settings)
 }
 
+/// The k-th fixed low-discrepancy spread in [0.5, 1.5) (`k >= 1`): a covering vector that is
+/// reproducible and never zero, for paths other than the all-ones one.
+pub(crate) fn spread(k: usize, out: &mut [f64]) {
+    let phi = 0.618_033_988_749_895 * k as f64;
+    for (i, v) in out.iter_mut().enumerate() {
+        *v = 0.5 + ((i as f64 + 1.0) * phi).fract();
+    }
+}
+
 /// The i-th covering vector on the equilibrated problem: the user's (scaled), all ones, then
 /// for restarts the user-units ones and deterministic spreads.
 fn covering(k: usize, eq: &Equilibration, user: Option<&[f64]>, out: &mut [f64]) {
@@ -189,13 +199,7 @@ fn covering(k: usize, eq: &Equilibration, user: Option<&[f64]>, out: &mut [f64])
         }
         (None, 0) => out.iter_mut().for_each(|v| *v = 1.0),
         (None, 1) => out.copy_from_slice(&eq.row),
-        (None, _) => {
-            // a fixed low-discrepancy spread in [0.5, 1.5): reproducible, never zero
-            let phi = 0.618_033_988_749_895 * k as f64;
-            for (i, v) in out.iter_mut().enumerate() {
-                *v = 0.5 + ((i as f64 + 1.0) * phi).fract();
-            }
-        }
+        (None, _) => spread(k, out),
     }
     let dmax = out.iter().fold(0.0f64, |m, v| m.max(*v));
     if dmax > 0.0 {
@@ -335,94 +339,6 @@ fn best_answer(
         }
         None => (candidate(lcp, eq, z.to_vec()), false),
     }
-}
-
-/// The status and message of a path's answer (already in `out`); `true` when it is final,
-/// `false` after a ray, which a restart with another covering vector may still overcome.
-fn verdict(
-    out: &mut LcpSolution,
-    ending: Ending,
-    polished: bool,
-    tol: f64,
-    max_pivots: usize,
-    attempt: usize,
-) -> bool {
-    let m = out.measures;
-    match ending {
-        Ending::Ray | Ending::Limit | Ending::Cycle if passes(&m, tol) => {
-            out.status = LcpStatus::Solved;
-            out.message = format!(
-                "solved in {} pivots (error {}{}; the path ended on {}, but the answer \
-                 there passes tol)",
-                out.pivots,
-                Readable(m.error),
-                if polished { ", polished" } else { "" },
-                match ending {
-                    Ending::Ray => "a ray",
-                    Ending::Cycle => "a cycle",
-                    _ => "the pivot limit",
-                }
-            );
-            return true;
-        }
-        Ending::Terminal if passes(&m, tol) => {
-            out.status = LcpStatus::Solved;
-            out.message = format!(
-                "solved in {} pivots (error {}{})",
-                out.pivots,
-                Readable(m.error),
-                if polished { ", polished" } else { "" }
-            );
-            return true;
-        }
-        // a rounding casualty of degenerate pivots (a wrong leaving row on a singular W,
-        // for example): another covering vector takes another path, so not final
-        Ending::Terminal => {
-            out.status = LcpStatus::NumericalFailure;
-            out.message = format!(
-                "z0 left the basis but the answer fails tol {}: error {}, \
-                 scaled error {} (ill-conditioned basis; {} covering vector(s) tried)",
-                Readable(tol),
-                Readable(m.error),
-                Readable(m.scaled_error),
-                attempt + 1
-            );
-        }
-        Ending::Cycle => {
-            out.status = LcpStatus::NumericalFailure;
-            out.message = format!(
-                "the path cycled (rounding at degenerate ties) after {} pivots, with {} \
-                 covering vector(s) tried: error {}",
-                out.pivots,
-                attempt + 1,
-                Readable(m.error)
-            );
-        }
-        Ending::Ray => {
-            out.status = LcpStatus::RayTermination;
-            out.message = format!(
-                "ray termination after {} pivots with {} covering vector(s): no solution \
-                 found on Lemke's path (for copositive-plus M, e.g. positive semidefinite, \
-                 this proves there is none)",
-                out.pivots,
-                attempt + 1
-            );
-        }
-        Ending::Limit => {
-            out.status = LcpStatus::PivotLimit;
-            out.message = format!(
-                "stopped at the pivot limit ({max_pivots}) with error {}",
-                Readable(m.error)
-            );
-            return true;
-        }
-        Ending::NonFinite => {
-            out.status = LcpStatus::NumericalFailure;
-            out.message = format!("the tableau became non-finite after {} pivots", out.pivots);
-            return true;
-        }
-    }
-    false
 }
 
 /// Solves the LCP by Lemke's method, reusing `ws` (resized if needed).
