@@ -58,9 +58,10 @@ use parry3d_f64::query::{
 use parry2d_f64::shape::Shape as Parry2;
 use parry3d_f64::shape::Shape as Parry3;
 
+use super::box_pair::{box_pair, BoxPair};
 use super::convex::{convex2, convex3, Convex2, Convex3};
 use super::shape2::{check_pose2, Shape2};
-use super::shape3::{check_pose3, Shape3};
+use super::shape3::{check_pose3, Shape3, ShapeKind3};
 use crate::error::{CoulombError, Result};
 
 /// Which features touch: the parts of a and b (index of a compound's part, of a mesh's or a
@@ -256,13 +257,16 @@ macro_rules! contacts_impl {
     ($(#[$doc:meta])* $name:ident, $raw:ident, $shape:ty, $iso:ident, $vec:ident, $point:ident,
      $cache:ident, $dispatcher:ident, $check_pose:ident, $manifold:ty, $workspace:ty,
      $dynshape:ty, $tracked:ident, $face:ident, $part_face:ident, $convex:ident,
-     $convex_ws:ty) => {
+     $convex_ws:ty, $pair:ident, $boxes:ident) => {
         /// parry's manifolds of `a` at `pose_a` and `b` at `pose_b` translated by `shift`,
         /// converted; gaps taken back to the unshifted poses (`g - n · shift`, exact while the
-        /// same features touch), kept when `<= prediction`.
+        /// same features touch), kept when `<= prediction`. `boxes`: both shapes are boxes,
+        /// whose manifold module `box_pair` may give exactly; the return value says whether
+        /// it did (no second query is then needed).
         #[allow(clippy::too_many_arguments)]
         fn $raw(
             (a, b): (&$dynshape, &$dynshape),
+            boxes: bool,
             unit: f64,
             pose_a: &$iso<f64>,
             pose_b: &$iso<f64>,
@@ -271,7 +275,7 @@ macro_rules! contacts_impl {
             manifolds: &mut Vec<$manifold>,
             (workspace, convex): (&mut Option<$workspace>, &mut $convex_ws),
             out: &mut Vec<$point>,
-        ) -> Result<()> {
+        ) -> Result<bool> {
             out.clear();
             // no history: parry's incremental update needs old points, and GJK's seed from the
             // last normal tilted a face contact's normal by 4e-7 (a box sliding on a box)
@@ -289,7 +293,8 @@ macro_rules! contacts_impl {
             );
             let pos12 = at.inv_mul(&bt);
             let query = (prediction + shift.norm()) * inv;
-            if !$convex(&pos12, a, b, query, manifolds, convex) {
+            let exact = boxes && $pair(&pos12, a, b, query, manifolds);
+            if !exact && !$convex(&pos12, a, b, query, manifolds, convex) {
                 $dispatcher
                     .contact_manifolds(&pos12, a, b, query, manifolds, workspace)
                     .map_err(|_| {
@@ -380,7 +385,7 @@ macro_rules! contacts_impl {
                     }
                 }
             }
-            Ok(())
+            Ok(exact)
         }
 
         $(#[$doc])*
@@ -422,7 +427,10 @@ macro_rules! contacts_impl {
             };
             let zero = $vec::zeros();
             let ws = (&mut *workspace, &mut *convex);
-            $raw(shapes, unit, pose_a, pose_b, zero, prediction, manifolds, ws, out)?;
+            let boxes = $boxes(a, b);
+            if $raw(shapes, boxes, unit, pose_a, pose_b, zero, prediction, manifolds, ws, out)? {
+                return Ok(());
+            }
             let first = deepest_gap(out, |p| p.gap);
             // a half-space's points are its support feature's vertices: no GJK to go wrong
             if a.is_half_space() || b.is_half_space() {
@@ -451,7 +459,7 @@ macro_rules! contacts_impl {
             };
             let shift = along * (PULL * size);
             let ws = (&mut *workspace, &mut *convex);
-            $raw(shapes, unit, pose_a, pose_b, shift, prediction, manifolds, ws, retry)?;
+            $raw(shapes, false, unit, pose_a, pose_b, shift, prediction, manifolds, ws, retry)?;
             let second = deepest_gap(retry, |p| p.gap);
             if (empty && !retry.is_empty()) || first <= second + PREFER * size {
                 std::mem::swap(out, retry);
@@ -477,12 +485,52 @@ contacts_impl!(
     /// the first beats it by more than `1e-12 L`).
     contacts3, raw3, Shape3, Isometry3, Vector3, ContactPoint3, ContactCache3, Dispatcher3,
     check_pose3, Manifold3<(), ()>, Workspace3, dyn Parry3, Tracked3, face_normal3, part_normal3,
-    convex3, Convex3
+    convex3, Convex3, box_pair3, boxes3
 );
 
 contacts_impl!(
     /// [`contacts3`] in 2D.
     contacts2, raw2, Shape2, Isometry2, Vector2, ContactPoint2, ContactCache2, Dispatcher2,
     check_pose2, Manifold2<(), ()>, Workspace2, dyn Parry2, Tracked2, face_normal2, part_normal2,
-    convex2, Convex2
+    convex2, Convex2, box_pair2, boxes2
 );
+
+/// Whether both shapes are boxes.
+fn boxes3(a: &Shape3, b: &Shape3) -> bool {
+    a.kind() == ShapeKind3::Cuboid && b.kind() == ShapeKind3::Cuboid
+}
+
+/// 2D has no box kind (a rectangle is a convex polygon).
+fn boxes2(_: &Shape2, _: &Shape2) -> bool {
+    false
+}
+
+/// Two boxes' manifold by their separating axes (module `box_pair`) into `manifolds` (one
+/// manifold), `true` when it decided the pair.
+fn box_pair3(
+    pos12: &Isometry3<f64>,
+    a: &dyn Parry3,
+    b: &dyn Parry3,
+    prediction: f64,
+    manifolds: &mut Vec<Manifold3<(), ()>>,
+) -> bool {
+    if manifolds.len() != 1 {
+        manifolds.clear();
+        manifolds.push(Manifold3::new());
+    }
+    // a box's polyhedron has its corners at exactly +-half extents
+    let half = |s: &dyn Parry3| s.compute_local_aabb().maxs.coords;
+    let (ha, hb) = (half(a), half(b));
+    box_pair(pos12, (a, ha), (b, hb), prediction, &mut manifolds[0]) == BoxPair::Exact
+}
+
+/// In 2D rectangles go through GJK (a polygon clip is already exact there).
+fn box_pair2(
+    _: &Isometry2<f64>,
+    _: &dyn Parry2,
+    _: &dyn Parry2,
+    _: f64,
+    _: &mut Vec<Manifold2<(), ()>>,
+) -> bool {
+    false
+}

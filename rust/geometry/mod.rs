@@ -28,7 +28,9 @@
 //! power-of-two unit near the shapes' size (parry's absolute tolerances), GJK's redundant
 //! extra point dropped, and two faces in 3D clipped as polygons along the face's own normal
 //! (module `clip`: parry's separate corner and crossing tests could both refuse a corner that
-//! two equal faces share to rounding); boxes are polyhedra (see [`Shape3::cuboid`]). With a cylinder or a
+//! two equal faces share to rounding); boxes are polyhedra (see [`Shape3::cuboid`]), and two
+//! boxes touching face to face get their normal and gap from the separating axes, not GJK
+//! (module `box_pair`). With a cylinder or a
 //! cone, parry builds the manifold from polygonal features picked by a GJK normal of limited
 //! accuracy: its deepest gap moves under swap, rigid motion or scaling by up to about 1e-5 of
 //! the shapes' size and its normal by about 1e-3 (the tests measure this); with spheres,
@@ -39,6 +41,7 @@
 //! sizes and degenerate hulls, meshes and heightfields with a [`crate::CoulombError`] before
 //! parry sees them (parry asserts on some of these).
 
+mod box_pair;
 pub mod broad;
 mod clip;
 pub mod contact;

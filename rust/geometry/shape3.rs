@@ -59,6 +59,16 @@ impl std::fmt::Debug for Shape3 {
     }
 }
 
+/// The convex hull of `points`, built at the unit `2^k` nearest their largest coordinate and
+/// scaled back (exactly, a power of two): parry's hull construction has absolute tolerances,
+/// which at a few nanometres merged a box's corners.
+fn hull(points: &[Point3<f64>]) -> Option<ConvexPolyhedron> {
+    let size = points.iter().map(|p| p.coords.amax()).fold(0.0, f64::max);
+    let unit = 2f64.powi(size.log2().round().clamp(-1000.0, 1000.0) as i32);
+    let at_unit: Vec<Point3<f64>> = points.iter().map(|p| p / unit).collect();
+    ConvexPolyhedron::from_convex_hull(&at_unit)?.scaled(&Vector3::repeat(unit))
+}
+
 fn check_pose(name: &str, pose: &Isometry3<f64>) -> Result<()> {
     let t = pose.translation.vector;
     let q = pose.rotation.coords;
@@ -84,10 +94,10 @@ impl Shape3 {
 
     /// A box with half side lengths `half_extents`, each > 0.
     ///
-    /// Held as the convex polyhedron of its 8 corners: parry's own box-box manifold is a
-    /// separating-axis test whose "gap" between separated boxes is the largest axis
-    /// separation (a lower bound of the distance), and which can return no point for boxes
-    /// within the prediction distance corner to corner; the polyhedron goes through GJK and
+    /// Held as the convex polyhedron of its 8 corners. Two boxes' manifold comes from their
+    /// separating axes where a face axis decides it exactly (module `box_pair`); otherwise
+    /// (an edge axis, or corners within the prediction of each other, where the largest axis
+    /// separation is only a lower bound of the distance) the polyhedra go through GJK, which
     /// gives the distance.
     pub fn cuboid(half_extents: [f64; 3]) -> Result<Self> {
         let [x, y, z] = half_extents;
@@ -101,7 +111,7 @@ impl Shape3 {
             let sign = |bit: usize| if k & bit == 0 { -1.0 } else { 1.0 };
             corners.push(Point3::new(sign(1) * x, sign(2) * y, sign(4) * z));
         }
-        ConvexPolyhedron::from_convex_hull(&corners)
+        hull(&corners)
             .map(|h| Self::new(Repr3::Cuboid(h)))
             .ok_or_else(|| CoulombError::InvalidParameter("box could not be built".to_string()))
     }
@@ -142,7 +152,7 @@ impl Shape3 {
             )));
         }
         let pts: Vec<Point3<f64>> = points.iter().map(|&p| p.into()).collect();
-        ConvexPolyhedron::from_convex_hull(&pts)
+        hull(&pts)
             .map(|h| Self::new(Repr3::ConvexHull(h)))
             .ok_or_else(|| {
                 CoulombError::InvalidParameter("convex hull could not be built".to_string())
