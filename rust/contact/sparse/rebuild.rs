@@ -2,7 +2,9 @@
 //! assembly produces them every step (`W_ij` summed over the bodies contacts i and j share):
 //! a counting sort of the tiles by block row, the distinct block columns of each row found with
 //! a marker array and sorted, the tiles summed into place. The buffers of the W and of a
-//! [`TileScratch`] are reused, so a rebuild of a size seen before allocates nothing.
+//! [`TileScratch`] are reused, so a rebuild of a size seen before allocates nothing; and when
+//! the tiles fall at the same places as in the last rebuild (a stepper's contacts unchanged
+//! from one step to the next) only the values are summed again, into the places kept.
 
 use super::{check_data, check_dims, BlockCsr};
 use crate::error::Result;
@@ -13,6 +15,33 @@ pub(crate) struct TileScratch {
     start: Vec<usize>,
     order: Vec<usize>,
     mark: Vec<usize>,
+    /// the last rebuild's `(dim, nc)`, its tiles' places `(i, j)` and where each tile's
+    /// values start in the W's values (`None` until a rebuild completes).
+    last: Option<(usize, usize)>,
+    places: Vec<(usize, usize)>,
+    slots: Vec<usize>,
+}
+
+impl TileScratch {
+    /// whether `tiles` fall at the places of the last rebuild, of the same shape.
+    fn same_places(&self, dim: usize, nc: usize, tiles: &[(usize, usize, [[f64; 3]; 3])]) -> bool {
+        self.last == Some((dim, nc))
+            && tiles.len() == self.places.len()
+            && tiles
+                .iter()
+                .zip(&self.places)
+                .all(|(t, p)| t.0 == p.0 && t.1 == p.1)
+    }
+}
+
+/// `out += tile`'s first `dim x dim` block, row-major.
+#[inline]
+fn add_tile(out: &mut [f64], tile: &[[f64; 3]; 3], dim: usize) {
+    for a in 0..dim {
+        for b in 0..dim {
+            out[a * dim + b] += tile[a][b];
+        }
+    }
 }
 
 impl BlockCsr {
@@ -44,7 +73,25 @@ impl BlockCsr {
                 }
             }
         }
-        let TileScratch { start, order, mark } = scratch;
+        let bs = dim * dim;
+        // the same places: the same structure, each tile summed into its slot in the given
+        // order (the order a full rebuild sums a place's tiles in, so the same values)
+        if scratch.same_places(dim, nc, tiles) && self.values.len() == self.cols.len() * bs {
+            self.values.fill(0.0);
+            for ((_, _, tile), &at) in tiles.iter().zip(&scratch.slots) {
+                add_tile(&mut self.values[at..at + bs], tile, dim);
+            }
+            return Ok(());
+        }
+        scratch.last = None;
+        let TileScratch {
+            start,
+            order,
+            mark,
+            places,
+            slots,
+            ..
+        } = scratch;
         // 1. the tiles by block row, in their given order (a counting sort)
         start.clear();
         start.resize(nc + 1, 0);
@@ -85,10 +132,12 @@ impl BlockCsr {
             self.cols[first..].sort_unstable();
             self.row_ptr.push(self.cols.len());
         }
-        // 3. the tiles summed into place (mark: block column -> tile index, per row)
-        let bs = dim * dim;
+        // 3. the tiles summed into place (mark: block column -> tile index, per row), each
+        // tile's slot kept for the next rebuild
         self.values.clear();
         self.values.resize(self.cols.len() * bs, 0.0);
+        slots.clear();
+        slots.resize(tiles.len(), 0);
         for i in 0..nc {
             for t in self.row_ptr[i]..self.row_ptr[i + 1] {
                 mark[self.cols[t]] = t;
@@ -98,14 +147,14 @@ impl BlockCsr {
             }
             for &k in &order[start[i]..start[i + 1]] {
                 let (_, j, tile) = &tiles[k];
-                let out = &mut self.values[mark[*j] * bs..(mark[*j] + 1) * bs];
-                for a in 0..dim {
-                    for b in 0..dim {
-                        out[a * dim + b] += tile[a][b];
-                    }
-                }
+                let at = mark[*j] * bs;
+                slots[k] = at;
+                add_tile(&mut self.values[at..at + bs], tile, dim);
             }
         }
+        places.clear();
+        places.extend(tiles.iter().map(|t| (t.0, t.1)));
+        scratch.last = Some((dim, nc));
         Ok(())
     }
 
@@ -145,20 +194,33 @@ mod tests {
                     )
                 })
                 .collect();
-            let (mut rows, mut cols, mut data) = (vec![], vec![], vec![]);
-            for &(i, j, t) in &tiles {
-                for (a, row) in t.iter().enumerate().take(dim) {
-                    for (b, &x) in row.iter().enumerate().take(dim) {
-                        rows.push(i * dim + a);
-                        cols.push(j * dim + b);
-                        data.push(x);
+            let coo = |tiles: &[(usize, usize, [[f64; 3]; 3])]| {
+                let (mut rows, mut cols, mut data) = (vec![], vec![], vec![]);
+                for &(i, j, t) in tiles {
+                    for (a, row) in t.iter().enumerate().take(dim) {
+                        for (b, &x) in row.iter().enumerate().take(dim) {
+                            rows.push(i * dim + a);
+                            cols.push(j * dim + b);
+                            data.push(x);
+                        }
                     }
                 }
-            }
-            let want = BlockCsr::from_coo(dim, dim * nc, &rows, &cols, &data).unwrap();
+                BlockCsr::from_coo(dim, dim * nc, &rows, &cols, &data).unwrap()
+            };
             csr.rebuild_from_tiles(dim, nc, &tiles, &mut scratch)
                 .unwrap();
-            assert_eq!(csr, want, "dim {dim}, nc {nc}");
+            assert_eq!(csr, coo(&tiles), "dim {dim}, nc {nc}");
+            // the same places with other values: summed into the places kept, the same W
+            let again: Vec<_> = tiles
+                .iter()
+                .map(|&(i, j, _)| {
+                    let t = std::array::from_fn(|_| std::array::from_fn(|_| rng.normal()));
+                    (i, j, t)
+                })
+                .collect();
+            csr.rebuild_from_tiles(dim, nc, &again, &mut scratch)
+                .unwrap();
+            assert_eq!(csr, coo(&again), "again: dim {dim}, nc {nc}");
         }
         let bad = [(0, 0, [[f64::NAN; 3]; 3])];
         assert!(csr.rebuild_from_tiles(2, 1, &bad, &mut scratch).is_err());
