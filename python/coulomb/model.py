@@ -442,7 +442,9 @@ class Scene:
             (proximal Newton, above; NSGS then gets 100 sweeps first) and keep the answer with
             the smaller exact-disk error (such steps are marked in ``fallback``); such a step
             is solved if that error is within ``max(tol, 1e-9)`` (a polygonal cone's answer
-            is not refined further).
+            is not refined further). With ``solver="lemke"``, when every Lemke path fails,
+            NSGS on the exact disk from Lemke's impulses with Lemke's tolerance; its answer is
+            kept (and the step marked in ``fallback``) when it passes the exact rule.
         drift : {"none", "bias", "projection"}
             The position-drift correction (a velocity-level step does not enforce
             ``g(q_{k+1}) >= 0`` exactly): none; a velocity bias, a closed contact with ``g < 0``

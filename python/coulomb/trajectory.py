@@ -144,7 +144,8 @@ class Trajectory:
         A closed contact took its restitution from the approach velocity of the step that
         closed it.
     fallback : ndarray of bool, shape (N,)
-        NSGS missed its tolerance and the fallback's better answer was used.
+        The step's solver missed its tolerance and the fallback's answer was used (see
+        ``fallback`` of ``Scene.simulate``).
     projection : ndarray, shape (N,)
         The largest coordinate change of the drift projection (0 without it).
     contact_step : ndarray of int, shape (n_records,)

@@ -43,7 +43,8 @@ pub struct StepRecord {
     /// an approach `v_n^- < 0` (Newton's law) or a compression (Poisson's), and `e > 0`.
     pub resumed: bool,
     /// NSGS missed its tolerance and the polyhedral Lemke's answer, better on the exact-disk
-    /// error, was used instead (see [`super::StepSettings::fallback`]).
+    /// error, was used instead; or Lemke failed and NSGS's answer, which passes the exact
+    /// rule, was (see [`super::StepSettings::fallback`]).
     pub fallback: bool,
     /// the largest position change of the drift projection (m or rad), 0 without it.
     pub projection: f64,

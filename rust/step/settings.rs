@@ -86,7 +86,9 @@ pub struct StepSettings {
     /// then solved if that error is within `max(tol, 1e-9)`. Above 32 contacts NSGS gets 100
     /// sweeps before the robust mode (a landing layer on a tall pile needs sweeps growing
     /// with its height, the robust mode a few Newton steps), and its remaining sweeps after it
-    /// if the robust mode misses the tolerance too.
+    /// if the robust mode misses the tolerance too. Under [`StepSolver::Lemke`], when every
+    /// Lemke path fails: NSGS on the exact disk from Lemke's impulses, with Lemke's
+    /// tolerance, its answer kept when it passes the exact rule.
     pub fallback: bool,
     /// the drift correction.
     pub drift: Drift,
