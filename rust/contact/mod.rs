@@ -34,6 +34,7 @@ use crate::error::{check_finite, CoulombError, Result};
 pub(crate) use measures::measure_into;
 pub use measures::{measure, ContactMeasures};
 pub use normalize::{solve, Method};
+pub(crate) use nsgs::solve_nsgs_measured;
 pub use nsgs::{solve_nsgs, ContactOrder, NsgsSettings};
 pub use polyhedral::{solve_polyhedral, PolyhedralSettings};
 pub use sparse::BlockCsr;

@@ -53,7 +53,7 @@ use local::{local_descent, LocalBlock};
 use rows::OffDiagonal;
 use schedule::CheckSchedule;
 
-use super::{measure_into, ContactProblem, ContactSolution, ContactStatus};
+use super::{measure_into, ContactMeasures, ContactProblem, ContactSolution, ContactStatus};
 use crate::error::{check_finite, CoulombError, Result};
 use crate::readable::Readable;
 
@@ -288,6 +288,17 @@ fn local_3d(blk: &LocalBlock, mu: f64, b: &[f64; 3], old: &[f64; 3]) -> Option<[
 
 /// Solves the friction-contact problem by nonsmooth Gauss-Seidel (see the module notes).
 pub fn solve_nsgs(problem: &ContactProblem<'_>, s: &NsgsSettings) -> Result<ContactSolution> {
+    solve_nsgs_measured(problem, s, None)
+}
+
+/// [`solve_nsgs`] given the measures and velocity `u = W r + q` of its initial impulses
+/// (`s.initial`) on this problem, as a caller that has just measured them holds them: they
+/// are taken instead of measured again when the sweeps start from those very impulses.
+pub(crate) fn solve_nsgs_measured(
+    problem: &ContactProblem<'_>,
+    s: &NsgsSettings,
+    start: Option<(ContactMeasures, &[f64])>,
+) -> Result<ContactSolution> {
     crate::lcp::check_tol(s.tol)?;
     if !(s.relaxation > 0.0 && s.relaxation < 2.0) {
         return Err(CoulombError::InvalidParameter(format!(
@@ -342,7 +353,22 @@ pub fn solve_nsgs(problem: &ContactProblem<'_>, s: &NsgsSettings) -> Result<Cont
 
     let mut lambda = vec![f64::NAN; nc];
     let mut u = vec![0.0; n];
-    let mut measures = measure_into(problem, &r, &mut u);
+    // the caller's measures hold for the sweeps' start when it is the caller's impulses, on
+    // the caller's W (not a block CSR copy, whose row counts give another rounding floor)
+    let given = start.filter(|(_, gu)| {
+        copy.is_none()
+            && gu.len() == n
+            && s.initial.as_deref().is_some_and(|init| {
+                init.len() == n && init.iter().zip(&r).all(|(a, b)| a.to_bits() == b.to_bits())
+            })
+    });
+    let mut measures = match given {
+        Some((m, gu)) => {
+            u.copy_from_slice(gu);
+            m
+        }
+        None => measure_into(problem, &r, &mut u),
+    };
     let mut schedule = CheckSchedule::new(s.tol, measures.scaled_error);
     let mut extrapolation = extrapolate::Extrapolation::new(n);
     let mut stick = stick::StickSolve::default();

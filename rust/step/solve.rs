@@ -7,8 +7,8 @@ use crate::contact::polyhedral::{LemkeVerdict, PolyhedralLcp};
 use crate::contact::{
     measure_into,
     prox::{solve_prox, ProxSettings},
-    solve_nsgs, BlockCsr, ContactMeasures, ContactProblem, ContactSolution, ContactStatus,
-    NsgsSettings, PolyhedralSettings,
+    solve_nsgs, solve_nsgs_measured, BlockCsr, ContactMeasures, ContactProblem, ContactSolution,
+    ContactStatus, NsgsSettings, PolyhedralSettings,
 };
 use crate::error::Result;
 use crate::lcp::lemke::spread;
@@ -85,6 +85,9 @@ pub(super) struct SolveBuffers {
     /// impulses also cancel the residual velocity the reused impulses had let build up, see
     /// [`reuse_warm_start`].
     pub(super) corrected: bool,
+    /// the warm start's measures, `velocity` holding its `W r + q`, when NSGS is to start
+    /// from it (set by [`reuse_warm_start`], taken by the solve).
+    warm_measures: Option<ContactMeasures>,
 }
 
 /// What a step's contact solve reports besides the impulses.
@@ -205,6 +208,7 @@ fn solve_or_reuse(
     ws: &mut SolveBuffers,
 ) -> Result<Outcome> {
     ws.basis.clear();
+    ws.warm_measures = None;
     // r = 0 solves the problem exactly when no contact's normal would close
     // (u = q, u_n >= 0, and 0 lies in every cone): no solve needed
     let separating = (0..problem.nc).all(|i| problem.q[i * problem.dim] >= 0.0);
@@ -231,7 +235,12 @@ fn solve_or_reuse(
                 max_iter: budget,
                 ..s.clone()
             };
-            let first = solve_nsgs(problem, &nsgs)?;
+            // the warm start's measures, taken by NSGS when it starts from those impulses
+            let first = solve_nsgs_measured(
+                problem,
+                &nsgs,
+                ws.warm_measures.take().map(|m| (m, &ws.velocity[..])),
+            )?;
             if first.success() || !settings.fallback {
                 return Ok(ws.take(first));
             }
@@ -349,6 +358,7 @@ fn reuse_warm_start(
         }
         return Ok(Warm::Start(Some(p.impulse)));
     }
+    ws.warm_measures = Some(m);
     Ok(Warm::Start(Some(init.to_vec())))
 }
 
