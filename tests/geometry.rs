@@ -10,6 +10,8 @@ use nalgebra::{Isometry2, Isometry3, Point3, Vector2, Vector3};
 use std::f64::consts::FRAC_PI_2;
 
 mod alloc_count;
+#[path = "geometry/boxes.rs"]
+mod boxes;
 #[path = "geometry/invariance.rs"]
 mod invariance;
 

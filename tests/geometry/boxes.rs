@@ -4,36 +4,9 @@
 //! none), the same deepest gap and the same normal there, to GJK-EPA's accuracy; and at the
 //! deepest point the gap is the one the witness points give.
 
-use coulomb::geometry::{contacts3, ContactCache3, ContactPoint3, Shape3};
+use super::*;
 use coulomb::testing::SplitMix64;
-use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
-
-fn ok<T>(r: coulomb::Result<T>) -> T {
-    match r {
-        Ok(v) => v,
-        Err(e) => panic!("unexpected error: {e}"),
-    }
-}
-
-fn query(
-    a: &Shape3,
-    pa: &Isometry3<f64>,
-    b: &Shape3,
-    pb: &Isometry3<f64>,
-    pred: f64,
-) -> Vec<ContactPoint3> {
-    let mut out = Vec::new();
-    ok(contacts3(
-        a,
-        pa,
-        b,
-        pb,
-        pred,
-        &mut ContactCache3::default(),
-        &mut out,
-    ));
-    out
-}
+use nalgebra::{Translation3, UnitQuaternion};
 
 fn corners(h: [f64; 3]) -> Vec<[f64; 3]> {
     (0..8)
@@ -66,7 +39,7 @@ fn boxes_by_separating_axes_agree_with_their_hulls_by_gjk() {
             let pa = Isometry3::from_parts(Translation3::from(centre), qa);
             let pb = Isometry3::from_parts(Translation3::from(centre + dir * dist), qb);
             let pred = 0.05 * scale;
-            let boxes = query(
+            let boxes = c3(
                 &ok(Shape3::cuboid(ha)),
                 &pa,
                 &ok(Shape3::cuboid(hb)),
@@ -75,7 +48,7 @@ fn boxes_by_separating_axes_agree_with_their_hulls_by_gjk() {
             );
             let hull_a = ok(Shape3::convex_hull(&corners(ha)));
             let hull_b = ok(Shape3::convex_hull(&corners(hb)));
-            let hulls = query(&hull_a, &pa, &hull_b, &pb, pred);
+            let hulls = c3(&hull_a, &pa, &hull_b, &pb, pred);
             let what = format!("scale {scale} ha {ha:?} hb {hb:?} pa {pa} pb {pb}");
             cases += 1;
             match (deepest(&boxes), deepest(&hulls)) {
