@@ -314,6 +314,53 @@ fn box_pile(count: usize) -> Result<Scene, Box<dyn std::error::Error>> {
     Ok(scene)
 }
 
+/// `count` Kapla-like planks (0.8 x 2.4 x 12 cm, 20 g) standing 6 cm apart on the floor, the
+/// first turning about its front bottom edge at `push` rad/s (examples/dominoes.py's row).
+fn dominoes(count: usize, push: f64) -> Result<Scene, Box<dyn std::error::Error>> {
+    let (t, w, hgt, m) = (0.008, 0.024, 0.12, 0.02);
+    let mut scene = empty_scene();
+    scene.half_spaces.push(HalfSpace {
+        point: vec![0.0; 3],
+        normal: vec![0.0, 0.0, 1.0],
+    });
+    for k in 0..count {
+        let half = [t / 2.0, w / 2.0, hgt / 2.0];
+        let (mut body, shape) = box_body(half, [0.0; 3], [0.0; 3]);
+        body.inertia = vec![
+            m * (w * w + hgt * hgt) / 12.0,
+            0.0,
+            0.0,
+            0.0,
+            m * (t * t + hgt * hgt) / 12.0,
+            0.0,
+            0.0,
+            0.0,
+            m * (t * t + w * w) / 12.0,
+        ];
+        body.mass = m;
+        body.q0 = vec![0.06 * k as f64, 0.0, hgt / 2.0, 1.0, 0.0, 0.0, 0.0];
+        let wk = if k == 0 { push } else { 0.0 };
+        body.v0 = vec![wk * hgt / 2.0, 0.0, wk * t / 2.0, 0.0, wk, 0.0];
+        let mut shape = shape;
+        shape.body = scene.bodies.len();
+        scene.solids.push(Solid {
+            body: Some(scene.bodies.len()),
+            pose: vec![0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0],
+            shape: SolidShape::Spatial(Shape3::cuboid(half)?),
+        });
+        scene.bodies.push(body);
+        scene.shapes.push(shape);
+        scene.pairs.push(Pair::ShapeHalfSpace {
+            shape: k,
+            half_space: 0,
+            mu: 0.6,
+            e: 0.0,
+        });
+    }
+    scene.pairs.push(Pair::Solids { mu: 0.3, e: 0.0 });
+    Ok(scene)
+}
+
 /// `links` rods (10 g, 5 cm, radius 5 mm) hinged end to end about y, the first to the world.
 fn chain(links: usize) -> (Scene, Vec<Joint>) {
     let (m, length, radius) = (0.01, 0.05, 0.005);
@@ -367,6 +414,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "pile-declared" => (pile(arg(2, 100), true), arg(3, 1000)),
         "tower" => (tower(arg(2, 10))?, arg(3, 2000)),
         "box-pile" => (box_pile(arg(2, 125))?, arg(3, 1000)),
+        "dominoes" => (dominoes(arg(2, 10), 1.5 * 0.7362)?, arg(3, 2000)),
         "chain" => {
             let (scene, joints) = chain(arg(2, 20));
             let settings = StepSettings::new(1e-3, arg(3, 1000));
@@ -447,6 +495,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     let fallbacks = tr.steps.iter().filter(|s| s.fallback).count();
+    let deepest = tr.contacts.iter().map(|c| c.gap).fold(0.0f64, f64::min);
+    println!("deepest contact gap {deepest:.3e} m");
     // the largest displacement of a body's position from its start (spatial bodies: 7
     // coordinates each, position first), and the first step where it exceeds 1e-9
     let mut drift: f64 = 0.0;

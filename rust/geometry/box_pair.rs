@@ -28,7 +28,7 @@ use parry3d_f64::query::ContactManifold;
 use parry3d_f64::shape::{PolygonalFeature, Shape};
 
 use super::clip::face_contacts;
-use super::contact::NEAR;
+use super::contact::{Reference, NEAR};
 
 /// Cross products of edge directions shorter than this are skipped: two edges parallel to
 /// within it span no axis of their own (their axis is, to within it, a face axis), and the
@@ -107,7 +107,7 @@ pub(super) fn box_pair(
     (a, ha): (&dyn Shape, Vector3<f64>),
     (b, hb): (&dyn Shape, Vector3<f64>),
     prediction: f64,
-    m: &mut ContactManifold<(), ()>,
+    m: &mut ContactManifold<Reference, ()>,
 ) -> BoxPair {
     m.points.clear();
     let (Some((pfm_a, _)), Some((pfm_b, _))) =

@@ -34,7 +34,7 @@ use nalgebra::{Isometry3, Point3, Unit, Vector3};
 use parry3d_f64::query::{ContactManifold, TrackedContact};
 use parry3d_f64::shape::{PackedFeatureId, PolygonalFeature};
 
-use super::contact::SAME_NORMAL;
+use super::contact::{Reference, SAME_NORMAL};
 
 /// An edge of the polygon being clipped: an edge of the subject face or a piece of a clip
 /// plane (by index in its feature).
@@ -117,7 +117,7 @@ pub(super) fn face_contacts(
     near: bool,
     f1: &PolygonalFeature,
     f2: &PolygonalFeature,
-    m: &mut ContactManifold<(), ()>,
+    m: &mut ContactManifold<Reference, ()>,
 ) -> Option<Unit<Vector3<f64>>> {
     let (n1, n2) = (f1.num_vertices, f2.num_vertices);
     if n1 < 2 || n2 < 2 || (n1 == 2 && n2 == 2) || n1 > 4 || n2 > 4 {
@@ -140,9 +140,11 @@ pub(super) fn face_contacts(
         let n = if n.dot(gjk) < 0.0 { -n } else { n };
         (near && n.dot(gjk) > SAME_NORMAL).then_some(n)
     };
-    let axis = face_normal(&second)
-        .or_else(|| face_normal(&first))
-        .unwrap_or(*gjk);
+    let (axis, reference) = match (face_normal(&second), face_normal(&first)) {
+        (Some(n), _) => (n, Reference::FaceB),
+        (None, Some(n)) => (n, Reference::FaceA),
+        (None, None) => (*gjk, Reference::Closest),
+    };
     // the face with an area clips the other
     let swapped = n1 < 3;
     let (clip, subject) = if swapped {
@@ -157,6 +159,7 @@ pub(super) fn face_contacts(
     if along.abs() <= 1e-9 * normal.norm() || !along.is_finite() {
         return None;
     }
+    m.data = reference;
     let poly = clip_polygon(clip, subject, &axis);
     for v in &poly.v[..poly.n] {
         let t = (c[0] - v.p).dot(&normal) / along;

@@ -75,6 +75,20 @@ pub struct ContactId {
     pub feature_b: u32,
 }
 
+/// Whose face a contact's normal is (the reference face of a face contact): as the shapes
+/// move, the normal turns with that shape (Stewart 2000, sec. 2: the gap of a vertex against
+/// a face plane). Points where edges cross say which face they were clipped on only here.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Reference {
+    /// neither: the normal of GJK's closest points, or of curved shapes.
+    #[default]
+    Closest,
+    /// a face of shape a.
+    FaceA,
+    /// a face of shape b.
+    FaceB,
+}
+
 /// One contact point in 3D.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ContactPoint3 {
@@ -87,6 +101,8 @@ pub struct ContactPoint3 {
     /// witness point on b, in b's body frame.
     pub point_b: Point3<f64>,
     pub id: ContactId,
+    /// whose face the normal is.
+    pub reference: Reference,
 }
 
 /// One contact point in 2D.
@@ -101,13 +117,15 @@ pub struct ContactPoint2 {
     /// witness point on b, in b's body frame.
     pub point_b: Point2<f64>,
     pub id: ContactId,
+    /// whose face the normal is.
+    pub reference: Reference,
 }
 
 /// The buffers of one pair of shapes in 3D, kept from call to call (one cache per pair: it
 /// holds the pair's scaled shapes, named by the shapes' ids).
 #[derive(Default)]
 pub struct ContactCache3 {
-    manifolds: Vec<Manifold3<(), ()>>,
+    manifolds: Vec<Manifold3<Reference, ()>>,
     workspace: Option<Workspace3>,
     convex: Convex3,
     retry: Vec<ContactPoint3>,
@@ -117,7 +135,7 @@ pub struct ContactCache3 {
 /// The buffers of one pair of shapes in 2D, kept from call to call.
 #[derive(Default)]
 pub struct ContactCache2 {
-    manifolds: Vec<Manifold2<(), ()>>,
+    manifolds: Vec<Manifold2<Reference, ()>>,
     workspace: Option<Workspace2>,
     convex: Convex2,
     retry: Vec<ContactPoint2>,
@@ -281,6 +299,7 @@ macro_rules! contacts_impl {
             // last normal tilted a face contact's normal by 4e-7 (a box sliding on a box)
             for m in manifolds.iter_mut() {
                 m.points.clear();
+                m.data = Reference::Closest;
                 m.local_n1.fill(0.0);
                 m.local_n2.fill(0.0);
             }
@@ -331,12 +350,17 @@ macro_rules! contacts_impl {
                 .map(|n| pose_a.rotation * n);
                 let near = m.points.iter().any(|p| p.dist <= NEAR);
                 let snapped = match (face_b, face_a) {
-                    (Some(n), _) | (None, Some(n)) if near && n.dot(&normal) > SAME_NORMAL => {
+                    (Some(n), _) if near && n.dot(&normal) > SAME_NORMAL => {
                         normal = n;
-                        true
+                        Some(Reference::FaceB)
                     }
-                    _ => false,
+                    (None, Some(n)) if near && n.dot(&normal) > SAME_NORMAL => {
+                        normal = n;
+                        Some(Reference::FaceA)
+                    }
+                    _ => None,
                 };
+                let reference = snapped.unwrap_or(m.data);
                 let back = normal.dot(&shift);
                 // parry adds GJK's closest pair (features unknown) to the clipped points in 3D:
                 // dropped when a clipped point is at least as deep (it lies among them)
@@ -356,7 +380,7 @@ macro_rules! contacts_impl {
                     }
                     let point_a = (part_a * p.local_p1) * unit;
                     let point_b = (part_b * p.local_p2) * unit;
-                    let gap = if snapped {
+                    let gap = if snapped.is_some() {
                         normal.dot(&((pose_b * point_b) - (pose_a * point_a)))
                     } else {
                         p.dist * unit - back
@@ -381,6 +405,7 @@ macro_rules! contacts_impl {
                                 feature_a: p.fid1.0,
                                 feature_b: p.fid2.0,
                             },
+                            reference,
                         });
                     }
                 }
@@ -484,14 +509,14 @@ contacts_impl!(
     /// `n · shift`), and the answer with the larger deepest gap is kept (the second one unless
     /// the first beats it by more than `1e-12 L`).
     contacts3, raw3, Shape3, Isometry3, Vector3, ContactPoint3, ContactCache3, Dispatcher3,
-    check_pose3, Manifold3<(), ()>, Workspace3, dyn Parry3, Tracked3, face_normal3, part_normal3,
+    check_pose3, Manifold3<Reference, ()>, Workspace3, dyn Parry3, Tracked3, face_normal3, part_normal3,
     convex3, Convex3, box_pair3, boxes3
 );
 
 contacts_impl!(
     /// [`contacts3`] in 2D.
     contacts2, raw2, Shape2, Isometry2, Vector2, ContactPoint2, ContactCache2, Dispatcher2,
-    check_pose2, Manifold2<(), ()>, Workspace2, dyn Parry2, Tracked2, face_normal2, part_normal2,
+    check_pose2, Manifold2<Reference, ()>, Workspace2, dyn Parry2, Tracked2, face_normal2, part_normal2,
     convex2, Convex2, box_pair2, boxes2
 );
 
@@ -512,7 +537,7 @@ fn box_pair3(
     a: &dyn Parry3,
     b: &dyn Parry3,
     prediction: f64,
-    manifolds: &mut Vec<Manifold3<(), ()>>,
+    manifolds: &mut Vec<Manifold3<Reference, ()>>,
 ) -> bool {
     if manifolds.len() != 1 {
         manifolds.clear();
@@ -530,7 +555,7 @@ fn box_pair2(
     _: &dyn Parry2,
     _: &dyn Parry2,
     _: f64,
-    _: &mut Vec<Manifold2<(), ()>>,
+    _: &mut Vec<Manifold2<Reference, ()>>,
 ) -> bool {
     false
 }

@@ -187,7 +187,7 @@ convex_impl!(
     Convex3,
     convex3,
     parry3d_f64,
-    Manifold3<(), ()>,
+    Manifold3<super::contact::Reference, ()>,
     true,
     super::clip::face_contacts
 );
@@ -195,7 +195,7 @@ convex_impl!(
     Convex2,
     convex2,
     parry2d_f64,
-    Manifold2<(), ()>,
+    Manifold2<super::contact::Reference, ()>,
     false,
     parry_contacts2
 );
@@ -207,7 +207,7 @@ fn parry_contacts2(
     _: bool,
     _: &parry2d_f64::shape::PolygonalFeature,
     _: &parry2d_f64::shape::PolygonalFeature,
-    _: &mut Manifold2<(), ()>,
+    _: &mut Manifold2<super::contact::Reference, ()>,
 ) -> Option<Unit<nalgebra::Vector2<f64>>> {
     None
 }

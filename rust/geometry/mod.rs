@@ -53,6 +53,7 @@ mod validate;
 pub use broad::AabbBroadPhase;
 pub use contact::{
     contacts2, contacts3, ContactCache2, ContactCache3, ContactId, ContactPoint2, ContactPoint3,
+    Reference,
 };
 pub use shape2::{Shape2, ShapeKind2};
 pub use shape3::{Shape3, ShapeKind3};

@@ -152,17 +152,19 @@ pub(super) fn contact_term(
 ) {
     mu.push(mu_c);
     let bound = normal_term(settings, a, st, e, &mut q1[0], poisson_impact, record);
-    qc[0] += bound + curvature_term(curvature, settings.h);
+    a.bias = bound + curvature_term(curvature, settings.h);
+    qc[0] += a.bias;
 }
 
 /// The contacts' memory after a solve, shared by both drivers: each active contact keeps its
 /// impulse (warm start), its variables in Lemke's basis and its impact record by identity (a
-/// closed contact consumes its record, an open one that pushed records its impact, one that
-/// did not push has none), and its record of the step (`id_of` its identity,
-/// `velocity_of` its contact velocity `J v_{k+1}`) is appended to `contacts`.
+/// closed contact consumes its record, an open one that the step stopped at its gap records
+/// its impact ([`landed`], with `slack` the gap tolerance over the step), any other has none),
+/// and its record of the step (`id_of` its identity, `velocity_of` its contact velocity
+/// `J v_{k+1}`) is appended to `contacts`.
 #[inline]
 pub(super) fn remember_contacts(
-    (dim, step): (usize, usize),
+    (dim, step, slack): (usize, usize, f64),
     active: &[Active],
     state: &mut [CandState],
     sol: &SolveBuffers,
@@ -176,7 +178,8 @@ pub(super) fn remember_contacts(
         st.warm[..dim].copy_from_slice(p);
         st.corrected = sol.corrected;
         st.basis = sol.basis.get(i).copied().unwrap_or(0);
-        st.impact = if !a.closed && p[0] > 0.0 {
+        let velocity = velocity_of(a);
+        st.impact = if !a.closed && p[0] > 0.0 && landed(a, velocity[0], slack) {
             ImpactMemory::landed(a.vn_k, p[0])
         } else {
             ImpactMemory::default()
@@ -187,12 +190,22 @@ pub(super) fn remember_contacts(
             step,
             id: id_of(a.cand),
             impulse,
-            velocity: velocity_of(a),
+            velocity,
             approach: a.approach,
             gap: a.gap,
             closed: a.closed,
         });
     }
+}
+
+/// Whether an open contact's step stopped it at the gap: its gap term holds with equality,
+/// `J_n v_{k+1} + g / h + min(c, 0) / h <= slack` (`vn_next = J_n v_{k+1}`; `slack`, a velocity,
+/// is the gap tolerance over the step). A positive impulse alone does not say so: a solve may
+/// leave a rounding-sized `P_n` on a contact still closing from far away, and taking that for
+/// a landing applied the impact law at a distance.
+#[inline]
+fn landed(a: &Active, vn_next: f64, slack: f64) -> bool {
+    vn_next + a.bias <= slack
 }
 
 /// `v_free` into the kept buffer `v_next` (taken out for the step), and `G P` cleared:

@@ -428,8 +428,9 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
     /// a contact's identity is its index, its velocity `J v_{k+1}` from its rows.
     fn remember(&mut self, v_next: &[f64], contacts: &mut Vec<ContactRecord>) {
         let (dim, nv, rows) = (self.dim, self.nv, &self.rows);
+        let slack = self.settings.gap_tolerance / self.settings.h;
         driver::remember_contacts(
-            (dim, self.step_index),
+            (dim, self.step_index, slack),
             &self.active,
             &mut self.state,
             &self.solve,

@@ -3,7 +3,9 @@
 //!
 //! An open contact that would close within a step gets the gap term
 //! `0 <= P_n ⊥ J_n v_{k+1} + g / h >= 0`: the contact may close during the step but not pass
-//! through. When that step pushes (`P_n > 0`) an impact has happened inside it, inelastically;
+//! through. When that step pushes (`P_n > 0`) and its gap term holds with equality (the
+//! contact closed, to the gap tolerance: a rounding-sized impulse on a contact still closing
+//! from afar is no landing) an impact has happened inside it, inelastically;
 //! its approach velocity `v_n^- = J_n(q_k) v_k` is recorded here, keyed to the contact's
 //! persistent identity, and the next step applies the impact law with it (Newton's
 //! `0 <= P_n ⊥ J_n v_{k+2} + e v_n^- >= 0`, or Poisson's restitution of the compression
@@ -23,7 +25,8 @@
 /// The impact record of one contact (see the module docs).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(super) struct ImpactMemory {
-    /// whether the last step stopped this contact's approach with the gap term (`P_n > 0`):
+    /// whether the last step stopped this contact's approach with the gap term (`P_n > 0`,
+    /// the term tight):
     /// the next step owes it the rebound.
     pub pending: bool,
     /// the approach velocity `v_n^- = J_n(q_k) v_k` of that step (m/s, `<= 0`).

@@ -66,12 +66,14 @@ pub(super) fn sphere_points(
 impl Stepper {
     /// After a solve: each active contact keeps its impulse (warm start), its variables in
     /// Lemke's basis and its impact record by identity (a closed contact consumes its
-    /// record, an open one that pushed records its impact, one that did not push has none),
+    /// record, an open one that the step stopped at its gap records its impact, any other
+    /// has none),
     /// and its record of the step is appended to `contacts`.
     pub(super) fn remember(&mut self, v_next: &[f64], contacts: &mut Vec<ContactRecord>) {
         let (dim, bodies, candidates) = (self.dim, &self.bodies, &self.candidates);
+        let slack = self.settings.gap_tolerance / self.settings.h;
         super::driver::remember_contacts(
-            (dim, self.step_index),
+            (dim, self.step_index, slack),
             &self.active,
             &mut self.state,
             &self.solve,

@@ -80,13 +80,14 @@ pub struct StepSettings {
     pub gap_tolerance: f64,
     /// start each contact solve from the previous step's impulses of the same contacts.
     pub warm_start: bool,
-    /// when NSGS misses its tolerance, also solve by the polyhedral Lemke (up to 32
-    /// contacts; tolerance `max(tol, 1e-9)`) or by the robust mode (proximal Newton, above;
-    /// NSGS's tolerance) and keep the answer with the smaller exact-disk error; the step is
-    /// then solved if that error is within `max(tol, 1e-9)`. Above 32 contacts NSGS gets 100
-    /// sweeps before the robust mode (a landing layer on a tall pile needs sweeps growing
-    /// with its height, the robust mode a few Newton steps), and its remaining sweeps after it
-    /// if the robust mode misses the tolerance too. Under [`StepSolver::Lemke`], when every
+    /// when NSGS misses its tolerance, try in turn, the first answer that passes taken: above
+    /// 32 contacts the robust mode (proximal Newton, NSGS's tolerance) from NSGS's answer
+    /// (NSGS then gets 100 sweeps first: a landing layer on a tall pile needs sweeps growing
+    /// with its height, the robust mode a few Newton steps); up to 64 contacts the polyhedral
+    /// Lemke (tolerance `max(tol, 1e-9)`), and where its answer misses the exact disk the
+    /// robust mode from it; above 32 contacts NSGS's remaining sweeps from the best answer so
+    /// far. Otherwise the answer with the smallest exact-disk error is kept; the step is
+    /// solved if that error is within `max(tol, 1e-9)`. Under [`StepSolver::Lemke`], when every
     /// Lemke path fails: NSGS on the exact disk from Lemke's impulses, with Lemke's
     /// tolerance, its answer kept when it passes the exact rule.
     pub fallback: bool,

@@ -20,14 +20,16 @@
 //! for the nonlinear gap of Moreau's time-stepping, Acary and Brogliato 2008, sec. 10.1):
 //! when a joint's remainder on `v_{k+1}` moves it by more than the gap tolerance its target
 //! is replaced and `v_free'` projected again, and when a body moves faster than the search
-//! assumed the search runs again with `v_{k+1}` among its velocities; if either changed the
+//! assumed, or a contact the search left out closes on `v_{k+1}`, the search runs again with
+//! `v_{k+1}` among its velocities; if either changed the
 //! problem, it is built (each curvature term the lower of those on `v_free` and `v_{k+1}`)
 //! and solved again; then
 //! each active contact's curvature term is evaluated on `v_{k+1}`, and where it would let the
 //! contact sink by more than the gap tolerance the term is lowered to it and the problem is
-//! solved again. Contacts only join and terms only fall, at most [`SETTLE_PASSES`] times.
+//! solved again (in scenes with joints). Contacts only join and terms only fall, at most
+//! [`SETTLE_PASSES`] times.
 
-use super::bodies::BodyInfo;
+use super::bodies::{norm3, BodyInfo};
 use super::law::curvature_term;
 use super::{BodyKind, Restitution, StepRecord, Stepper};
 use crate::contact::ContactStatus;
@@ -83,7 +85,7 @@ impl Stepper {
                 sb[1] = sb[1].max(ang);
             }
         }
-        if !faster {
+        if !faster && !self.trial_closes_another() {
             return false;
         }
         // the search only widens (a contact kept from the last solve stays, even where a
@@ -102,17 +104,48 @@ impl Stepper {
         false
     }
 
+    /// whether a candidate the search left inactive would be active on `v_trial`: the other
+    /// contacts' impulses can turn two bodies towards each other at a speed neither `v_k`
+    /// nor `v_free` shows (a plank struck in a row of dominoes, pushed back by the floor
+    /// onto the plank that struck it), and such a contact passes through within the step.
+    fn trial_closes_another(&self) -> bool {
+        let (h, tol) = (self.settings.h, self.settings.gap_tolerance);
+        // the active contacts are in candidate order (the search builds them so)
+        let mut next_active = self.active.iter().map(|a| a.cand).peekable();
+        for c in 0..self.candidates.len() {
+            while next_active.next_if(|&a| a < c).is_some() {}
+            if next_active.next_if_eq(&c).is_some() {
+                continue;
+            }
+            let geo = &self.geo_cache[c];
+            let mut reach = 0.0;
+            for &(body, _, r) in &geo.sides[..geo.nsides] {
+                let [lin, ang] = self.speed_bounds[body];
+                reach += lin + ang * norm3(r);
+            }
+            if geo.gap > tol + 2.0 * h * reach {
+                continue;
+            }
+            let vn = self.normal_velocity(geo, &self.v_trial);
+            if geo.gap <= tol + 2.0 * h * (-vn).max(0.0) {
+                return true;
+            }
+        }
+        false
+    }
+
     /// each active contact's curvature term on `v_trial`, lowered where it falls by more
     /// than the gap tolerance over the step; true when one was.
     fn lower_curvature(&mut self) -> bool {
         let (dim, h, tol) = (self.dim, self.settings.h, self.settings.gap_tolerance);
         let mut lowered = false;
-        for (i, a) in self.active.iter().enumerate() {
-            let c = a.cand;
+        for i in 0..self.active.len() {
+            let c = self.active[i].cand;
             let rem = self.gap_curvature(c, &self.geo_cache[c], &self.v_trial);
             let term = curvature_term(rem, h);
             if (self.curvature[i] - term) * h > tol {
                 self.qc[i * dim] += term - self.curvature[i];
+                self.active[i].bias += term - self.curvature[i];
                 self.curvature[i] = term;
                 lowered = true;
             }
@@ -122,22 +155,23 @@ impl Stepper {
 
     /// after the contact solve: the search and the curvature terms checked on the step's
     /// velocity, and the problem solved again while a contact joins or a term falls (module
-    /// docs). Scenes with joints and Newton's restitution only (Poisson's impact phase keeps
-    /// its own terms; scenes without joints are not yet checked).
+    /// docs). Newton's restitution only (Poisson's impact phase keeps its own terms); the
+    /// curvature terms only in scenes with joints.
     pub(super) fn settle(&mut self, record: &mut StepRecord) -> Result<()> {
-        if self.settings.restitution == Restitution::Poisson || self.joints.is_none() {
+        if self.settings.restitution == Restitution::Poisson {
             return Ok(());
         }
         let (h, tol) = (self.settings.h, self.settings.gap_tolerance);
         for _ in 0..SETTLE_PASSES {
             // an answer that failed is no velocity to check predictions on: a joint
             // retargeted on it can carry its error into `v_free`, and a later solve of that
-            // problem would report the step solved; the step keeps the failure instead
-            if record.status.is_some_and(|s| s != ContactStatus::Solved) {
-                break;
-            }
+            // problem would report the step solved, and curvature terms taken on it can push
+            // where nothing turns. It is still the velocity the step will apply, so the
+            // search is checked on it: a contact it closes joins (a wider problem, solved
+            // on `v_free`'s terms), and the step keeps the failure if that fails too.
+            let failed = record.status.is_some_and(|s| s != ContactStatus::Solved);
             self.trial_velocity();
-            let retargeted = match self.joints.as_mut() {
+            let retargeted = match self.joints.as_mut().filter(|_| !failed) {
                 Some(js) => js.retarget(
                     &self.bodies,
                     &self.q,
@@ -150,13 +184,16 @@ impl Stepper {
             };
             if self.search_again() || retargeted {
                 record.active = self.active.len();
-                self.trial_terms = true;
+                self.trial_terms = !failed;
                 let solved = self.solve_contacts(record);
                 self.trial_terms = false;
                 solved?;
                 continue;
             }
-            if !self.lower_curvature() {
+            // the curvature terms are checked again in scenes with joints, where an impulse
+            // carried along a chain turns a link the prediction left alone; without joints
+            // the step keeps the terms on `v_free`, as the models' stepper does
+            if failed || self.joints.is_none() || !self.lower_curvature() {
                 break;
             }
             self.solve_assembled(record)?;

@@ -33,7 +33,7 @@ use super::{BodyKind, Pair, Scene, Stepper};
 use crate::geometry::broad::{lift2, Aabb};
 use crate::geometry::{
     contacts2, contacts3, AabbBroadPhase, ContactCache2, ContactCache3, ContactId, ContactPoint2,
-    ContactPoint3, Shape2, Shape3,
+    ContactPoint3, Reference, Shape2, Shape3,
 };
 use crate::step::solid::Pose;
 use crate::step::{Solid, SolidShape};
@@ -394,7 +394,13 @@ impl Stepper {
                     let wb_point = pb * p.point_b;
                     let lb = lift3(sp.local[b], p.point_b);
                     let n = [-p.normal[0], -p.normal[1], -p.normal[2]];
-                    self.push_solid(sp, pair, (la, lb, wb_point.coords.into()), n, p.id);
+                    self.push_solid(
+                        sp,
+                        pair,
+                        (la, lb, wb_point.coords.into()),
+                        n,
+                        (p.id, p.reference),
+                    );
                 }
             }
             (
@@ -413,7 +419,13 @@ impl Stepper {
                     let wbp = pb * p.point_b;
                     let lb = lift_2(sp.local[b], p.point_b);
                     let n = [-p.normal[0], -p.normal[1], 0.0];
-                    self.push_solid(sp, pair, (la, lb, [wbp.x, wbp.y, 0.0]), n, p.id);
+                    self.push_solid(
+                        sp,
+                        pair,
+                        (la, lb, [wbp.x, wbp.y, 0.0]),
+                        n,
+                        (p.id, p.reference),
+                    );
                 }
             }
             _ => {}
@@ -421,15 +433,15 @@ impl Stepper {
     }
 
     /// appends one solid candidate: witnesses `(a in a's body, b in b's body, b in the
-    /// world)`, the normal `n` (world, from b to a), its features `id`; it takes over the
-    /// state of its name.
+    /// world)`, the normal `n` (world, from b to a), its features `id` and whose face the
+    /// normal is; it takes over the state of its name.
     fn push_solid(
         &mut self,
         sp: &mut SolidPairs,
         pair: SolidPair,
         (la, lb, wb): ([f64; 3], [f64; 3], [f64; 3]),
         n: [f64; 3],
-        id: ContactId,
+        (id, reference): (ContactId, Reference),
     ) {
         let (a, b) = (pair.a as usize, pair.b as usize);
         let pair_key = (u64::from(pair.a.min(pair.b)) << 32) | u64::from(pair.a.max(pair.b));
@@ -440,12 +452,15 @@ impl Stepper {
         let (cand_b, plane, turn) = match sp.solids[b].body {
             None => (None, (wb, n), Turn::Centres),
             Some(body_b) => {
+                // the normal turns with the shape whose face it is: the manifold's reference
+                // face, which a point where two edges cross does not name by its features
                 let face_a = id.feature_a >> 30 == 3;
                 let face_b = id.feature_b >> 30 == 3;
-                let (carrier, turn) = if face_b && !face_a {
-                    (body_b, Turn::WithB)
-                } else {
-                    (body_a, Turn::WithA)
+                let (carrier, turn) = match reference {
+                    Reference::FaceB => (body_b, Turn::WithB),
+                    Reference::FaceA => (body_a, Turn::WithA),
+                    Reference::Closest if face_b && !face_a => (body_b, Turn::WithB),
+                    Reference::Closest => (body_a, Turn::WithA),
                 };
                 let local_n = self.body_direction(carrier, n);
                 (Some((body_b, lb, 0.0)), ([0.0; 3], local_n), turn)

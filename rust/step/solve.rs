@@ -21,6 +21,10 @@ pub(super) const SPARSE_FROM: usize = 24;
 /// NSGS's fallback is the polyhedral Lemke up to this many contacts, the robust mode above.
 pub(super) const LEMKE_FALLBACK_MAX: usize = 32;
 
+/// NSGS's fallback tries the polygon by Lemke up to this many contacts (its dense tableau,
+/// `(2 + facets) nc` square, stays below 15 MB).
+pub(super) const POLYGON_FALLBACK_MAX: usize = 64;
+
 /// above [`LEMKE_FALLBACK_MAX`] contacts, NSGS gets at most this many sweeps before the
 /// robust mode is tried; its remaining sweeps follow only if that misses the tolerance.
 pub(super) const NSGS_BUDGET: usize = 100;
@@ -362,12 +366,16 @@ fn reuse_warm_start(
     Ok(Warm::Start(Some(init.to_vec())))
 }
 
-/// NSGS missed its tolerance (it can stall on singular, strongly coupled W, e.g. a rod lying
-/// on two contacts with mu = 2): Lemke's pivoting on the polyhedral cone (exact in 2D)
-/// decides for few contacts, the robust mode (proximal Newton, sparse LU) for many, where the
-/// dense LCP of nc (facets + 2) unknowns would cost more than the whole run; the better
-/// answer is kept, and for many contacts NSGS's remaining sweeps follow if the robust mode
-/// misses the tolerance too.
+/// NSGS missed its tolerance (it can stall on singular, strongly coupled W: a rod lying on
+/// two contacts with mu = 2, planks leaning on each other in a row of dominoes). Tried in
+/// turn, the first answer that passes the exact rule taken (the record's `fallback`):
+/// above [`LEMKE_FALLBACK_MAX`] contacts the robust mode (proximal Newton, sparse LU) from
+/// NSGS's answer; up to [`POLYGON_FALLBACK_MAX`] contacts the polygon by Lemke (exact in 2D;
+/// its dense LCP of `nc (facets + 2)` unknowns would cost more than the whole run above), and
+/// where its answer misses the disk the robust mode from it (a sliding impulse on a facet
+/// lies next to the circle's); above [`LEMKE_FALLBACK_MAX`] contacts NSGS's remaining sweeps
+/// from the best answer so far. Otherwise the best answer is kept, with NSGS's verdict where
+/// it is the polygon's.
 #[allow(clippy::too_many_arguments)]
 fn nsgs_fallback(
     s: &NsgsSettings,
@@ -380,61 +388,103 @@ fn nsgs_fallback(
     ws: &mut SolveBuffers,
 ) -> Result<Outcome> {
     let tol = s.tol.max(1e-9);
-    let second = if !large {
+    let prox_from = |from: Vec<f64>| ProxSettings {
+        tol: s.tol,
+        max_iter: PROX_MAX_ITER,
+        initial: Some(from),
+        ..ProxSettings::default()
+    };
+    let nsgs_status = first.status;
+    let mut best = Best::Nsgs(first);
+    if large {
+        let prox = solve_prox(problem, &prox_from(best.impulse(ws).to_vec()))?;
+        if prox.success() {
+            record.fallback = true;
+            return Ok(ws.take(prox));
+        }
+        best.offer(Best::Other(prox));
+    }
+    if problem.nc <= POLYGON_FALLBACK_MAX {
         let mut lemke = PolyhedralSettings::for_dim(problem.dim);
         lemke.lemke.tol = tol;
-        solve_polyhedral_warm(problem, &lemke, guess, ws)?
-    } else {
-        let prox = ProxSettings {
-            tol: s.tol,
-            max_iter: PROX_MAX_ITER,
-            initial: Some(first.impulse.clone()),
-            ..ProxSettings::default()
-        };
-        ws.take(solve_prox(problem, &prox)?)
-    };
-    let better = second.measures.scaled_error < first.measures.scaled_error;
-    if large && budget < s.max_iter && !(better && second.measures.passes(s.tol)) {
-        // NSGS's remaining sweeps from the better answer, and the best of the three
-        let from = if better {
-            ws.impulse.clone()
-        } else {
-            first.impulse.clone()
-        };
+        let polygon = solve_polyhedral_warm(problem, &lemke, guess, ws)?;
+        if polygon.measures.passes(tol) {
+            record.fallback = true;
+            return Ok(Outcome {
+                status: ContactStatus::Solved,
+                ..polygon
+            });
+        }
+        // onto the disk from the polygon's answer (in ws.impulse)
+        let prox = solve_prox(problem, &prox_from(ws.impulse.clone()))?;
+        if prox.success() {
+            record.fallback = true;
+            return Ok(ws.take(prox));
+        }
+        best.offer(Best::Polygon(polygon));
+        best.offer(Best::Other(prox));
+    }
+    if large && budget < s.max_iter {
         let rest = NsgsSettings {
-            initial: Some(from),
+            initial: Some(best.impulse(ws).to_vec()),
             max_iter: s.max_iter - budget,
             ..s.clone()
         };
         let third = solve_nsgs(problem, &rest)?;
-        let best_so_far = if better {
-            second.measures.scaled_error
-        } else {
-            first.measures.scaled_error
+        let third = ContactSolution {
+            iterations: budget + third.iterations,
+            ..third
         };
-        if third.measures.scaled_error <= best_so_far {
-            record.fallback = better;
-            return Ok(ws.take(ContactSolution {
-                iterations: budget + third.iterations,
-                ..third
-            }));
+        if third.success() {
+            record.fallback = !matches!(best, Best::Nsgs(_));
+            return Ok(ws.take(third));
+        }
+        best.offer(Best::Nsgs(third));
+    }
+    record.fallback = !matches!(best, Best::Nsgs(_));
+    Ok(match best {
+        Best::Nsgs(sol) | Best::Other(sol) => ws.take(sol),
+        // NSGS's contract is the exact cone: a polygon's answer (3D) that misses it keeps
+        // NSGS's verdict
+        Best::Polygon(out) => Outcome {
+            status: if out.status == ContactStatus::Solved {
+                nsgs_status
+            } else {
+                out.status
+            },
+            ..out
+        },
+    })
+}
+
+/// The best answer of a step's fallback so far (the lowest unit-consistent error): a
+/// solver's, or the polygon's held in the buffers.
+enum Best {
+    Nsgs(ContactSolution),
+    Other(ContactSolution),
+    Polygon(Outcome),
+}
+
+impl Best {
+    fn error(&self) -> f64 {
+        match self {
+            Best::Nsgs(s) | Best::Other(s) => s.measures.scaled_error,
+            Best::Polygon(o) => o.measures.scaled_error,
         }
     }
-    if better {
-        record.fallback = true;
-        Ok(Outcome {
-            // NSGS's contract is the exact cone: a polygon's answer (3D) that misses it keeps
-            // NSGS's verdict
-            status: if second.measures.passes(tol) {
-                ContactStatus::Solved
-            } else if second.status == ContactStatus::Solved {
-                first.status
-            } else {
-                second.status
-            },
-            ..second
-        })
-    } else {
-        Ok(ws.take(first))
+
+    fn impulse<'a>(&'a self, ws: &'a SolveBuffers) -> &'a [f64] {
+        match self {
+            Best::Nsgs(s) | Best::Other(s) => &s.impulse,
+            Best::Polygon(_) => &ws.impulse,
+        }
+    }
+
+    /// takes `other` where its error is lower; a polygon's answer offered later must still be
+    /// the one in the buffers.
+    fn offer(&mut self, other: Best) {
+        if other.error() < self.error() {
+            *self = other;
+        }
     }
 }

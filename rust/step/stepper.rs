@@ -107,6 +107,9 @@ struct Active {
     approach: f64,
     /// Poisson: the compression impulse already applied by landing steps.
     carried: f64,
+    /// the normal condition's constant beyond `J_n v_free`: the restitution, bias or gap term
+    /// and the curvature term, so that the condition reads `J_n v_{k+1} + bias >= 0`.
+    bias: f64,
     sides: [Side; 2],
     nsides: usize,
 }

@@ -2,9 +2,11 @@
 //! hulls of their 8 corners (the GJK-EPA path), over random sizes, poses and offsets from deep
 //! overlap to beyond the prediction, at scales 1e-8 to 1e8: the same verdict (a contact or
 //! none), the same deepest gap and the same normal there, to GJK-EPA's accuracy; and at the
-//! deepest point the gap is the one the witness points give.
+//! deepest point the gap is the one the witness points give. Every point names the box whose
+//! face its normal is, edges crossing included.
 
 use super::*;
+use coulomb::geometry::Reference;
 use coulomb::testing::SplitMix64;
 use nalgebra::{Translation3, UnitQuaternion};
 
@@ -50,6 +52,9 @@ fn boxes_by_separating_axes_agree_with_their_hulls_by_gjk() {
             let hull_b = ok(Shape3::convex_hull(&corners(hb)));
             let hulls = c3(&hull_a, &pa, &hull_b, &pb, pred);
             let what = format!("scale {scale} ha {ha:?} hb {hb:?} pa {pa} pb {pb}");
+            for p in &boxes {
+                named_face(p, &pa, &pb, &what);
+            }
             cases += 1;
             match (deepest(&boxes), deepest(&hulls)) {
                 (None, None) => separated += 1,
@@ -91,4 +96,62 @@ fn boxes_by_separating_axes_agree_with_their_hulls_by_gjk() {
         touching > 500 && separated > 200,
         "touching {touching}, separated {separated}"
     );
+}
+
+/// A point whose normal is a box's face says so, and its normal is then one of that box's face
+/// normals (from a to b: out of a's face, into b's).
+fn named_face(p: &ContactPoint3, pa: &Isometry3<f64>, pb: &Isometry3<f64>, what: &str) {
+    let (pose, sign) = match p.reference {
+        Reference::FaceA => (pa, 1.0),
+        Reference::FaceB => (pb, -1.0),
+        Reference::Closest => return,
+    };
+    let along = (0..3)
+        .map(|i| sign * p.normal.dot(&(pose.rotation * Vector3::ith(i, 1.0))))
+        .map(f64::abs)
+        .fold(0.0, f64::max);
+    assert!(
+        (along - 1.0).abs() <= 1e-12,
+        "{what}: {p:?} is no face normal of its reference ({along})"
+    );
+}
+
+/// A plank leaning on an upright plank of the same width: its top edge lies on the upright's
+/// face, and the edge's ends fall on the face's sides, so the points are crossings of edges
+/// (no face among their features). They still name the upright's face as their normal's: the
+/// stepper turns the normal with that body (with the leaning one, the gap of sliding planks
+/// was mispredicted by 3e-8 m a step and they sank into each other).
+#[test]
+fn edges_crossing_on_a_face_name_that_face() {
+    let (t, w, hgt) = (0.008, 0.024, 0.12);
+    let half = [t / 2.0, w / 2.0, hgt / 2.0];
+    for tilt in [0.3f64, 0.45, 0.6] {
+        // the leaning plank a turns about its bottom front edge (x = t/2, z = 0) by `tilt`
+        // about +y; the upright b stands with its back face where a's top front edge reaches
+        let turn = UnitQuaternion::from_scaled_axis(Vector3::y() * tilt);
+        let edge = Vector3::new(t / 2.0, 0.0, 0.0);
+        let centre_a = edge + turn * Vector3::new(-t / 2.0, 0.0, hgt / 2.0);
+        let top_front = edge + turn * Vector3::new(0.0, 0.0, hgt);
+        let pa = Isometry3::from_parts(Translation3::from(centre_a), turn);
+        let pb = Isometry3::translation(top_front.x + t / 2.0, 0.0, hgt / 2.0);
+        let pts = c3(
+            &ok(Shape3::cuboid(half)),
+            &pa,
+            &ok(Shape3::cuboid(half)),
+            &pb,
+            1e-3,
+        );
+        assert_eq!(pts.len(), 2, "tilt {tilt}: {pts:?}");
+        for p in &pts {
+            assert!(p.gap.abs() <= 1e-15, "tilt {tilt}: {p:?}");
+            assert_eq!(p.reference, Reference::FaceB, "tilt {tilt}: {p:?}");
+            named_face(p, &pa, &pb, "leaning plank");
+        }
+        let face = |f: u32| f >> 30 == 3;
+        assert!(
+            pts.iter()
+                .any(|p| !face(p.id.feature_a) && !face(p.id.feature_b)),
+            "tilt {tilt}: no crossing of edges among {pts:?}"
+        );
+    }
 }
