@@ -325,18 +325,11 @@ fn dominoes(count: usize, push: f64) -> Result<Scene, Box<dyn std::error::Error>
     });
     for k in 0..count {
         let half = [t / 2.0, w / 2.0, hgt / 2.0];
+        // box_body's inertia is for 1 kg
         let (mut body, shape) = box_body(half, [0.0; 3], [0.0; 3]);
-        body.inertia = vec![
-            m * (w * w + hgt * hgt) / 12.0,
-            0.0,
-            0.0,
-            0.0,
-            m * (t * t + hgt * hgt) / 12.0,
-            0.0,
-            0.0,
-            0.0,
-            m * (t * t + w * w) / 12.0,
-        ];
+        for x in body.inertia.iter_mut() {
+            *x *= m;
+        }
         body.mass = m;
         body.q0 = vec![0.06 * k as f64, 0.0, hgt / 2.0, 1.0, 0.0, 0.0, 0.0];
         let wk = if k == 0 { push } else { 0.0 };

@@ -437,17 +437,13 @@ class Scene:
         warm_start : bool
             Start NSGS from the previous step's impulses.
         fallback : bool
-            When NSGS misses its tolerance (it can stall on singular, strongly coupled W),
-            try in turn, taking the first answer that passes: above 32 contacts the robust
-            mode (proximal Newton) from NSGS's answer (NSGS then gets 100 sweeps first); up to
-            64 contacts the polyhedral Lemke, and where its answer misses the exact disk the
-            robust mode from it; above 32 contacts NSGS's remaining sweeps from the best
-            answer so far. Otherwise the answer with the smallest exact-disk error is kept.
-            Steps whose answer came from these are marked in ``fallback``; such a step is
-            solved if its error is within ``max(tol, 1e-9)``. With ``solver="lemke"``, when
-            every Lemke path fails, NSGS on the exact disk from Lemke's impulses with Lemke's
-            tolerance; its answer is kept (and the step marked in ``fallback``) when it passes
-            the exact rule.
+            When NSGS misses its tolerance (singular, strongly coupled W), try in turn, the
+            first passing answer taken, else the one of least exact-disk error (steps marked
+            in ``fallback``; solved within ``max(tol, 1e-9)``): above 32 contacts the robust
+            mode (proximal Newton, after 100 NSGS sweeps); up to 64 the polyhedral Lemke, then
+            the robust mode from its answer; above 32 NSGS's remaining sweeps. With
+            ``solver="lemke"``, when every Lemke path fails, NSGS on the exact disk from
+            Lemke's impulses, kept (and marked) when it passes the exact rule.
         drift : {"none", "bias", "projection"}
             The position-drift correction (a velocity-level step does not enforce
             ``g(q_{k+1}) >= 0`` exactly): none; a velocity bias, a closed contact with ``g < 0``

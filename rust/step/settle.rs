@@ -29,7 +29,7 @@
 //! solved again (in scenes with joints). Contacts only join and terms only fall, at most
 //! [`SETTLE_PASSES`] times.
 
-use super::bodies::{norm3, BodyInfo};
+use super::bodies::BodyInfo;
 use super::law::curvature_term;
 use super::{BodyKind, Restitution, StepRecord, Stepper};
 use crate::contact::ContactStatus;
@@ -116,12 +116,7 @@ impl Stepper {
                 continue;
             }
             let geo = &self.geo_cache[c];
-            let mut reach = 0.0;
-            for &(body, _, r) in &geo.sides[..geo.nsides] {
-                let [lin, ang] = self.speed_bounds[body];
-                reach += lin + ang * norm3(r);
-            }
-            if geo.gap > tol + 2.0 * h * reach {
+            if geo.gap > tol + 2.0 * h * self.reach(geo) {
                 continue;
             }
             let vn = self.normal_velocity(geo, &self.v_trial);

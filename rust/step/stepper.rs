@@ -344,11 +344,7 @@ impl Stepper {
         active.clear();
         for c in 0..self.candidates.len() {
             let geo = &self.geo_cache[c];
-            let mut reach = 0.0;
-            for &(body, _, r) in &geo.sides[..geo.nsides] {
-                let [lin, ang] = self.speed_bounds[body];
-                reach += lin + ang * norm3(r);
-            }
+            let reach = self.reach(geo);
             // a contact owed a rebound stays active whatever its gap (module impact); the
             // search again on the step's velocity (module settle) only adds contacts, since
             // `v_free` may have changed in between (a joint retargeted) and must not
@@ -386,6 +382,17 @@ impl Stepper {
             }
         }
         self.active = active;
+    }
+
+    /// a bound on how fast a candidate's gap can close: the speed bounds of its sides' bodies
+    /// at its witness points (`lin + ang |r|` summed over the sides).
+    fn reach(&self, geo: &Geometry) -> f64 {
+        let mut reach = 0.0;
+        for &(body, _, r) in &geo.sides[..geo.nsides] {
+            let [lin, ang] = self.speed_bounds[body];
+            reach += lin + ang * norm3(r);
+        }
+        reach
     }
 
     /// an active contact from a candidate's geometry, into `act` (a default one): per side,
