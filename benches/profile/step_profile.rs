@@ -461,10 +461,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let worst = tr.steps.iter().map(|s| s.iterations).max().unwrap_or(0);
     println!("sweeps {sweeps}, worst step {worst}");
     for (k, s) in tr.steps.iter().enumerate() {
-        if (s.iterations > 300 || s.fallback) && std::env::var("QUIET").is_err() {
+        let unsolved = s.status.is_some_and(|x| x.as_str() != "solved");
+        if (s.iterations > 300 || s.fallback || unsolved) && std::env::var("QUIET").is_err() {
             println!(
-                "step {k}: {} sweeps, error {:.2e}, fallback {}, {} contacts",
-                s.iterations, s.error, s.fallback, s.active
+                "step {k}: {} sweeps, error {:.2e}, error_q {:.2e}, fallback {}, {} contacts, {}",
+                s.iterations,
+                s.error,
+                s.error_q,
+                s.fallback,
+                s.active,
+                s.status.map_or("free", |x| x.as_str())
             );
         }
     }

@@ -26,11 +26,13 @@
 //! and solved again; then
 //! each active contact's curvature term is evaluated on `v_{k+1}`, and where it would let the
 //! contact sink by more than the gap tolerance the term is lowered to it and the problem is
-//! solved again (in scenes with joints). Contacts only join and terms only fall, at most
-//! [`SETTLE_PASSES`] times.
+//! solved again (every contact in scenes with joints, contacts between two bodies in the
+//! others); a lowered problem the solver fails on gives the step back the answer that passed.
+//! Contacts only join and terms only fall, at most [`SETTLE_PASSES`] times.
 
-use super::bodies::BodyInfo;
+use super::bodies::{norm3, BodyInfo};
 use super::law::curvature_term;
+use super::narrow::Geometry;
 use super::{BodyKind, Restitution, StepRecord, Stepper};
 use crate::contact::ContactStatus;
 use crate::error::Result;
@@ -128,15 +130,29 @@ impl Stepper {
     }
 
     /// each active contact's curvature term on `v_trial`, lowered where it falls by more
-    /// than the gap tolerance over the step; true when one was.
-    fn lower_curvature(&mut self) -> bool {
+    /// than the gap tolerance over the step; true when one was. The terms and the answer
+    /// before the first change are kept (`self.kept`), so that a lowered problem the solver
+    /// fails on leaves the step the answer that passed. In scenes without joints only
+    /// contacts between two bodies are checked: against a half-space the models' stepper
+    /// (which has no body pairs) keeps the terms on `v_free`, and the two must agree.
+    fn lower_curvature(&mut self, record: &StepRecord) -> bool {
         let (dim, h, tol) = (self.dim, self.settings.h, self.settings.gap_tolerance);
+        let every = self.joints.is_some();
         let mut lowered = false;
         for i in 0..self.active.len() {
+            if !every && self.active[i].nsides < 2 {
+                continue;
+            }
             let c = self.active[i].cand;
+            if self.turns_too_little(&self.geo_cache[c], tol) {
+                continue;
+            }
             let rem = self.gap_curvature(c, &self.geo_cache[c], &self.v_trial);
             let term = curvature_term(rem, h);
             if (self.curvature[i] - term) * h > tol {
+                if !lowered {
+                    self.keep_answer(record);
+                }
                 self.qc[i * dim] += term - self.curvature[i];
                 self.active[i].bias += term - self.curvature[i];
                 self.curvature[i] = term;
@@ -183,14 +199,75 @@ impl Stepper {
                 solved?;
                 continue;
             }
-            // the curvature terms are checked again in scenes with joints, where an impulse
-            // carried along a chain turns a link the prediction left alone; without joints
-            // the step keeps the terms on `v_free`, as the models' stepper does
-            if failed || self.joints.is_none() || !self.lower_curvature() {
+            // the curvature terms are checked again on the answer that passed: an impulse
+            // carried along a chain, or through a stack, turns a body the prediction left
+            // alone (see `lower_curvature` for which contacts)
+            if failed || !self.lower_curvature(record) {
                 break;
             }
             self.solve_assembled(record)?;
+            if record.status != Some(ContactStatus::Solved) {
+                // the lower terms asked more than the solver gave: the answer that passed
+                // on the higher ones is the better step (Lemke and the fallbacks may fail
+                // where the first solve did not)
+                self.restore_answer(record);
+                break;
+            }
         }
         Ok(())
     }
+
+    /// whether no turn the speed bounds allow (widened to `v_trial`'s) can move a contact's
+    /// curvature term by the gap tolerance: every part of the remainder `c` carries a turn
+    /// `phi = h |w|` of a side times a length (the points' offsets and separation, or the
+    /// step's displacement), so `|c| <= 4 phi (L + h reach)` for `phi <= 1`, and a margin of
+    /// 1000 below `tol` leaves the exact evaluation to every contact that could matter (a
+    /// tower at rest turns by rounding: `phi` about 1e-15).
+    fn turns_too_little(&self, geo: &Geometry, tol: f64) -> bool {
+        let h = self.settings.h;
+        let mut phi: f64 = 0.0;
+        let mut length = 2.0 * geo.gap.abs() + h * self.reach(geo);
+        for &(body, _, r) in &geo.sides[..geo.nsides] {
+            phi = phi.max(h * self.speed_bounds[body][1]);
+            length += norm3(r);
+        }
+        phi <= 1.0 && 4.0 * phi * length <= 1e-3 * tol
+    }
+
+    /// keeps the current answer, its record and the terms it solved.
+    fn keep_answer(&mut self, record: &StepRecord) {
+        let k = &mut self.kept;
+        k.impulse.clone_from(&self.solve.impulse);
+        k.qc.clone_from(&self.qc);
+        k.curvature.clone_from(&self.curvature);
+        k.bias.clear();
+        k.bias.extend(self.active.iter().map(|a| a.bias));
+        k.record = Some(record.clone());
+    }
+
+    /// the answer [`Stepper::keep_answer`] kept, with its record and terms.
+    fn restore_answer(&mut self, record: &mut StepRecord) {
+        let k = &mut self.kept;
+        let Some(kept) = k.record.take() else {
+            return;
+        };
+        *record = kept;
+        self.solve.impulse.clone_from(&k.impulse);
+        self.qc.clone_from(&k.qc);
+        self.curvature.clone_from(&k.curvature);
+        for (a, &b) in self.active.iter_mut().zip(&k.bias) {
+            a.bias = b;
+        }
+    }
+}
+
+/// An answer that passed and the contact terms it solved, kept while the settle stage solves
+/// a problem with lowered terms (reused from step to step).
+#[derive(Debug, Default)]
+pub(super) struct Kept {
+    impulse: Vec<f64>,
+    qc: Vec<f64>,
+    curvature: Vec<f64>,
+    bias: Vec<f64>,
+    record: Option<StepRecord>,
 }

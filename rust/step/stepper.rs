@@ -153,6 +153,8 @@ pub struct Stepper {
     active_kept: Vec<Active>,
     /// whether the contact terms also take the curvature on `v_trial` (module `settle`).
     trial_terms: bool,
+    /// a passing answer kept while a lowered problem is solved (module `settle`).
+    kept: settle::Kept,
     q1: Vec<f64>,
     mu: Vec<f64>,
     /// whether this step's Poisson impact phase has work.
@@ -230,6 +232,7 @@ impl Stepper {
             trial_search: false,
             active_kept: Vec::new(),
             trial_terms: false,
+            kept: settle::Kept::default(),
             q1: Vec::new(),
             mu: Vec::new(),
             poisson_impact: false,
