@@ -29,13 +29,15 @@ fn side(r: &Row, c: usize) -> (&[f64; 6], &[f64; 6]) {
 
 impl Island {
     /// the equality targets set to 0 when none moves its joint by more than `tol` over the
-    /// step (`h |target| <= tol`): a resting jointed body's remainders are rounding-sized,
+    /// step (`h |target| l <= tol`, l the row's length): a resting jointed body's remainders are rounding-sized,
     /// yet a target off `J v = 0` makes the sticking contacts that hold the body
     /// inconsistent with its joints at that size, which the contact solvers cannot resolve
     /// below it (a resting chain's steps stalled at 1.4e-12 against the step's 1e-12); the
     /// position projection closes what is left, as it does for the targets' own rounding.
     pub(super) fn drop_small_targets(&mut self, h: f64, tol: f64) {
-        let big = self.eq_target.iter().fold(0.0f64, |m, t| m.max(t.abs()));
+        // in metres: a row of angles by its length
+        let big = (self.eq_target.iter().zip(&self.eq_length))
+            .fold(0.0f64, |m, (t, l)| m.max(t.abs() * l));
         if h * big <= tol {
             self.eq_target.iter_mut().for_each(|t| *t = 0.0);
         }

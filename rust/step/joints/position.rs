@@ -7,7 +7,7 @@
 //! quadratically. And the joints' violation at a state.
 
 use super::super::rows::WORLD;
-use super::{Island, JointSystem};
+use super::{gyration, row_length, Island, JointSystem};
 use crate::step::stepper::bodies::{displace_body, BodyInfo, Frozen};
 
 /// Newton steps of the position projection at most (it converges quadratically: two or
@@ -30,14 +30,17 @@ impl JointSystem {
         let dim = self.dim;
         let mut islands = std::mem::take(&mut self.islands);
         for isl in &mut islands {
+            // in metres, relative to the island's lengths (levers, radii of gyration) and
+            // positions: an absolute floor made the projection 1e-6 loose in units of 1e-8
             let mut scale = isl.scale;
             for &b in &isl.bodies {
                 let off = bodies[b].off_q;
+                scale = scale.max(gyration(&bodies[b]));
                 for k in 0..dim {
                     scale = scale.max(q[off + k].abs());
                 }
             }
-            let tol = 1e-14 * (1.0 + scale);
+            let tol = 1e-14 * scale;
             let mut last = f64::INFINITY;
             for _ in 0..NEWTON_MAX {
                 let worst = self.constraints_at(isl, bodies, q);
@@ -84,7 +87,7 @@ impl JointSystem {
     }
 
     /// island `isl`'s equality rows at q and the limits overshot, into `isl.moved`; the
-    /// largest `|C|` among them.
+    /// largest `|C| l` among them (l the row's length, a row of angles in metres).
     fn constraints_at(&self, isl: &mut Island, bodies: &[BodyInfo], q: &[f64]) -> f64 {
         let mut rows = std::mem::take(&mut isl.moved);
         rows.clear();
@@ -101,7 +104,10 @@ impl JointSystem {
             }
         }
         isl.moved = rows;
-        isl.moved.iter().fold(0.0f64, |m, r| m.max(r.c.abs()))
+        // rows of angles by their length (module `step`, `row_length`)
+        isl.moved.iter().fold(0.0f64, |m, r| {
+            m.max(r.c.abs() * row_length(r, self.dim, bodies))
+        })
     }
 
     /// the largest `|C|` of the equality rows and limit overshoot at q.

@@ -13,6 +13,7 @@ use super::rows::{Frame, JointData, Row, WORLD};
 use crate::contact::assembly::WAssembly;
 use crate::step::stepper::bodies::{displace_body, BodyInfo, Frozen};
 use crate::step::stepper::{dot6, Active};
+use crate::step::BodyKind;
 
 /// A limit's condition this step.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -58,6 +59,8 @@ struct Island {
     /// previous ones (scratch).
     eq_target: Vec<f64>,
     prev_target: Vec<f64>,
+    /// each equality row's length (metres per unit of its coordinate: [`row_length`]).
+    eq_length: Vec<f64>,
     /// the equality rows at `q ⊕ h u` (scratch).
     moved: Vec<Row>,
     /// the rows acting on each body (by slot in `bodies`, module `island`) and a cursor.
@@ -206,6 +209,10 @@ impl JointSystem {
             d.rows(self.dim, &fa, &fb, &mut isl.rows);
         }
         isl.n_eq = isl.rows.len();
+        isl.eq_length.clear();
+        let dim = self.dim;
+        isl.eq_length
+            .extend(isl.rows.iter().map(|r| row_length(r, dim, bodies)));
     }
 
     /// limit l's gap row (`c` the gap, J its rate) at q, None for an infinite bound.
@@ -272,7 +279,7 @@ impl JointSystem {
                     let e = self.data[lim.joint].e;
                     (lim.mode, lim.target) = if let Some(vm) = lim.pending {
                         (Mode::Pending, -e * vm.min(0.0))
-                    } else if row.c <= gap_tol {
+                    } else if row.c * row_length(&row, self.dim, bodies) <= gap_tol {
                         (Mode::Closed, -e * vk.min(0.0))
                     } else {
                         (Mode::Imminent, -row.c / h)
@@ -552,7 +559,8 @@ impl JointSystem {
             isl.prev_target.clone_from(&isl.eq_target);
             self.remainders(isl, bodies, q, vel, h);
             let moved = (isl.eq_target.iter().zip(&isl.prev_target))
-                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+                .zip(&isl.eq_length)
+                .fold(0.0f64, |m, ((a, b), l)| m.max((a - b).abs() * l));
             if moved * h > tol {
                 changed = true;
                 self.reproject(isl, bodies, v_free);
@@ -582,5 +590,31 @@ impl JointSystem {
                 rank: i.factor.rank(),
             })
             .collect()
+    }
+}
+
+/// Metres per unit of a row's coordinate, so that the rows of angles and of lengths meet the
+/// gap tolerance (a length) in one unit system: 1 for a row with a linear part; for a row of
+/// angles alone the largest radius of gyration `sqrt(tr I / m)` of its bodies, the distance
+/// a body's mass moves per radian of turn. Without it a joint's angle in radians was compared
+/// with a tolerance in metres, and the verdicts changed with the unit of length.
+pub(super) fn row_length(row: &Row, dim: usize, bodies: &[BodyInfo]) -> f64 {
+    let linear = |j: &[f64; 6]| j[..dim].iter().any(|&x| x != 0.0);
+    if linear(&row.ja) || (row.b != WORLD && linear(&row.jb)) {
+        return 1.0;
+    }
+    let la = gyration(&bodies[row.a]);
+    if row.b == WORLD {
+        la
+    } else {
+        la.max(gyration(&bodies[row.b]))
+    }
+}
+
+/// a body's radius of gyration `sqrt(tr I / m)` (0 for a particle).
+pub(super) fn gyration(b: &BodyInfo) -> f64 {
+    match b.kind {
+        BodyKind::Particle => 0.0,
+        _ => (b.inertia.trace() / b.mass).sqrt(),
     }
 }
