@@ -14,7 +14,12 @@ const G: f64 = 9.81;
 /// x-z plane (2D: x-y), the lowest end `z_low` above the floor; mu 0.3, e 0. In 3D the
 /// hinges turn about y.
 fn dropped_chain(dim: usize, n: usize, tilt: f64) -> (Scene, Vec<Joint>, f64) {
-    let (m, l, r, z_low) = (0.01, 0.05, 0.004, 0.3);
+    dropped_chain_in(dim, n, tilt, 1.0)
+}
+
+/// [`dropped_chain`] with lengths in units scaled by `u` (lengths, inertia, gravity).
+fn dropped_chain_in(dim: usize, n: usize, tilt: f64, u: f64) -> (Scene, Vec<Joint>, f64) {
+    let (m, l, r, z_low) = (0.01, 0.05 * u, 0.004 * u, 0.3 * u);
     let (s, c) = tilt.sin_cos();
     let up = dim - 1;
     let mut bodies = Vec::new();
@@ -80,7 +85,7 @@ fn dropped_chain(dim: usize, n: usize, tilt: f64) -> (Scene, Vec<Joint>, f64) {
         }
     }
     let mut gravity = vec![0.0; dim];
-    gravity[up] = -G;
+    gravity[up] = -G * u;
     let mut normal = vec![0.0; dim];
     normal[up] = 1.0;
     let scene = Scene {
@@ -230,4 +235,51 @@ fn a_chain_dropped_on_the_floor_never_sinks_into_it_with_lemke() {
     // corrupted problem passed. Then a path that cycled to the pivot limit (step 330)
     settings.solver = StepSolver::Lemke(PolyhedralSettings::for_dim(3));
     drop_and_check(3, 12, 900, &settings, [1e-7, 1e-8]);
+}
+
+/// the chain's turn of every link at every step over `steps` steps, lengths in units of `u`
+/// (the gap tolerance with them), and the steps' statuses.
+fn chain_in_units(dim: usize, u: f64, steps: usize) -> (Vec<f64>, Vec<Option<&'static str>>) {
+    let (sc, joints, _) = dropped_chain_in(dim, 6, 0.4, u);
+    let mut settings = StepSettings::new(1e-3, 0);
+    settings.gap_tolerance *= u;
+    let mut st = Stepper::with_joints(&sc, &joints, &settings).unwrap();
+    let mut contacts = Vec::new();
+    let (mut turns, mut statuses) = (Vec::new(), Vec::new());
+    for _ in 0..steps {
+        let rec = st.step(&mut contacts).unwrap();
+        statuses.push(rec.status.map(|s| s.as_str()));
+        for i in 0..6 {
+            turns.push(if dim == 2 {
+                st.q[3 * i + 2]
+            } else {
+                2.0 * st.q[7 * i + 5].atan2(st.q[7 * i + 3])
+            });
+        }
+    }
+    (turns, statuses)
+}
+
+/// Joints and contacts together: the chain dropped on the floor with lengths in units from
+/// 1e-8 to 1e8 turns its links as in metres (to 1e-12 rad), and every step keeps its status.
+/// While the joints' rows of angles met the gap tolerance in radians and the position
+/// projection stopped at an absolute 1e-14, the 2D chain in units of 1e-8 turned 1.4e-3 rad
+/// away from the one in metres.
+#[test]
+fn a_dropped_chain_falls_the_same_in_every_unit_of_length() {
+    for dim in [2, 3] {
+        let (base, base_status) = chain_in_units(dim, 1.0, 600);
+        for u in [1e-8, 1e-4, 1e4, 1e8] {
+            let (turns, status) = chain_in_units(dim, u, 600);
+            let worst = base
+                .iter()
+                .zip(&turns)
+                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            assert_eq!(status, base_status, "dim {dim}, lengths x {u:e}");
+            assert!(
+                worst < 1e-9,
+                "dim {dim}, lengths x {u:e}: turns differ by {worst:.3e}"
+            );
+        }
+    }
 }
