@@ -21,7 +21,8 @@
 //! NSGS's sweep order, relaxation and sweep limit can be changed for experiments through the
 //! environment: `ORDER=symmetric|backward|forward`, `RELAX=1.3`, `MAXIT=100`; `STICK=1` turns on
 //! NSGS's sticking-set solve. `QUIET=1` lists no steps, `CONTACTS=K` prints the contacts of the
-//! first K steps; the boxes' drift (largest displacement from the start) and the fallback count
+//! first K steps; `UNIT=1e-4` builds the dominoes with lengths in that unit (gravity, inertia
+//! and the gap tolerance with them); the boxes' drift (largest displacement from the start) and the fallback count
 //! are printed.
 use coulomb::geometry::Shape3;
 use coulomb::step::{
@@ -316,9 +317,10 @@ fn box_pile(count: usize) -> Result<Scene, Box<dyn std::error::Error>> {
 
 /// `count` Kapla-like planks (0.8 x 2.4 x 12 cm, 20 g) standing 6 cm apart on the floor, the
 /// first turning about its front bottom edge at `push` rad/s (examples/dominoes.py's row).
-fn dominoes(count: usize, push: f64) -> Result<Scene, Box<dyn std::error::Error>> {
-    let (t, w, hgt, m) = (0.008, 0.024, 0.12, 0.02);
+fn dominoes(count: usize, push: f64, u: f64) -> Result<Scene, Box<dyn std::error::Error>> {
+    let (t, w, hgt, m) = (0.008 * u, 0.024 * u, 0.12 * u, 0.02);
     let mut scene = empty_scene();
+    scene.gravity[2] *= u;
     scene.half_spaces.push(HalfSpace {
         point: vec![0.0; 3],
         normal: vec![0.0, 0.0, 1.0],
@@ -331,7 +333,7 @@ fn dominoes(count: usize, push: f64) -> Result<Scene, Box<dyn std::error::Error>
             *x *= m;
         }
         body.mass = m;
-        body.q0 = vec![0.06 * k as f64, 0.0, hgt / 2.0, 1.0, 0.0, 0.0, 0.0];
+        body.q0 = vec![0.06 * u * k as f64, 0.0, hgt / 2.0, 1.0, 0.0, 0.0, 0.0];
         let wk = if k == 0 { push } else { 0.0 };
         body.v0 = vec![wk * hgt / 2.0, 0.0, wk * t / 2.0, 0.0, wk, 0.0];
         let mut shape = shape;
@@ -388,6 +390,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let which = args.get(1).map_or("ramp", |s| s.as_str());
     let arg = |i: usize, d: usize| args.get(i).and_then(|s| s.parse().ok()).unwrap_or(d);
     let th = 20f64.to_radians();
+    let unit: f64 = std::env::var("UNIT").map_or(Ok(1.0), |u| u.parse())?;
     let (scene, steps) = match which {
         "ramp" => (
             one_box(
@@ -407,7 +410,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "pile-declared" => (pile(arg(2, 100), true), arg(3, 1000)),
         "tower" => (tower(arg(2, 10))?, arg(3, 2000)),
         "box-pile" => (box_pile(arg(2, 125))?, arg(3, 1000)),
-        "dominoes" => (dominoes(arg(2, 10), 1.5 * 0.7362)?, arg(3, 2000)),
+        "dominoes" => (dominoes(arg(2, 10), 1.5 * 0.7362, unit)?, arg(3, 2000)),
         "chain" => {
             let (scene, joints) = chain(arg(2, 20));
             let settings = StepSettings::new(1e-3, arg(3, 1000));
@@ -429,6 +432,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     };
     let mut settings = StepSettings::new(1e-3, steps);
+    settings.gap_tolerance *= unit;
     if let (Ok(order), coulomb::step::StepSolver::Nsgs(s)) =
         (std::env::var("ORDER"), &mut settings.solver)
     {

@@ -28,7 +28,7 @@ use parry3d_f64::query::ContactManifold;
 use parry3d_f64::shape::{PolygonalFeature, Shape};
 
 use super::clip::face_contacts;
-use super::contact::{Reference, NEAR};
+use super::contact::Reference;
 
 /// Cross products of edge directions shorter than this are skipped: two edges parallel to
 /// within it span no axis of their own (their axis is, to within it, a face axis), and the
@@ -101,12 +101,13 @@ fn separating_axes(
 
 /// The manifold of two boxes (parry polyhedra `a`, `b` of half extents `ha`, `hb`, b at
 /// `pos12` in a's frame) into `m`, points within `prediction`, when a face axis separates
-/// them best (module docs); [`BoxPair::Gjk`], with `m` cleared, otherwise.
+/// them best (module docs); [`BoxPair::Gjk`], with `m` cleared, otherwise. `near`: the gap
+/// within which the clipped face's normal is the contact's (module `contact`, `NEAR`).
 pub(super) fn box_pair(
     pos12: &Isometry3<f64>,
     (a, ha): (&dyn Shape, Vector3<f64>),
     (b, hb): (&dyn Shape, Vector3<f64>),
-    prediction: f64,
+    (prediction, near): (f64, f64),
     m: &mut ContactManifold<Reference, ()>,
 ) -> BoxPair {
     m.points.clear();
@@ -134,7 +135,7 @@ pub(super) fn box_pair(
     let mut f2 = PolygonalFeature::default();
     pfm_a.local_support_feature(&n1, &mut f1);
     pfm_b.local_support_feature(&n2, &mut f2);
-    let Some(axis) = face_contacts(pos12, &n1, sep <= NEAR, &f1, &f2, m) else {
+    let Some(axis) = face_contacts(pos12, &n1, sep <= near, &f1, &f2, m) else {
         m.points.clear();
         return BoxPair::Gjk;
     };

@@ -268,7 +268,8 @@ const SAME_NORMAL_DUP: f64 = 1e-6;
 /// so that a closest pair whose normal is not the face's moves by at most `1e-6 g <= 1e-9 L`.
 pub(super) const SAME_NORMAL: f64 = 0.999_999;
 
-/// The gap (relative to the query's unit) within which a face contact takes the face's normal.
+/// The gap (relative to the smaller shape's size) within which a face contact takes the
+/// face's normal.
 pub(super) const NEAR: f64 = 1e-3;
 
 macro_rules! contacts_impl {
@@ -285,7 +286,7 @@ macro_rules! contacts_impl {
         fn $raw(
             (a, b): (&$dynshape, &$dynshape),
             boxes: bool,
-            unit: f64,
+            (unit, near): (f64, f64),
             pose_a: &$iso<f64>,
             pose_b: &$iso<f64>,
             shift: $vec<f64>,
@@ -312,8 +313,8 @@ macro_rules! contacts_impl {
             );
             let pos12 = at.inv_mul(&bt);
             let query = (prediction + shift.norm()) * inv;
-            let exact = boxes && $pair(&pos12, a, b, query, manifolds);
-            if !exact && !$convex(&pos12, a, b, query, manifolds, convex) {
+            let exact = boxes && $pair(&pos12, a, b, (query, near), manifolds);
+            if !exact && !$convex(&pos12, a, b, (query, near), manifolds, convex) {
                 $dispatcher
                     .contact_manifolds(&pos12, a, b, query, manifolds, workspace)
                     .map_err(|_| {
@@ -348,7 +349,7 @@ macro_rules! contacts_impl {
                     _ => None,
                 }
                 .map(|n| pose_a.rotation * n);
-                let near = m.points.iter().any(|p| p.dist <= NEAR);
+                let near = m.points.iter().any(|p| p.dist <= near);
                 let snapped = match (face_b, face_a) {
                     (Some(n), _) if near && n.dot(&normal) > SAME_NORMAL => {
                         normal = n;
@@ -450,10 +451,14 @@ macro_rules! contacts_impl {
                 Some(s) if unit != 1.0 && s.ids == ids && s.scale == unit => ((&*s.a, &*s.b), unit),
                 _ => ((a.parry(), b.parry()), 1.0),
             };
+            // NEAR of the smaller shape's size, in the query's unit (a power of two near it:
+            // NEAR of the unit itself moved the threshold by up to a factor sqrt(2), or 1e3
+            // where no scaled shape is kept, with the scene's unit of length)
+            let near = NEAR * size / unit;
             let zero = $vec::zeros();
             let ws = (&mut *workspace, &mut *convex);
             let boxes = $boxes(a, b);
-            if $raw(shapes, boxes, unit, pose_a, pose_b, zero, prediction, manifolds, ws, out)? {
+            if $raw(shapes, boxes, (unit, near), pose_a, pose_b, zero, prediction, manifolds, ws, out)? {
                 return Ok(());
             }
             let first = deepest_gap(out, |p| p.gap);
@@ -484,7 +489,7 @@ macro_rules! contacts_impl {
             };
             let shift = along * (PULL * size);
             let ws = (&mut *workspace, &mut *convex);
-            $raw(shapes, false, unit, pose_a, pose_b, shift, prediction, manifolds, ws, retry)?;
+            $raw(shapes, false, (unit, near), pose_a, pose_b, shift, prediction, manifolds, ws, retry)?;
             let second = deepest_gap(retry, |p| p.gap);
             if (empty && !retry.is_empty()) || first <= second + PREFER * size {
                 std::mem::swap(out, retry);
@@ -536,7 +541,7 @@ fn box_pair3(
     pos12: &Isometry3<f64>,
     a: &dyn Parry3,
     b: &dyn Parry3,
-    prediction: f64,
+    prediction: (f64, f64),
     manifolds: &mut Vec<Manifold3<Reference, ()>>,
 ) -> bool {
     if manifolds.len() != 1 {
@@ -554,7 +559,7 @@ fn box_pair2(
     _: &Isometry2<f64>,
     _: &dyn Parry2,
     _: &dyn Parry2,
-    _: f64,
+    _: (f64, f64),
     _: &mut Vec<Manifold2<Reference, ()>>,
 ) -> bool {
     false

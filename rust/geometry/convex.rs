@@ -50,7 +50,7 @@ macro_rules! convex_impl {
             pos12: &$parry::math::Isometry<f64>,
             a: &dyn $parry::shape::Shape,
             b: &dyn $parry::shape::Shape,
-            prediction: f64,
+            (prediction, near): (f64, f64),
             manifolds: &mut Vec<$manifold>,
             ws: &mut $ws,
         ) -> bool {
@@ -140,7 +140,7 @@ macro_rules! convex_impl {
                     let mut f2 = $parry::shape::PolygonalFeature::default();
                     pfm_a.local_support_feature(&n1, &mut f1);
                     pfm_b.local_support_feature(&n2, &mut f2);
-                    let near = (p2_1 - p1).dot(&n1) - ra - rb <= super::contact::NEAR;
+                    let near = (p2_1 - p1).dot(&n1) - ra - rb <= near;
                     let axis = $faces(pos12, &n1, near, &f1, &f2, m).unwrap_or_else(|| {
                         $parry::shape::PolygonalFeature::contacts(
                             pos12,

@@ -155,3 +155,67 @@ fn edges_crossing_on_a_face_name_that_face() {
         );
     }
 }
+
+/// The leaning plank of [`edges_crossing_on_a_face_name_that_face`] short of the upright by
+/// `gap_rel` of the plank's height, in lengths of unit `u`: its points and their reference.
+fn leaning_at(tilt: f64, gap_rel: f64, u: f64, hull: bool) -> Vec<ContactPoint3> {
+    let (t, w, hgt) = (0.008 * u, 0.024 * u, 0.12 * u);
+    let half = [t / 2.0, w / 2.0, hgt / 2.0];
+    let turn = UnitQuaternion::from_scaled_axis(Vector3::y() * tilt);
+    let edge = Vector3::new(t / 2.0, 0.0, 0.0);
+    let centre_a = edge + turn * Vector3::new(-t / 2.0, 0.0, hgt / 2.0);
+    let top_front = edge + turn * Vector3::new(0.0, 0.0, hgt);
+    let pa = Isometry3::from_parts(Translation3::from(centre_a), turn);
+    let pb = Isometry3::translation(top_front.x + t / 2.0 + gap_rel * hgt, 0.0, hgt / 2.0);
+    let shape = || {
+        if hull {
+            let mut corners = Vec::new();
+            for k in 0..8 {
+                let s = |bit: usize| if k & bit == 0 { -1.0 } else { 1.0 };
+                corners.push([s(1) * half[0], s(2) * half[1], s(4) * half[2]]);
+            }
+            ok(Shape3::convex_hull(&corners))
+        } else {
+            ok(Shape3::cuboid(half))
+        }
+    };
+    c3(&shape(), &pa, &shape(), &pb, 1e-2 * u)
+}
+
+/// Whether a contact takes its face's normal (and names the face) was decided by its gap
+/// against 1e-3 of the query's unit, a power of two near the smaller shape's size: with the
+/// scene's unit of length the threshold moved by up to a factor of sqrt(2), so a plank
+/// 0.8e-3 of its height short of another named the other's face in some units and no face in
+/// others (the dominoes' strikes then differed in metres and in units of 1e-4). It is now
+/// 1e-3 of the smaller shape's size itself: the same answer in every unit, for boxes (the
+/// separating axes) and for hulls (GJK's path).
+#[test]
+fn whether_a_point_names_a_face_does_not_depend_on_the_unit_of_length() {
+    for hull in [false, true] {
+        for gap_rel in [1e-4, 5e-4, 8e-4, 1.2e-3, 2e-3] {
+            let base = leaning_at(0.45, gap_rel, 1.0, hull);
+            assert!(!base.is_empty(), "gap {gap_rel}: no point");
+            for k in -8..=8 {
+                for m in [1.0, 1.3, 1.7, 2.3, 3.1, 4.2, 5.6, 7.5] {
+                    let u = m * 10f64.powi(k);
+                    let pts = leaning_at(0.45, gap_rel, u, hull);
+                    let names =
+                        |p: &[ContactPoint3]| p.iter().map(|p| p.reference).collect::<Vec<_>>();
+                    assert_eq!(
+                        names(&pts),
+                        names(&base),
+                        "hull {hull}, gap {gap_rel} of the height, unit {u:e}"
+                    );
+                    for (p, q) in pts.iter().zip(&base) {
+                        assert!(
+                            (p.gap / u - q.gap).abs() <= 1e-9 * 0.12,
+                            "hull {hull}, gap {gap_rel}, unit {u:e}: {} against {}",
+                            p.gap / u,
+                            q.gap
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
