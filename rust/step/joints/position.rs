@@ -6,8 +6,8 @@
 //! `M_k`), so the iteration is Newton's on `C(q) = 0` whatever the metric, and converges
 //! quadratically. And the joints' violation at a state.
 
-use super::super::rows::WORLD;
-use super::{gyration, row_length, Island, JointSystem};
+use super::super::rows::{gyration, row_length, WORLD};
+use super::{Island, JointSystem};
 use crate::step::stepper::bodies::{displace_body, BodyInfo, Frozen};
 
 /// Newton steps of the position projection at most (it converges quadratically: two or

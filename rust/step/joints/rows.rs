@@ -26,6 +26,8 @@
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 
 use super::{Joint, JointKind};
+use crate::step::stepper::bodies::BodyInfo;
+use crate::step::BodyKind;
 
 /// a body's pose: centre, rotation (body to world), planar angle, orientation.
 #[derive(Clone, Copy, Debug)]
@@ -296,6 +298,32 @@ impl JointData {
             }
             _ => None,
         }
+    }
+}
+
+/// Metres per unit of a row's coordinate, so that the rows of angles and of lengths meet the
+/// gap tolerance (a length) in one unit system: 1 for a row with a linear part; for a row of
+/// angles alone the largest radius of gyration `sqrt(tr I / m)` of its bodies, the distance
+/// a body's mass moves per radian of turn. Without it a joint's angle in radians was compared
+/// with a tolerance in metres, and the verdicts changed with the unit of length.
+pub(super) fn row_length(row: &Row, dim: usize, bodies: &[BodyInfo]) -> f64 {
+    let linear = |j: &[f64; 6]| j[..dim].iter().any(|&x| x != 0.0);
+    if linear(&row.ja) || (row.b != WORLD && linear(&row.jb)) {
+        return 1.0;
+    }
+    let la = gyration(&bodies[row.a]);
+    if row.b == WORLD {
+        la
+    } else {
+        la.max(gyration(&bodies[row.b]))
+    }
+}
+
+/// a body's radius of gyration `sqrt(tr I / m)` (0 for a particle).
+pub(super) fn gyration(b: &BodyInfo) -> f64 {
+    match b.kind {
+        BodyKind::Particle => 0.0,
+        _ => (b.inertia.trace() / b.mass).sqrt(),
     }
 }
 

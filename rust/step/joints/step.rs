@@ -9,11 +9,10 @@ mod island;
 mod position;
 
 use super::factor::Factor;
-use super::rows::{Frame, JointData, Row, WORLD};
+use super::rows::{row_length, Frame, JointData, Row, WORLD};
 use crate::contact::assembly::WAssembly;
 use crate::step::stepper::bodies::{displace_body, BodyInfo, Frozen};
 use crate::step::stepper::{dot6, Active};
-use crate::step::BodyKind;
 
 /// A limit's condition this step.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -590,31 +589,5 @@ impl JointSystem {
                 rank: i.factor.rank(),
             })
             .collect()
-    }
-}
-
-/// Metres per unit of a row's coordinate, so that the rows of angles and of lengths meet the
-/// gap tolerance (a length) in one unit system: 1 for a row with a linear part; for a row of
-/// angles alone the largest radius of gyration `sqrt(tr I / m)` of its bodies, the distance
-/// a body's mass moves per radian of turn. Without it a joint's angle in radians was compared
-/// with a tolerance in metres, and the verdicts changed with the unit of length.
-pub(super) fn row_length(row: &Row, dim: usize, bodies: &[BodyInfo]) -> f64 {
-    let linear = |j: &[f64; 6]| j[..dim].iter().any(|&x| x != 0.0);
-    if linear(&row.ja) || (row.b != WORLD && linear(&row.jb)) {
-        return 1.0;
-    }
-    let la = gyration(&bodies[row.a]);
-    if row.b == WORLD {
-        la
-    } else {
-        la.max(gyration(&bodies[row.b]))
-    }
-}
-
-/// a body's radius of gyration `sqrt(tr I / m)` (0 for a particle).
-pub(super) fn gyration(b: &BodyInfo) -> f64 {
-    match b.kind {
-        BodyKind::Particle => 0.0,
-        _ => (b.inertia.trace() / b.mass).sqrt(),
     }
 }
