@@ -5,6 +5,10 @@
 //! share when untwisted; the twist moves its corners by at most `theta` times the size.
 //! Scales 1e-8 to 1e8 (boxes of a few nanometres: their hulls are built at a power-of-two unit
 //! near their size, since parry's hull construction merged their corners).
+//!
+//! Convex hulls whose faces have more than 4 corners (prisms of 5 to 40 sides) standing on a
+//! box, on a half-space and on each other touch at every corner of the face (at most 32,
+//! sampled evenly beyond): parry's support feature keeps a face's first 4 corners only.
 
 use coulomb::geometry::{contacts3, ContactCache3, ContactPoint3, Shape3};
 use nalgebra::{Isometry3, Point3, UnitQuaternion, Vector3};
@@ -115,4 +119,110 @@ fn check(
         );
         assert!((p.normal - up_n).norm() <= 1e-12, "{what}: normal {p:?}");
     }
+}
+
+/// A prism of `n` sides, circumradius `r` and half height `h`, as the hull of its corners.
+fn prism(n: usize, r: f64, h: f64) -> Shape3 {
+    let mut pts = Vec::new();
+    for k in 0..n {
+        let a = 0.3 + k as f64 * std::f64::consts::TAU / n as f64;
+        pts.push([r * a.cos(), r * a.sin(), -h]);
+        pts.push([r * a.cos(), r * a.sin(), h]);
+    }
+    match Shape3::convex_hull(&pts) {
+        Ok(s) => s,
+        Err(e) => panic!("prism of {n} sides: {e}"),
+    }
+}
+
+/// The largest distance from the centre `(0, 0)` of the points' convex polygon in the plane z
+/// (world frame, points on the prism), measured inward: > 0 when the centre is inside by that
+/// much, the margin of the support polygon.
+fn centre_margin(points: &[Point3<f64>]) -> f64 {
+    // the polygon's corners sorted by angle about the centre (all on a circle here)
+    let mut p: Vec<[f64; 2]> = points.iter().map(|q| [q.x, q.y]).collect();
+    p.sort_by(|a, b| a[1].atan2(a[0]).total_cmp(&b[1].atan2(b[0])));
+    let mut margin = f64::INFINITY;
+    for k in 0..p.len() {
+        let (a, b) = (p[k], p[(k + 1) % p.len()]);
+        let (ex, ey) = (b[0] - a[0], b[1] - a[1]);
+        let len = ex.hypot(ey);
+        if len == 0.0 {
+            continue;
+        }
+        // the distance of the origin to the edge's line, positive on the left (counterclockwise)
+        margin = margin.min((ex * (-a[1]) - ey * (-a[0])) / len);
+    }
+    if p.len() < 3 {
+        f64::NEG_INFINITY
+    } else {
+        margin
+    }
+}
+
+#[test]
+fn a_hull_face_with_more_than_four_corners_touches_at_every_corner() {
+    let (r, h) = (0.05, 0.05);
+    let slab = Shape3::cuboid([0.2, 0.2, 0.05]).unwrap_or_else(|e| panic!("{e}"));
+    let floor = Shape3::half_space([0.0, 0.0, 1.0]).unwrap_or_else(|e| panic!("{e}"));
+    for n in [3, 4, 5, 6, 7, 8, 12, 20, 32, 40, 64] {
+        let body = prism(n, r, h);
+        let corners = n.min(32);
+        // the inradius of the taken corners' polygon: consecutive ones at most ceil(n / 32)
+        // of the prism's edges apart
+        let skip = n.div_ceil(32) as f64;
+        let inner = r * (std::f64::consts::PI * skip / n as f64).cos();
+        let on = Isometry3::translation(0.0, 0.0, h);
+        let below_slab = Isometry3::translation(0.0, 0.0, -0.05);
+        let above = Isometry3::translation(0.0, 0.0, 3.0 * h);
+        let cases: [(&str, Vec<Point3<f64>>); 5] = [
+            (
+                "box, prism",
+                world_b(&contacts(&slab, &below_slab, &body, &on), &on),
+            ),
+            (
+                "prism, box",
+                world_a(&contacts(&body, &on, &slab, &below_slab), &on),
+            ),
+            (
+                "floor, prism",
+                world_b(&contacts(&floor, &Isometry3::identity(), &body, &on), &on),
+            ),
+            (
+                "prism, floor",
+                world_a(&contacts(&body, &on, &floor, &Isometry3::identity()), &on),
+            ),
+            (
+                "prism, prism",
+                world_b(&contacts(&body, &on, &prism(n, r, h), &above), &above),
+            ),
+        ];
+        for (what, pts) in cases {
+            // two sampled faces (n > 32) take different corners: their intersection's
+            if n <= 32 || what != "prism, prism" {
+                assert_eq!(
+                    pts.len(),
+                    corners,
+                    "{n} sides, {what}: {} points",
+                    pts.len()
+                );
+            }
+            let margin = centre_margin(&pts);
+            assert!(
+                margin >= inner * (1.0 - 1e-9),
+                "{n} sides, {what}: the centre is {margin:e} inside the support polygon, \
+                 inradius {inner:e}"
+            );
+        }
+    }
+}
+
+/// each point's witness on the second shape, in the world frame.
+fn world_b(pts: &[ContactPoint3], pose_b: &Isometry3<f64>) -> Vec<Point3<f64>> {
+    pts.iter().map(|p| pose_b * p.point_b).collect()
+}
+
+/// each point's witness on the first shape, in the world frame.
+fn world_a(pts: &[ContactPoint3], pose_a: &Isometry3<f64>) -> Vec<Point3<f64>> {
+    pts.iter().map(|p| pose_a * p.point_a).collect()
 }

@@ -32,7 +32,7 @@
 
 use nalgebra::{Isometry3, Point3, Unit, Vector3};
 use parry3d_f64::query::{ContactManifold, TrackedContact};
-use parry3d_f64::shape::{PackedFeatureId, PolygonalFeature};
+use parry3d_f64::shape::{ConvexPolyhedron, FeatureId, PackedFeatureId, PolygonalFeature, Shape};
 
 use super::contact::{Reference, SAME_NORMAL};
 
@@ -57,18 +57,117 @@ struct Vertex {
 /// A point closer than this times the clip face's diameter to a side plane is on it.
 const ON_PLANE: f64 = 1e-12;
 
-/// At most 4 subject corners, and each of at most 4 clip planes adds at most one corner to a
-/// convex polygon.
-const MAX: usize = 12;
+/// The most corners of a face taken: of a convex hull's face of `n > MAX_CORNERS` corners,
+/// corners evenly spaced along it, consecutive ones at most `ceil(n / MAX_CORNERS)` edges
+/// apart (of a regular 64-gon of circumradius R the support polygon's inradius is then
+/// `R cos(pi / 32)`, 0.5 % short of the face's).
+pub(super) const MAX_CORNERS: usize = 32;
 
-/// A fixed-capacity polygon: no allocation per query.
+/// A support feature with every corner of its face (parry's `PolygonalFeature` keeps at most
+/// the first 4 corners of a polyhedron's face: a hexagonal prism standing on a box touched it
+/// at 4 consecutive corners, a support polygon with its centre on the boundary), in the same
+/// layout, with room for `N` corners.
+#[derive(Clone, Copy, Debug)]
+struct FullFeature<const N: usize> {
+    vertices: [Point3<f64>; N],
+    vids: [PackedFeatureId; N],
+    /// `eids[i]`: the edge leaving corner i (of a sampled face: the face's edge leaving it).
+    eids: [PackedFeatureId; N],
+    fid: PackedFeatureId,
+    num_vertices: usize,
+}
+
+/// The convex polyhedron `shape` is, and where its face `f` starts in its face adjacency
+/// lists and how many corners it has, when `f` is a face of more than 4 corners (the ones
+/// parry's feature cuts short).
+fn long_face<'a>(
+    shape: &'a dyn Shape,
+    f: &PolygonalFeature,
+) -> Option<(&'a ConvexPolyhedron, usize, usize)> {
+    let hull = shape
+        .as_convex_polyhedron()
+        .filter(|_| f.num_vertices >= 4)?;
+    match f.fid.unpack() {
+        FeatureId::Face(i) => hull
+            .faces()
+            .get(i as usize)
+            .filter(|face| face.num_vertices_or_edges > 4)
+            .map(|face| {
+                (
+                    hull,
+                    face.first_vertex_or_edge as usize,
+                    face.num_vertices_or_edges as usize,
+                )
+            }),
+        _ => None,
+    }
+}
+
+impl<const N: usize> FullFeature<N> {
+    /// `f` as it is where it is not a long face of a convex polyhedron (see [`long_face`]);
+    /// otherwise every corner of that face, evenly sampled beyond `N` (see [`MAX_CORNERS`]).
+    fn of(shape: &dyn Shape, f: &PolygonalFeature) -> Self {
+        let mut out = Self {
+            vertices: [Point3::origin(); N],
+            vids: [PackedFeatureId::UNKNOWN; N],
+            eids: [PackedFeatureId::UNKNOWN; N],
+            fid: f.fid,
+            num_vertices: f.num_vertices.min(4).min(N),
+        };
+        let Some((hull, first, count)) = long_face(shape, f) else {
+            let n = out.num_vertices;
+            out.vertices[..n].copy_from_slice(&f.vertices[..n]);
+            out.vids[..n].copy_from_slice(&f.vids[..n]);
+            out.eids[..n].copy_from_slice(&f.eids[..n]);
+            return out;
+        };
+        let take = count.min(N);
+        let (vs, es) = (hull.vertices_adj_to_face(), hull.edges_adj_to_face());
+        for k in 0..take {
+            // corner k of `take` evenly spaced ones (all of them when take == count)
+            let at = first + k * count / take;
+            let (Some(&v), Some(&e)) = (vs.get(at), es.get(at)) else {
+                break;
+            };
+            let Some(p) = hull.points().get(v as usize) else {
+                break;
+            };
+            out.vertices[k] = *p;
+            out.vids[k] = PackedFeatureId::vertex(v);
+            out.eids[k] = PackedFeatureId::edge(e);
+            out.num_vertices = k + 1;
+        }
+        out
+    }
+}
+
+/// Calls `each(corner, id)` for every corner of the support feature `f` of `shape`, every
+/// corner of a long face of a convex polyhedron included (see [`long_face`]).
+pub(super) fn each_corner(
+    shape: &dyn Shape,
+    f: &PolygonalFeature,
+    mut each: impl FnMut(Point3<f64>, PackedFeatureId),
+) {
+    if long_face(shape, f).is_some() {
+        let full = FullFeature::<MAX_CORNERS>::of(shape, f);
+        for i in 0..full.num_vertices {
+            each(full.vertices[i], full.vids[i]);
+        }
+    } else {
+        for i in 0..f.num_vertices.min(4) {
+            each(f.vertices[i], f.vids[i]);
+        }
+    }
+}
+
+/// A fixed-capacity polygon of at most `M` corners: no allocation per query.
 #[derive(Clone, Copy)]
-struct Polygon {
-    v: [Vertex; MAX],
+struct Polygon<const M: usize> {
+    v: [Vertex; M],
     n: usize,
 }
 
-impl Polygon {
+impl<const M: usize> Polygon<M> {
     fn new() -> Self {
         let empty = Vertex {
             p: Point3::origin(),
@@ -77,13 +176,13 @@ impl Polygon {
             next: Along::Subject(0),
         };
         Self {
-            v: [empty; MAX],
+            v: [empty; M],
             n: 0,
         }
     }
 
     fn push(&mut self, v: Vertex) {
-        if self.n < MAX {
+        if self.n < M {
             self.v[self.n] = v;
             self.n += 1;
         }
@@ -91,13 +190,13 @@ impl Polygon {
 }
 
 /// A face feature's corners and labels in the first shape's frame.
-struct Face<'a> {
-    p: [Point3<f64>; 4],
+struct Face<'a, const N: usize> {
+    p: [Point3<f64>; N],
     n: usize,
-    f: &'a PolygonalFeature,
+    f: &'a FullFeature<N>,
 }
 
-impl Face<'_> {
+impl<const N: usize> Face<'_, N> {
     /// the id of the edge from corner `i` to the next (a segment has one edge).
     fn edge(&self, i: usize) -> PackedFeatureId {
         self.f.eids[if self.n == 2 { 0 } else { i }]
@@ -111,16 +210,40 @@ impl Face<'_> {
 /// `local_p2` in each shape's frame, `dist = (p2 - p1) · n`). Returns the normal `n` used, or
 /// `None`, pushing nothing, where clipping does not apply (a vertex, two edges, or a face seen
 /// edge-on): the caller then uses parry's own contacts.
+///
+/// `f1`, `f2` are parry's support features of shapes `a`, `b`; a convex polyhedron's face of
+/// more than 4 corners is taken whole (see [`FullFeature`]).
 pub(super) fn face_contacts(
     pos12: &Isometry3<f64>,
     gjk: &Unit<Vector3<f64>>,
     near: bool,
-    f1: &PolygonalFeature,
-    f2: &PolygonalFeature,
+    (a, f1): (&dyn Shape, &PolygonalFeature),
+    (b, f2): (&dyn Shape, &PolygonalFeature),
+    m: &mut ContactManifold<Reference, ()>,
+) -> Option<Unit<Vector3<f64>>> {
+    // boxes and the faces parry keeps whole on buffers sized for 4 corners
+    if long_face(a, f1).is_none() && long_face(b, f2).is_none() {
+        let (g1, g2) = (FullFeature::<4>::of(a, f1), FullFeature::<4>::of(b, f2));
+        face_contacts_of::<4, { 3 * 4 }>(pos12, gjk, near, &g1, &g2, m)
+    } else {
+        let g1 = FullFeature::<MAX_CORNERS>::of(a, f1);
+        let g2 = FullFeature::<MAX_CORNERS>::of(b, f2);
+        face_contacts_of::<MAX_CORNERS, { 2 * MAX_CORNERS }>(pos12, gjk, near, &g1, &g2, m)
+    }
+}
+
+/// [`face_contacts`] on whole features of at most `N` corners, clipped polygons of at most `M`
+/// (the subject's corners, and one more per clip plane at most).
+fn face_contacts_of<const N: usize, const M: usize>(
+    pos12: &Isometry3<f64>,
+    gjk: &Unit<Vector3<f64>>,
+    near: bool,
+    f1: &FullFeature<N>,
+    f2: &FullFeature<N>,
     m: &mut ContactManifold<Reference, ()>,
 ) -> Option<Unit<Vector3<f64>>> {
     let (n1, n2) = (f1.num_vertices, f2.num_vertices);
-    if n1 < 2 || n2 < 2 || (n1 == 2 && n2 == 2) || n1 > 4 || n2 > 4 {
+    if n1 < 2 || n2 < 2 || (n1 == 2 && n2 == 2) || n1 > N || n2 > N {
         return None;
     }
     let first = Face {
@@ -133,7 +256,7 @@ pub(super) fn face_contacts(
         n: n2,
         f: f2,
     };
-    let face_normal = |f: &Face<'_>| {
+    let face_normal = |f: &Face<'_, N>| {
         let n = (f.n >= 3)
             .then(|| (f.p[1] - f.p[0]).cross(&(f.p[2] - f.p[0])))
             .and_then(|n| Unit::try_new(n, 0.0))?;
@@ -160,7 +283,7 @@ pub(super) fn face_contacts(
         return None;
     }
     m.data = reference;
-    let poly = clip_polygon(clip, subject, &axis);
+    let poly = clip_polygon::<N, M>(clip, subject, &axis);
     for v in &poly.v[..poly.n] {
         let t = (c[0] - v.p).dot(&normal) / along;
         let on_clip = v.p + axis.into_inner() * t;
@@ -181,8 +304,15 @@ pub(super) fn face_contacts(
 }
 
 /// The subject polygon clipped by the prism over the clip face along `axis` (module docs).
-fn clip_polygon(clip: &Face<'_>, subject: &Face<'_>, axis: &Unit<Vector3<f64>>) -> Polygon {
-    let mut poly = Polygon::new();
+fn clip_polygon<const N: usize, const M: usize>(
+    clip: &Face<'_, N>,
+    subject: &Face<'_, N>,
+    axis: &Unit<Vector3<f64>>,
+) -> Polygon<M> {
+    // two buffers, each filled from the other by one clip plane (made once: a polygon is a
+    // few kilobytes)
+    let (mut first, mut second) = (Polygon::<M>::new(), Polygon::<M>::new());
+    let (mut poly, mut out) = (&mut first, &mut second);
     for i in 0..subject.n {
         poly.push(Vertex {
             p: subject.p[i],
@@ -209,7 +339,7 @@ fn clip_polygon(clip: &Face<'_>, subject: &Face<'_>, axis: &Unit<Vector3<f64>>) 
         }
         let slack = ON_PLANE * diameter * side.norm();
         let depth = |p: &Point3<f64>| (p - a).dot(&side);
-        let mut out = Polygon::new();
+        out.n = 0;
         for i in 0..poly.n {
             let cur = poly.v[i];
             let nxt = poly.v[(i + 1) % poly.n];
@@ -236,17 +366,17 @@ fn clip_polygon(clip: &Face<'_>, subject: &Face<'_>, axis: &Unit<Vector3<f64>>) 
                 });
             }
         }
-        poly = out;
+        std::mem::swap(&mut poly, &mut out);
         if poly.n == 0 {
             break;
         }
     }
-    poly
+    *poly
 }
 
 /// The clip face's corner shared by its edges `l` and `k` (unknown if they are not adjacent,
 /// which a convex clip does not produce).
-fn corner_between(clip: &Face<'_>, l: usize, k: usize) -> PackedFeatureId {
+fn corner_between<const N: usize>(clip: &Face<'_, N>, l: usize, k: usize) -> PackedFeatureId {
     if (l + 1) % clip.n == k {
         clip.f.vids[k]
     } else if (k + 1) % clip.n == l {

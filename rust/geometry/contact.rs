@@ -156,7 +156,8 @@ fn unit_of(size: f64) -> f64 {
     2f64.powi(e)
 }
 
-/// Depth (in the query's unit) by which GJK's extra point must beat the clipped ones to stay.
+/// Depth (relative to the smaller shape's size) by which GJK's extra point must beat the
+/// clipped ones to stay.
 const REDUNDANT: f64 = 1e-9;
 
 /// Relative size of the pull-apart of the second query (see [`contacts3`]).
@@ -256,7 +257,8 @@ fn shared_face(fids: impl Iterator<Item = Option<u32>>) -> Option<u32> {
     face
 }
 
-/// Two points of one manifold closer than this (in the query's unit) on both shapes are one.
+/// Two points of one manifold closer than this (relative to the smaller shape's size) on both
+/// shapes are one.
 const SAME_POINT: f64 = 1e-9;
 
 /// Normals closer than this are one (parry's GJK normals of two coplanar triangles of a mesh
@@ -286,7 +288,7 @@ macro_rules! contacts_impl {
         fn $raw(
             (a, b): (&$dynshape, &$dynshape),
             boxes: bool,
-            (unit, near): (f64, f64),
+            (unit, size): (f64, f64),
             pose_a: &$iso<f64>,
             pose_b: &$iso<f64>,
             shift: $vec<f64>,
@@ -296,6 +298,8 @@ macro_rules! contacts_impl {
             out: &mut Vec<$point>,
         ) -> Result<bool> {
             out.clear();
+            // the thresholds relative to the smaller shape's size `size` (in the query's unit)
+            let near = NEAR * size;
             // no history: parry's incremental update needs old points, and GJK's seed from the
             // last normal tilted a face contact's normal by 4e-7 (a box sliding on a box)
             for m in manifolds.iter_mut() {
@@ -376,7 +380,7 @@ macro_rules! contacts_impl {
                     .map(|p| p.dist)
                     .fold(f64::INFINITY, f64::min);
                 for p in &m.points {
-                    if unknown(&p) && known <= p.dist + REDUNDANT {
+                    if unknown(&p) && known <= p.dist + REDUNDANT * size {
                         continue;
                     }
                     let point_a = (part_a * p.local_p1) * unit;
@@ -390,8 +394,8 @@ macro_rules! contacts_impl {
                     // corner from either side; two triangles of a mesh both give the points on
                     // their shared edge) would make the contact Delassus matrix singular
                     let twice = out.iter().any(|q: &$point| {
-                        (q.point_a - point_a).norm() <= SAME_POINT * unit
-                            && (q.point_b - point_b).norm() <= SAME_POINT * unit
+                        (q.point_a - point_a).norm() <= SAME_POINT * size * unit
+                            && (q.point_b - point_b).norm() <= SAME_POINT * size * unit
                             && (q.normal - normal).norm() <= SAME_NORMAL_DUP
                     });
                     if gap <= prediction && !twice {
@@ -451,14 +455,14 @@ macro_rules! contacts_impl {
                 Some(s) if unit != 1.0 && s.ids == ids && s.scale == unit => ((&*s.a, &*s.b), unit),
                 _ => ((a.parry(), b.parry()), 1.0),
             };
-            // NEAR of the smaller shape's size, in the query's unit (a power of two near it:
-            // NEAR of the unit itself moved the threshold by up to a factor sqrt(2), or 1e3
-            // where no scaled shape is kept, with the scene's unit of length)
-            let near = NEAR * size / unit;
+            // the smaller shape's size in the query's unit: the thresholds are relative to it
+            // (relative to the unit, a power of two near it, they moved by up to a factor
+            // sqrt(2) with the scene's unit of length, or by 1e3 where no scaled shape is kept)
+            let size_q = size / unit;
             let zero = $vec::zeros();
             let ws = (&mut *workspace, &mut *convex);
             let boxes = $boxes(a, b);
-            if $raw(shapes, boxes, (unit, near), pose_a, pose_b, zero, prediction, manifolds, ws, out)? {
+            if $raw(shapes, boxes, (unit, size_q), pose_a, pose_b, zero, prediction, manifolds, ws, out)? {
                 return Ok(());
             }
             let first = deepest_gap(out, |p| p.gap);
@@ -489,7 +493,7 @@ macro_rules! contacts_impl {
             };
             let shift = along * (PULL * size);
             let ws = (&mut *workspace, &mut *convex);
-            $raw(shapes, false, (unit, near), pose_a, pose_b, shift, prediction, manifolds, ws, retry)?;
+            $raw(shapes, false, (unit, size_q), pose_a, pose_b, shift, prediction, manifolds, ws, retry)?;
             let second = deepest_gap(retry, |p| p.gap);
             if (empty && !retry.is_empty()) || first <= second + PREFER * size {
                 std::mem::swap(out, retry);

@@ -12,11 +12,13 @@
 //!   polytope and a ball of radius `r`: GJK (EPA when the polytopes overlap) gives the
 //!   closest points `p_1`, `p_2` and the unit direction `n_1` from `A` to `B` of the polytopes;
 //!   the support features of `A` along `n_1` and of `B` along `-n_1` are clipped against each
-//!   other (in 3D by polygon clipping where one is a face, module `clip`), each point's distance `(p_2 - p_1) · n_1 - r_A - r_B`; in 3D GJK's own pair is
+//!   other (in 3D by polygon clipping where one is a face, module `clip`, a convex
+//!   polyhedron's face with all its corners: parry's feature keeps its first 4), each point's
+//!   distance `(p_2 - p_1) · n_1 - r_A - r_B`; in 3D GJK's own pair is
 //!   added (the caller drops it where it is redundant), in 2D only when the clip gave none;
-//! - a shape against the half-space `{x : m · x <= 0}`: the support feature of the shape along
-//!   `-m`, each vertex `v` kept when `m · v - r <= prediction`, its partner `v - (m · v) m` on
-//!   the plane.
+//! - a shape against the half-space `{x : m · x <= 0}` (either one first): the support feature
+//!   of the shape along `-m` (a polyhedron's face whole), each vertex `v` kept when
+//!   `m · v - r <= prediction`, its partner `v - (m · v) m` on the plane.
 //!
 //! Both are the separating-axis construction of a manifold (Acary-Brogliato 2008, ch. 3;
 //! Stewart 2000, §2: the gap function along the normal). Other pairs (balls, compounds,
@@ -27,7 +29,7 @@ use parry2d_f64::query::ContactManifold as Manifold2;
 use parry3d_f64::query::ContactManifold as Manifold3;
 
 macro_rules! convex_impl {
-    ($ws:ident, $query:ident, $parry:ident, $manifold:ty, $dim3:expr, $faces:path) => {
+    ($ws:ident, $query:ident, $parry:ident, $manifold:ty, $dim3:expr, $faces:path, $corners:path) => {
         /// GJK's simplex and EPA's buffers of one pair, kept from query to query.
         pub(super) struct $ws {
             simplex: $parry::query::gjk::VoronoiSimplex,
@@ -58,6 +60,20 @@ macro_rules! convex_impl {
             let (ta, tb) = (a.shape_type(), b.shape_type());
             // parry's dispatcher has closed forms for these (and composites go through their
             // parts): left to it
+            // a half-space first: the same manifold with the roles swapped, then flipped back
+            if ta == T::HalfSpace && tb != T::HalfSpace {
+                let done = $query(&pos12.inverse(), b, a, (prediction, near), manifolds, ws);
+                if done {
+                    for m in manifolds.iter_mut() {
+                        std::mem::swap(&mut m.local_n1, &mut m.local_n2);
+                        for p in &mut m.points {
+                            std::mem::swap(&mut p.local_p1, &mut p.local_p2);
+                            std::mem::swap(&mut p.fid1, &mut p.fid2);
+                        }
+                    }
+                }
+                return done;
+            }
             let special = |t| matches!(t, T::Ball | T::Cuboid | T::Triangle | T::HalfSpace);
             let both_capsules = ta == T::Capsule && tb == T::Capsule;
             if special(ta) || both_capsules {
@@ -95,20 +111,20 @@ macro_rules! convex_impl {
                 let mut feature = $parry::shape::PolygonalFeature::default();
                 pfm_a.local_support_feature(&-n_a, &mut feature);
                 let pos21 = pos12.inverse();
-                for i in 0..feature.num_vertices {
-                    let v = feature.vertices[i];
+                let points = &mut m.points;
+                $corners(a, &feature, |v, vid| {
                     let v_b = pos21 * v;
                     let d = v_b.coords.dot(&n);
                     if d - ra <= prediction {
-                        m.points.push($parry::query::TrackedContact::new(
+                        points.push($parry::query::TrackedContact::new(
                             v - *n_a * ra,
                             v_b - *n * d,
-                            feature.vids[i],
+                            vid,
                             $parry::shape::PackedFeatureId::face(0),
                             d - ra,
                         ));
                     }
-                }
+                });
                 m.local_n1 = -*n_a;
                 m.local_n2 = *n;
                 return true;
@@ -141,19 +157,20 @@ macro_rules! convex_impl {
                     pfm_a.local_support_feature(&n1, &mut f1);
                     pfm_b.local_support_feature(&n2, &mut f2);
                     let near = (p2_1 - p1).dot(&n1) - ra - rb <= near;
-                    let axis = $faces(pos12, &n1, near, &f1, &f2, m).unwrap_or_else(|| {
-                        $parry::shape::PolygonalFeature::contacts(
-                            pos12,
-                            &pos12.inverse(),
-                            &n1,
-                            &n2,
-                            &f1,
-                            &f2,
-                            m,
-                            false,
-                        );
-                        n1
-                    });
+                    let axis =
+                        $faces(pos12, &n1, near, (a, &f1), (b, &f2), m).unwrap_or_else(|| {
+                            $parry::shape::PolygonalFeature::contacts(
+                                pos12,
+                                &pos12.inverse(),
+                                &n1,
+                                &n2,
+                                &f1,
+                                &f2,
+                                m,
+                                false,
+                            );
+                            n1
+                        });
                     if $dim3 || m.points.is_empty() {
                         let unknown = $parry::shape::PackedFeatureId::UNKNOWN;
                         m.points.push($parry::query::TrackedContact::new(
@@ -189,7 +206,8 @@ convex_impl!(
     parry3d_f64,
     Manifold3<super::contact::Reference, ()>,
     true,
-    super::clip::face_contacts
+    super::clip::face_contacts,
+    super::clip::each_corner
 );
 convex_impl!(
     Convex2,
@@ -197,16 +215,34 @@ convex_impl!(
     parry2d_f64,
     Manifold2<super::contact::Reference, ()>,
     false,
-    parry_contacts2
+    parry_contacts2,
+    each_corner2
 );
+
+/// In 2D a support feature has at most 2 corners: parry's is whole.
+fn each_corner2(
+    _: &dyn parry2d_f64::shape::Shape,
+    f: &parry2d_f64::shape::PolygonalFeature,
+    mut each: impl FnMut(nalgebra::Point2<f64>, parry2d_f64::shape::PackedFeatureId),
+) {
+    for i in 0..f.num_vertices.min(2) {
+        each(f.vertices[i], f.vids[i]);
+    }
+}
 
 /// In 2D a face is a segment, and parry's segment clipping is kept.
 fn parry_contacts2(
     _: &nalgebra::Isometry2<f64>,
     _: &Unit<nalgebra::Vector2<f64>>,
     _: bool,
-    _: &parry2d_f64::shape::PolygonalFeature,
-    _: &parry2d_f64::shape::PolygonalFeature,
+    _: (
+        &dyn parry2d_f64::shape::Shape,
+        &parry2d_f64::shape::PolygonalFeature,
+    ),
+    _: (
+        &dyn parry2d_f64::shape::Shape,
+        &parry2d_f64::shape::PolygonalFeature,
+    ),
     _: &mut Manifold2<super::contact::Reference, ()>,
 ) -> Option<Unit<nalgebra::Vector2<f64>>> {
     None

@@ -219,3 +219,46 @@ fn whether_a_point_names_a_face_does_not_depend_on_the_unit_of_length() {
         }
     }
 }
+
+/// A cube of half side `h = 0.05 u` whose bottom corner at (+h, +h) is cut off by a chamfer
+/// `eps h` long on each side (two corners about `eps h` apart), standing on a larger box.
+fn chamfered_on_box(eps: f64, u: f64) -> Vec<ContactPoint3> {
+    let h = 0.05 * u;
+    let mut pts = corners([h; 3]);
+    pts.retain(|p| !(p[0] > 0.0 && p[1] > 0.0 && p[2] < 0.0));
+    pts.push([h - eps * h, h, -h]);
+    pts.push([h, h - eps * h, -h]);
+    let hull = ok(Shape3::convex_hull(&pts));
+    let slab = ok(Shape3::cuboid([4.0 * h, 4.0 * h, h]));
+    let pa = Isometry3::translation(0.0, 0.0, -h);
+    let pb = Isometry3::translation(0.0, 0.0, h);
+    c3(&slab, &pa, &hull, &pb, 1e-2 * u)
+}
+
+/// Two points of a manifold closer than a threshold are one (a point twice would make W
+/// singular). The threshold was 1e-9 of the query's unit, a power of two within a factor
+/// sqrt(2) of the smaller shape's size, so a chamfer 1e-9 of the size long gave its two
+/// corners in some units of length and one of them in others. It is now relative to the size
+/// itself: the same points in every unit.
+#[test]
+fn whether_two_points_are_one_does_not_depend_on_the_unit_of_length() {
+    for eps in [1e-10, 5e-10, 7e-10, 1e-9, 1.4e-9, 2e-9, 5e-9, 1e-3] {
+        let base = chamfered_on_box(eps, 1.0);
+        // the pentagon's 5 corners, or 4 where the chamfer's two are one
+        assert!(
+            (4..=5).contains(&base.len()),
+            "chamfer {eps}: {} points",
+            base.len()
+        );
+        if eps >= 1e-3 {
+            assert_eq!(base.len(), 5, "chamfer {eps}: a corner lost");
+        }
+        for k in -8..=8 {
+            for m in [1.0, 1.3, 1.7, 2.3, 3.1, 4.2, 5.6, 7.5] {
+                let u = m * 10f64.powi(k);
+                let pts = chamfered_on_box(eps, u);
+                assert_eq!(pts.len(), base.len(), "chamfer {eps}, unit {u:e}");
+            }
+        }
+    }
+}
