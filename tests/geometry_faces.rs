@@ -226,3 +226,55 @@ fn world_b(pts: &[ContactPoint3], pose_b: &Isometry3<f64>) -> Vec<Point3<f64>> {
 fn world_a(pts: &[ContactPoint3], pose_a: &Isometry3<f64>) -> Vec<Point3<f64>> {
     pts.iter().map(|p| pose_a * p.point_a).collect()
 }
+
+/// A compound of a prism and a ball standing on a box, on a half-space (either order) and on
+/// another such compound: the prism's part touches at every corner of its face (parry's
+/// composite path kept 4), the ball at one point.
+#[test]
+fn a_compound_s_hull_part_touches_at_every_corner() {
+    let (r, h) = (0.05, 0.05);
+    let slab = Shape3::cuboid([0.4, 0.4, 0.05]).unwrap_or_else(|e| panic!("{e}"));
+    let floor = Shape3::half_space([0.0, 0.0, 1.0]).unwrap_or_else(|e| panic!("{e}"));
+    let ball = Shape3::sphere(h).unwrap_or_else(|e| panic!("{e}"));
+    for n in [5, 8, 12, 40] {
+        let compound = |ball: &Shape3| {
+            Shape3::compound(&[
+                (Isometry3::translation(-0.1, 0.0, 0.0), prism(n, r, h)),
+                (Isometry3::translation(0.1, 0.0, 0.0), ball.clone()),
+            ])
+            .unwrap_or_else(|e| panic!("{e}"))
+        };
+        let body = compound(&ball);
+        let corners = n.min(32);
+        let on = Isometry3::translation(0.0, 0.0, h);
+        let below_slab = Isometry3::translation(0.0, 0.0, -0.05);
+        let id = Isometry3::identity();
+        let cases = [
+            (
+                "box, compound",
+                contacts(&slab, &below_slab, &body, &on).len(),
+            ),
+            (
+                "compound, box",
+                contacts(&body, &on, &slab, &below_slab).len(),
+            ),
+            ("floor, compound", contacts(&floor, &id, &body, &on).len()),
+            ("compound, floor", contacts(&body, &on, &floor, &id).len()),
+        ];
+        for (what, count) in cases {
+            assert_eq!(count, corners + 1, "{n} sides, {what}");
+        }
+        // two compounds, the upper one's prism on the lower one's
+        let above = Isometry3::translation(0.0, 0.0, 3.0 * h + 0.5);
+        let lifted = Isometry3::translation(0.0, 0.0, 3.0 * h);
+        let upper = compound(&ball);
+        let both = contacts(&body, &on, &upper, &lifted).len();
+        // two sampled faces (n > 32) take different corners: their intersection's
+        if n <= 32 {
+            assert_eq!(both, corners + 1, "{n} sides, compound on compound");
+        } else {
+            assert!(both > 4, "{n} sides, compound on compound: {both} points");
+        }
+        assert!(contacts(&body, &on, &upper, &above).is_empty());
+    }
+}

@@ -39,9 +39,9 @@
 //! Allocation: a warm query between separated shapes allocates nothing, nor does a touching
 //! or overlapping one between convex shapes with polygonal features or of one against a
 //! half-space (module `convex`: the manifold, GJK's simplex and EPA's buffers kept in the
-//! cache); balls, compounds, meshes and heightfields go through parry's dispatcher, which
-//! still allocates inside touching queries (a few allocations per query, a few tens for
-//! meshes and heightfields).
+//! cache), nor one of a compound, whose parts go through the same construction pair by pair;
+//! balls, meshes and heightfields go through parry's dispatcher, which still allocates inside
+//! touching queries (a few allocations per query, a few tens for meshes and heightfields).
 
 use nalgebra::{Isometry2, Isometry3, Point2, Point3, Vector2, Vector3};
 use parry2d_f64::query::{
@@ -59,7 +59,7 @@ use parry2d_f64::shape::Shape as Parry2;
 use parry3d_f64::shape::Shape as Parry3;
 
 use super::box_pair::{box_pair, BoxPair};
-use super::convex::{convex2, convex3, Convex2, Convex3};
+use super::convex::{convex2, convex3_or_parts, Convex2, Convex3};
 use super::shape2::{check_pose2, Shape2};
 use super::shape3::{check_pose3, Shape3, ShapeKind3};
 use crate::error::{CoulombError, Result};
@@ -519,7 +519,7 @@ contacts_impl!(
     /// the first beats it by more than `1e-12 L`).
     contacts3, raw3, Shape3, Isometry3, Vector3, ContactPoint3, ContactCache3, Dispatcher3,
     check_pose3, Manifold3<Reference, ()>, Workspace3, dyn Parry3, Tracked3, face_normal3, part_normal3,
-    convex3, Convex3, box_pair3, boxes3
+    convex3_or_parts, Convex3, box_pair3, boxes3
 );
 
 contacts_impl!(

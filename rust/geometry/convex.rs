@@ -29,7 +29,7 @@ use parry2d_f64::query::ContactManifold as Manifold2;
 use parry3d_f64::query::ContactManifold as Manifold3;
 
 macro_rules! convex_impl {
-    ($ws:ident, $query:ident, $parry:ident, $manifold:ty, $dim3:expr, $faces:path, $corners:path) => {
+    ($ws:ident, $query:ident, $handles:ident, $one:ident, $parry:ident, $manifold:ty, $dim3:expr, $faces:path, $corners:path) => {
         /// GJK's simplex and EPA's buffers of one pair, kept from query to query.
         pub(super) struct $ws {
             simplex: $parry::query::gjk::VoronoiSimplex,
@@ -52,32 +52,61 @@ macro_rules! convex_impl {
             pos12: &$parry::math::Isometry<f64>,
             a: &dyn $parry::shape::Shape,
             b: &dyn $parry::shape::Shape,
-            (prediction, near): (f64, f64),
+            pn: (f64, f64),
             manifolds: &mut Vec<$manifold>,
+            ws: &mut $ws,
+        ) -> bool {
+            if !$handles(a, b) {
+                return false;
+            }
+            if manifolds.len() != 1 {
+                manifolds.clear();
+                manifolds.push(<$manifold>::new());
+            }
+            $one(pos12, a, b, pn, &mut manifolds[0], ws)
+        }
+
+        /// Whether [`$one`] handles the pair: convex shapes with polygonal features, or one of
+        /// them and a half-space (parry's dispatcher has closed forms for balls, cuboids,
+        /// triangles and two capsules, and composites go through their parts).
+        pub(super) fn $handles(a: &dyn $parry::shape::Shape, b: &dyn $parry::shape::Shape) -> bool {
+            use $parry::shape::ShapeType as T;
+            let (ta, tb) = (a.shape_type(), b.shape_type());
+            let special = |t| matches!(t, T::Ball | T::Cuboid | T::Triangle | T::HalfSpace);
+            let featured = |s: &dyn $parry::shape::Shape, t| {
+                !special(t) && s.as_polygonal_feature_map().is_some()
+            };
+            if ta == T::Capsule && tb == T::Capsule {
+                return false;
+            }
+            match (ta == T::HalfSpace, tb == T::HalfSpace) {
+                (true, true) => false,
+                (true, false) => featured(b, tb),
+                (false, true) => featured(a, ta),
+                (false, false) => featured(a, ta) && featured(b, tb),
+            }
+        }
+
+        /// The manifold of a pair [`$handles`] accepts into `m` (its points replaced).
+        fn $one(
+            pos12: &$parry::math::Isometry<f64>,
+            a: &dyn $parry::shape::Shape,
+            b: &dyn $parry::shape::Shape,
+            (prediction, near): (f64, f64),
+            m: &mut $manifold,
             ws: &mut $ws,
         ) -> bool {
             use $parry::shape::ShapeType as T;
             let (ta, tb) = (a.shape_type(), b.shape_type());
-            // parry's dispatcher has closed forms for these (and composites go through their
-            // parts): left to it
             // a half-space first: the same manifold with the roles swapped, then flipped back
-            if ta == T::HalfSpace && tb != T::HalfSpace {
-                let done = $query(&pos12.inverse(), b, a, (prediction, near), manifolds, ws);
-                if done {
-                    for m in manifolds.iter_mut() {
-                        std::mem::swap(&mut m.local_n1, &mut m.local_n2);
-                        for p in &mut m.points {
-                            std::mem::swap(&mut p.local_p1, &mut p.local_p2);
-                            std::mem::swap(&mut p.fid1, &mut p.fid2);
-                        }
-                    }
+            if ta == T::HalfSpace {
+                let done = $one(&pos12.inverse(), b, a, (prediction, near), m, ws);
+                std::mem::swap(&mut m.local_n1, &mut m.local_n2);
+                for p in &mut m.points {
+                    std::mem::swap(&mut p.local_p1, &mut p.local_p2);
+                    std::mem::swap(&mut p.fid1, &mut p.fid2);
                 }
                 return done;
-            }
-            let special = |t| matches!(t, T::Ball | T::Cuboid | T::Triangle | T::HalfSpace);
-            let both_capsules = ta == T::Capsule && tb == T::Capsule;
-            if special(ta) || both_capsules {
-                return false;
             }
             let Some((pfm_a, ra)) = a.as_polygonal_feature_map() else {
                 return false;
@@ -87,22 +116,13 @@ macro_rules! convex_impl {
             } else {
                 None
             };
-            let other = if half_space.is_none() {
-                if special(tb) {
-                    return false;
-                }
-                match b.as_polygonal_feature_map() {
+            let other = match half_space {
+                Some(_) => None,
+                None => match b.as_polygonal_feature_map() {
                     Some(x) => Some(x),
                     None => return false,
-                }
-            } else {
-                None
+                },
             };
-            if manifolds.len() != 1 {
-                manifolds.clear();
-                manifolds.push(<$manifold>::new());
-            }
-            let m = &mut manifolds[0];
             m.points.clear();
             if let Some(hs) = half_space {
                 // the half-space is b: its frame is a's moved by pos12
@@ -203,6 +223,8 @@ macro_rules! convex_impl {
 convex_impl!(
     Convex3,
     convex3,
+    handles3,
+    one3,
     parry3d_f64,
     Manifold3<super::contact::Reference, ()>,
     true,
@@ -212,6 +234,8 @@ convex_impl!(
 convex_impl!(
     Convex2,
     convex2,
+    handles2,
+    one2,
     parry2d_f64,
     Manifold2<super::contact::Reference, ()>,
     false,
@@ -246,4 +270,92 @@ fn parry_contacts2(
     _: &mut Manifold2<super::contact::Reference, ()>,
 ) -> Option<Unit<nalgebra::Vector2<f64>>> {
     None
+}
+
+/// [`convex3`], and compounds of convex parts against convex shapes, half-spaces and other
+/// compounds part by part: each pair of parts whose bounding boxes (grown by the prediction)
+/// meet gets its manifold from [`convex3`]'s construction where it applies (a polyhedron's
+/// face whole), from parry's convex-convex manifold otherwise (balls, boxes of parry's own
+/// kind). parry's composite path took every part pair through its own convex-convex manifold,
+/// which keeps only 4 corners of a face. `false`, with `manifolds` untouched, for any other
+/// pair (meshes, heightfields: parry's dispatcher).
+pub(super) fn convex3_or_parts(
+    pos12: &nalgebra::Isometry3<f64>,
+    a: &dyn parry3d_f64::shape::Shape,
+    b: &dyn parry3d_f64::shape::Shape,
+    pn: (f64, f64),
+    manifolds: &mut Vec<Manifold3<super::contact::Reference, ()>>,
+    ws: &mut Convex3,
+) -> bool {
+    use parry3d_f64::bounding_volume::BoundingVolume as _;
+    use parry3d_f64::query::PersistentQueryDispatcher as _;
+    use parry3d_f64::shape::ShapeType as T;
+    let (ca, cb) = (a.as_compound(), b.as_compound());
+    if ca.is_none() && cb.is_none() {
+        return convex3(pos12, a, b, pn, manifolds, ws);
+    }
+    let whole = |s: &dyn parry3d_f64::shape::Shape| s.is_convex() || s.shape_type() == T::HalfSpace;
+    if (ca.is_none() && !whole(a)) || (cb.is_none() && !whole(b)) {
+        return false;
+    }
+    let identity = nalgebra::Isometry3::identity();
+    let (na, nb) = (
+        ca.map_or(1, |c| c.shapes().len()),
+        cb.map_or(1, |c| c.shapes().len()),
+    );
+    let prediction = pn.0;
+    let mut used = 0;
+    for ia in 0..na {
+        let Some((pa, sa)) = part(ca, a, ia, identity) else {
+            return false;
+        };
+        let box_a = sa.compute_local_aabb().loosened(prediction);
+        for ib in 0..nb {
+            let Some((pb, sb)) = part(cb, b, ib, identity) else {
+                return false;
+            };
+            let pos = pa.inv_mul(&(pos12 * pb));
+            if !box_a.intersects(&sb.compute_aabb(&pos)) {
+                continue;
+            }
+            if used == manifolds.len() {
+                manifolds.push(Manifold3::new());
+            }
+            let m = &mut manifolds[used];
+            used += 1;
+            m.points.clear();
+            m.subshape1 = ia as u32;
+            m.subshape2 = ib as u32;
+            m.subshape_pos1 = ca.map(|_| pa);
+            m.subshape_pos2 = cb.map(|_| pb);
+            let done = if handles3(sa, sb) {
+                one3(&pos, sa, sb, pn, m, ws)
+            } else {
+                parry3d_f64::query::DefaultQueryDispatcher
+                    .contact_manifold_convex_convex(&pos, sa, sb, None, None, prediction, m)
+                    .is_ok()
+            };
+            if !done {
+                return false;
+            }
+        }
+    }
+    for m in &mut manifolds[used..] {
+        m.points.clear();
+    }
+    true
+}
+
+/// Part `k` of compound `c` with its pose in the compound's frame, or `s` itself (at
+/// `identity`) where `s` is not a compound.
+fn part<'a>(
+    c: Option<&'a parry3d_f64::shape::Compound>,
+    s: &'a dyn parry3d_f64::shape::Shape,
+    k: usize,
+    identity: nalgebra::Isometry3<f64>,
+) -> Option<(nalgebra::Isometry3<f64>, &'a dyn parry3d_f64::shape::Shape)> {
+    match c {
+        Some(c) => c.shapes().get(k).map(|(p, sh)| (*p, &**sh)),
+        None => Some((identity, s)),
+    }
 }

@@ -138,10 +138,12 @@ def test_a_compound_and_a_hull_touch_as_their_parts() -> None:
     assert abs(tr.q[-1, 9]) < 1e-6
 
 
+@pytest.mark.parametrize("compound", [False, True])
 @pytest.mark.parametrize("sides", [5, 6, 8, 12, 40])
-def test_a_prism_of_many_sides_stands_still_on_the_floor(sides: int) -> None:
+def test_a_prism_of_many_sides_stands_still_on_the_floor(sides: int, compound: bool) -> None:
     """A hull's face of more than 4 corners touches at all of them (up to 32, sampled evenly
-    beyond): before, an octagonal prism stood on 4 consecutive corners and fell over."""
+    beyond), alone or as a compound's part: before, an octagonal prism stood on 4 consecutive
+    corners and fell over."""
     r = h = 0.05
     corners = []
     for k in range(sides):
@@ -151,7 +153,10 @@ def test_a_prism_of_many_sides_stands_still_on_the_floor(sides: int) -> None:
     floor = scene.add(coulomb.HalfSpace(normal=(0, 0, 1), point=(0, 0, 0)))
     body = scene.add(coulomb.RigidBody3D(mass=1.0, inertia=(1e-3, 1e-3, 1.25e-3),
                                          position=(0.0, 0.0, h)))
-    scene.contact(scene.attach(body, coulomb.ConvexHull(points=corners)), floor, mu=0.5)
+    shape = coulomb.ConvexHull(points=corners)
+    if compound:
+        shape = coulomb.Compound(parts=[(shape, None, None)])
+    scene.contact(scene.attach(body, shape), floor, mu=0.5)
     tr = scene.simulate(t_end=1.0, h=1e-3)
     assert tr.success
     assert np.max(np.abs(tr.q - tr.q[0])) < 1e-9
