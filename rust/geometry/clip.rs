@@ -104,9 +104,9 @@ fn long_face<'a>(
 }
 
 impl<const N: usize> FullFeature<N> {
-    /// `f` as it is where it is not a long face of a convex polyhedron (see [`long_face`]);
-    /// otherwise every corner of that face, evenly sampled beyond `N` (see [`MAX_CORNERS`]).
-    fn of(shape: &dyn Shape, f: &PolygonalFeature) -> Self {
+    /// `f` as it is where `long` is `None`; otherwise every corner of the long face `long`
+    /// ([`long_face`] of `f`), evenly sampled beyond `N` (see [`MAX_CORNERS`]).
+    fn of(f: &PolygonalFeature, long: Option<(&ConvexPolyhedron, usize, usize)>) -> Self {
         let mut out = Self {
             vertices: [Point3::origin(); N],
             vids: [PackedFeatureId::UNKNOWN; N],
@@ -114,7 +114,7 @@ impl<const N: usize> FullFeature<N> {
             fid: f.fid,
             num_vertices: f.num_vertices.min(4).min(N),
         };
-        let Some((hull, first, count)) = long_face(shape, f) else {
+        let Some((hull, first, count)) = long else {
             let n = out.num_vertices;
             out.vertices[..n].copy_from_slice(&f.vertices[..n]);
             out.vids[..n].copy_from_slice(&f.vids[..n]);
@@ -148,8 +148,8 @@ pub(super) fn each_corner(
     f: &PolygonalFeature,
     mut each: impl FnMut(Point3<f64>, PackedFeatureId),
 ) {
-    if long_face(shape, f).is_some() {
-        let full = FullFeature::<MAX_CORNERS>::of(shape, f);
+    if let Some(long) = long_face(shape, f) {
+        let full = FullFeature::<MAX_CORNERS>::of(f, Some(long));
         for i in 0..full.num_vertices {
             each(full.vertices[i], full.vids[i]);
         }
@@ -221,13 +221,17 @@ pub(super) fn face_contacts(
     (b, f2): (&dyn Shape, &PolygonalFeature),
     m: &mut ContactManifold<Reference, ()>,
 ) -> Option<Unit<Vector3<f64>>> {
+    let (long1, long2) = (long_face(a, f1), long_face(b, f2));
     // boxes and the faces parry keeps whole on buffers sized for 4 corners
-    if long_face(a, f1).is_none() && long_face(b, f2).is_none() {
-        let (g1, g2) = (FullFeature::<4>::of(a, f1), FullFeature::<4>::of(b, f2));
+    if long1.is_none() && long2.is_none() {
+        let (g1, g2) = (
+            FullFeature::<4>::of(f1, None),
+            FullFeature::<4>::of(f2, None),
+        );
         face_contacts_of::<4, { 3 * 4 }>(pos12, gjk, near, &g1, &g2, m)
     } else {
-        let g1 = FullFeature::<MAX_CORNERS>::of(a, f1);
-        let g2 = FullFeature::<MAX_CORNERS>::of(b, f2);
+        let g1 = FullFeature::<MAX_CORNERS>::of(f1, long1);
+        let g2 = FullFeature::<MAX_CORNERS>::of(f2, long2);
         face_contacts_of::<MAX_CORNERS, { 2 * MAX_CORNERS }>(pos12, gjk, near, &g1, &g2, m)
     }
 }
@@ -309,8 +313,8 @@ fn clip_polygon<const N: usize, const M: usize>(
     subject: &Face<'_, N>,
     axis: &Unit<Vector3<f64>>,
 ) -> Polygon<M> {
-    // two buffers, each filled from the other by one clip plane (made once: a polygon is a
-    // few kilobytes)
+    // two buffers, each filled from the other by one clip plane (made once per query, not
+    // per plane: a polygon of 2 * MAX_CORNERS corners is 3 kB)
     let (mut first, mut second) = (Polygon::<M>::new(), Polygon::<M>::new());
     let (mut poly, mut out) = (&mut first, &mut second);
     for i in 0..subject.n {

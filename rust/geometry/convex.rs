@@ -21,8 +21,9 @@
 //!   `m · v - r <= prediction`, its partner `v - (m · v) m` on the plane.
 //!
 //! Both are the separating-axis construction of a manifold (Acary-Brogliato 2008, ch. 3;
-//! Stewart 2000, §2: the gap function along the normal). Other pairs (balls, compounds,
-//! meshes, heightfields) go through parry's dispatcher.
+//! Stewart 2000, §2: the gap function along the normal). Compounds go part by part
+//! ([`convex3_or_parts`]); other pairs (balls, meshes, heightfields) go through parry's
+//! dispatcher.
 
 use nalgebra::Unit;
 use parry2d_f64::query::ContactManifold as Manifold2;
@@ -304,11 +305,16 @@ pub(super) fn convex3_or_parts(
         cb.map_or(1, |c| c.shapes().len()),
     );
     let prediction = pn.0;
+    // b's bounding box in a's frame: a's parts away from it are skipped before any pairing
+    let whole_b = b.compute_aabb(pos12).loosened(prediction);
     let mut used = 0;
     for ia in 0..na {
         let Some((pa, sa)) = part(ca, a, ia, identity) else {
             return false;
         };
+        if !sa.compute_aabb(&pa).intersects(&whole_b) {
+            continue;
+        }
         let box_a = sa.compute_local_aabb().loosened(prediction);
         for ib in 0..nb {
             let Some((pb, sb)) = part(cb, b, ib, identity) else {
