@@ -9,6 +9,10 @@
 //! Convex hulls whose faces have more than 4 corners (prisms of 5 to 40 sides) standing on a
 //! box, on a half-space and on each other touch at every corner of the face (at most 32,
 //! sampled evenly beyond): parry's support feature keeps a face's first 4 corners only.
+//!
+//! A cylinder's or a cone's flat cap touches at the 32 corners of its inscribed regular
+//! polygon (parry's feature is the inscribed square), and rocking on its rim at the rim's
+//! lowest point.
 
 use coulomb::geometry::{contacts3, ContactCache3, ContactPoint3, Shape3};
 use nalgebra::{Isometry3, Point3, UnitQuaternion, Vector3};
@@ -276,5 +280,96 @@ fn a_compound_s_hull_part_touches_at_every_corner() {
             assert!(both > 4, "{n} sides, compound on compound: {both} points");
         }
         assert!(contacts(&body, &on, &upper, &above).is_empty());
+    }
+}
+
+/// A cylinder or a cone (half height `h`, radius `r`) standing on its base on a box, on the
+/// floor (either order) and, for the cylinder, on another one's top: 32 points on the base's
+/// circle, the centre inside their polygon by its inradius `r cos(pi / 32)`; turned about its
+/// axis, the same. Tilted on its rim, one point at the rim's lowest point.
+#[test]
+fn a_round_cap_touches_at_the_corners_of_its_inscribed_polygon() {
+    let (r, h) = (0.05, 0.1);
+    let slab = Shape3::cuboid([0.2, 0.2, 0.05]).unwrap_or_else(|e| panic!("{e}"));
+    let floor = Shape3::half_space([0.0, 0.0, 1.0]).unwrap_or_else(|e| panic!("{e}"));
+    let below_slab = Isometry3::translation(0.0, 0.0, -0.05);
+    let id = Isometry3::identity();
+    let inner = r * (std::f64::consts::PI / 32.0).cos();
+    let cylinder = Shape3::cylinder(h, r).unwrap_or_else(|e| panic!("{e}"));
+    let cone = Shape3::cone(h, r).unwrap_or_else(|e| panic!("{e}"));
+    // the shapes' axis y turned to z, then about z by `spin`
+    let upright = |spin: f64, z: f64| {
+        let turn = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), spin)
+            * UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::FRAC_PI_2);
+        Isometry3::from_parts(Vector3::new(0.0, 0.0, z).into(), turn)
+    };
+    for (name, body) in [("cylinder", &cylinder), ("cone", &cone)] {
+        for spin in [0.0, 0.01, 0.7, 2.0] {
+            let on = upright(spin, h);
+            let mut cases = vec![
+                (
+                    "box",
+                    world_b(&contacts(&slab, &below_slab, body, &on), &on),
+                ),
+                (
+                    "box second",
+                    world_a(&contacts(body, &on, &slab, &below_slab), &on),
+                ),
+                ("floor", world_b(&contacts(&floor, &id, body, &on), &on)),
+                (
+                    "floor second",
+                    world_a(&contacts(body, &on, &floor, &id), &on),
+                ),
+            ];
+            if name == "cylinder" {
+                let above = upright(0.3, 3.0 * h);
+                cases.push((
+                    "cylinder",
+                    world_b(&contacts(body, &on, body, &above), &above),
+                ));
+            }
+            for (what, pts) in cases {
+                let case = format!("{name} turned {spin} on {what}");
+                // two caps turned apart: their polygons' intersection, whose corners between
+                // two of a cap's lie inside the rim by at most r - inner
+                let (count, slack, z) = if what == "cylinder" {
+                    (32..=64, r - inner, 2.0 * h)
+                } else {
+                    (32..=32, 1e-12, 0.0)
+                };
+                assert!(count.contains(&pts.len()), "{case}: {} points", pts.len());
+                for p in &pts {
+                    let off = r - p.x.hypot(p.y);
+                    let on = (-1e-12..=slack + 1e-12).contains(&off);
+                    assert!(on && (p.z - z).abs() <= 1e-12, "{case}: {p:?} off the rim");
+                }
+                let margin = centre_margin(&pts);
+                assert!(
+                    margin >= inner * (1.0 - 1e-9),
+                    "{case}: the centre is {margin:e} inside the support polygon, inradius {inner:e}"
+                );
+            }
+            // tilted by 0.3 rad about x: the rim's lowest point, at y = h sin(0.3) - r cos(0.3)
+            // and z = 0 when the centre is at height h cos(0.3) + r sin(0.3)
+            let tilt = 0.3f64;
+            let turn = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), tilt)
+                * upright(spin, 0.0).rotation;
+            let lift = h * tilt.cos() + r * tilt.sin();
+            let pose = Isometry3::from_parts(Vector3::new(0.0, 0.0, lift).into(), turn);
+            let pts = contacts(body, &pose, &floor, &id);
+            let touching: Vec<_> = pts.iter().filter(|p| p.gap <= 1e-12).collect();
+            assert_eq!(touching.len(), 1, "{name} turned {spin}, tilted: {pts:?}");
+            let w = pose * touching[0].point_a;
+            let lowest = Point3::new(0.0, h * tilt.sin() - r * tilt.cos(), 0.0);
+            assert!(
+                (w - lowest).norm() <= 1e-12,
+                "{name} turned {spin}, tilted: {w:?}"
+            );
+            assert!(
+                touching[0].gap.abs() <= 1e-12,
+                "{name}: gap {}",
+                touching[0].gap
+            );
+        }
     }
 }

@@ -1,8 +1,16 @@
-//! Convex hulls whose faces have more than 4 corners (prisms of 5 to 40 sides) standing on
-//! the floor and on each other: they stand still (exact sticking, every coordinate within
-//! 1e-9 of its start over 1 s). parry's support feature keeps only the first 4 corners of a
-//! polyhedron's face; an octagonal prism then stood on 4 consecutive corners, its centre
-//! outside their polygon, and fell over (0.06 m, 0.5 rad in 1 s) with every step solved.
+//! Flat faces that parry's support feature cuts short, standing on the floor and on each
+//! other.
+//!
+//! Convex hulls whose faces have more than 4 corners (prisms of 5 to 40 sides) stand still
+//! (exact sticking, every coordinate within 1e-9 of its start over 1 s). parry's support
+//! feature keeps only the first 4 corners of a polyhedron's face; an octagonal prism then
+//! stood on 4 consecutive corners, its centre outside their polygon, and fell over (0.06 m,
+//! 0.5 rad in 1 s) with every step solved.
+//!
+//! A cylinder or a cone standing on its base on a slope stands while the line of gravity
+//! through its centre meets the base within the inscribed polygon of 32 corners, and tips
+//! over beyond the base's circle. parry gives a cap as its inscribed square: the body tipped
+//! over at `r / sqrt 2`.
 
 use coulomb::contact::ContactStatus;
 use coulomb::geometry::Shape3;
@@ -77,6 +85,78 @@ fn prisms_of_many_sides_stand_still_on_the_floor_and_on_each_other() {
                 .map(|(a, b)| (a - b).abs())
                 .fold(0.0, f64::max);
             assert!(moved < 1e-9, "{case}: moved by {moved:e}");
+        }
+    }
+}
+
+/// A cylinder or a cone (axis y turned to z, half height 0.1, radius 0.05, its body's centre
+/// at the shape's) standing on its base on the floor under gravity tilted by `slope` toward
+/// the azimuth `azimuth`, friction 2 (sticking): how far its centre moved in 1 s, with every
+/// step's status.
+fn on_a_slope(cone: bool, slope: f64, azimuth: f64) -> (f64, bool) {
+    let (hh, r) = (0.1, 0.05);
+    let shape = if cone {
+        ok(Shape3::cone(hh, r))
+    } else {
+        ok(Shape3::cylinder(hh, r))
+    };
+    let (c, s) = (
+        std::f64::consts::FRAC_PI_4.cos(),
+        std::f64::consts::FRAC_PI_4.sin(),
+    );
+    let q0 = vec![0.0, 0.0, hh, c, s, 0.0, 0.0];
+    let mut scene = one_solid_on_floor(3, SolidShape::Spatial(shape), q0, 2.0);
+    scene.gravity = vec![
+        G * slope.sin() * azimuth.cos(),
+        G * slope.sin() * azimuth.sin(),
+        -G * slope.cos(),
+    ];
+    let tr = match simulate(&scene, &StepSettings::new(1e-3, 1000)) {
+        Ok(tr) => tr,
+        Err(e) => panic!("valid scene: {e}"),
+    };
+    let solved = tr
+        .steps
+        .iter()
+        .all(|s| s.status == Some(ContactStatus::Solved));
+    let last = &tr.q[tr.q.len() - tr.nq..];
+    let moved = (0..3)
+        .map(|k| (last[k] - tr.q[k]).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    (moved, solved)
+}
+
+#[test]
+fn a_cylinder_or_a_cone_on_a_slope_tips_over_at_the_edge_of_its_round_base() {
+    // the base's radius over the centre's height: the line of gravity leaves the circle at
+    // tan(slope) = r / hh = 0.5; the inscribed 32-gon's inradius is r cos(pi / 32)
+    let edge = 0.5f64;
+    let inner = edge * (std::f64::consts::PI / 32.0).cos();
+    for cone in [false, true] {
+        for azimuth in [
+            0.0,
+            0.05,
+            std::f64::consts::PI / 32.0,
+            0.4,
+            std::f64::consts::FRAC_PI_4,
+            2.0,
+        ] {
+            let case = format!(
+                "{} toward azimuth {azimuth}",
+                if cone { "cone" } else { "cylinder" }
+            );
+            let (moved, solved) = on_a_slope(cone, (0.99 * inner).atan(), azimuth);
+            assert!(solved, "{case}: standing, a step not solved");
+            assert!(
+                moved < 1e-9,
+                "{case}: standing at 0.99 of the inradius, moved {moved:e}"
+            );
+            let (moved, _) = on_a_slope(cone, (1.05 * edge).atan(), azimuth);
+            assert!(
+                moved > 1e-2,
+                "{case}: beyond the base's edge, moved only {moved:e}"
+            );
         }
     }
 }

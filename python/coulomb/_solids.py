@@ -119,7 +119,8 @@ class _Round(Shape):
 class Cylinder(_Round):
     """A cylinder of ``radius`` and half height ``half_height`` (both > 0) whose axis is the
     y axis of its frame, placed in the body frame at ``center`` turned by ``orientation`` (a
-    quaternion ``(w, x, y, z)``); spatial scenes."""
+    quaternion ``(w, x, y, z)``); spatial scenes. A flat end touches at the 32 corners of
+    the regular polygon inscribed in its circle."""
 
     _kind = "cylinder"
 
@@ -127,7 +128,8 @@ class Cylinder(_Round):
 @dataclass(eq=False)
 class Cone(_Round):
     """A cone of base ``radius`` and half height ``half_height`` along its frame's y axis (apex
-    at ``y = +half_height``, base disk at ``-half_height``), placed like :class:`Cylinder`."""
+    at ``y = +half_height``, base disk at ``-half_height``), placed like :class:`Cylinder`;
+    the base touches like a cylinder's end."""
 
     _kind = "cone"
 

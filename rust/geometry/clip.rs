@@ -32,7 +32,9 @@
 
 use nalgebra::{Isometry3, Point3, Unit, Vector3};
 use parry3d_f64::query::{ContactManifold, TrackedContact};
-use parry3d_f64::shape::{ConvexPolyhedron, FeatureId, PackedFeatureId, PolygonalFeature, Shape};
+use parry3d_f64::shape::{
+    ConvexPolyhedron, FeatureId, PackedFeatureId, PolygonalFeature, Shape, ShapeType,
+};
 
 use super::contact::{Reference, SAME_NORMAL};
 
@@ -65,8 +67,9 @@ pub(super) const MAX_CORNERS: usize = 32;
 
 /// A support feature with every corner of its face (parry's `PolygonalFeature` keeps at most
 /// the first 4 corners of a polyhedron's face: a hexagonal prism standing on a box touched it
-/// at 4 consecutive corners, a support polygon with its centre on the boundary), in the same
-/// layout, with room for `N` corners.
+/// at 4 consecutive corners, a support polygon with its centre on the boundary; and a
+/// cylinder's or cone's cap is a square, see [`Whole::Cap`]), in the same layout, with room
+/// for `N` corners.
 #[derive(Clone, Copy, Debug)]
 struct FullFeature<const N: usize> {
     vertices: [Point3<f64>; N],
@@ -77,36 +80,57 @@ struct FullFeature<const N: usize> {
     num_vertices: usize,
 }
 
-/// The convex polyhedron `shape` is, and where its face `f` starts in its face adjacency
-/// lists and how many corners it has, when `f` is a face of more than 4 corners (the ones
-/// parry's feature cuts short).
-fn long_face<'a>(
-    shape: &'a dyn Shape,
-    f: &PolygonalFeature,
-) -> Option<(&'a ConvexPolyhedron, usize, usize)> {
-    let hull = shape
-        .as_convex_polyhedron()
-        .filter(|_| f.num_vertices >= 4)?;
-    match f.fid.unpack() {
-        FeatureId::Face(i) => hull
-            .faces()
-            .get(i as usize)
-            .filter(|face| face.num_vertices_or_edges > 4)
-            .map(|face| {
-                (
-                    hull,
-                    face.first_vertex_or_edge as usize,
-                    face.num_vertices_or_edges as usize,
-                )
-            }),
-        _ => None,
+/// Where a support feature's whole face comes from, when parry's feature is short of it.
+#[derive(Clone, Copy)]
+enum Whole<'a> {
+    /// a convex polyhedron's face of more than 4 corners: the polyhedron, where the face
+    /// starts in its face adjacency lists, and how many corners it has.
+    Hull(&'a ConvexPolyhedron, usize, usize),
+    /// a cylinder's or a cone's flat cap, which parry gives as the square inscribed in the
+    /// cap's circle with a corner toward the support direction: here the regular polygon of
+    /// [`MAX_CORNERS`] corners inscribed in it, with the same first corner (a body standing
+    /// on the square tipped over at `r / sqrt 2` of its radius instead of `r`; rocking on the
+    /// rim, the deepest point of the rim is still a corner).
+    Cap,
+}
+
+/// Where the whole face of `shape`'s support feature `f` comes from, when parry's feature
+/// cuts it short: a convex polyhedron's face of more than 4 corners, or a cylinder's or a
+/// cone's flat cap.
+fn whole_face<'a>(shape: &'a dyn Shape, f: &PolygonalFeature) -> Option<Whole<'a>> {
+    if f.num_vertices < 4 {
+        return None;
+    }
+    let FeatureId::Face(i) = f.fid.unpack() else {
+        return None;
+    };
+    match shape.shape_type() {
+        // parry's cap faces: 9 (the bottom), 19 (a cylinder's top)
+        ShapeType::Cylinder | ShapeType::Cone => matches!(i, 9 | 19).then_some(Whole::Cap),
+        _ => {
+            let hull = shape.as_convex_polyhedron()?;
+            hull.faces()
+                .get(i as usize)
+                .filter(|face| face.num_vertices_or_edges > 4)
+                .map(|face| {
+                    Whole::Hull(
+                        hull,
+                        face.first_vertex_or_edge as usize,
+                        face.num_vertices_or_edges as usize,
+                    )
+                })
+        }
     }
 }
 
+/// The first of the ids given to a cap's corners and edges (bottom cap; the top one 100
+/// more): parry's own ids of a cylinder or cone end at 19.
+const CAP_IDS: u32 = 100;
+
 impl<const N: usize> FullFeature<N> {
-    /// `f` as it is where `long` is `None`; otherwise every corner of the long face `long`
-    /// ([`long_face`] of `f`), evenly sampled beyond `N` (see [`MAX_CORNERS`]).
-    fn of(f: &PolygonalFeature, long: Option<(&ConvexPolyhedron, usize, usize)>) -> Self {
+    /// `f` as it is where `whole` is `None`; otherwise every corner of the whole face
+    /// ([`whole_face`] of `f`), evenly sampled beyond `N` (see [`MAX_CORNERS`]).
+    fn of(f: &PolygonalFeature, whole: Option<Whole<'_>>) -> Self {
         let mut out = Self {
             vertices: [Point3::origin(); N],
             vids: [PackedFeatureId::UNKNOWN; N],
@@ -114,13 +138,22 @@ impl<const N: usize> FullFeature<N> {
             fid: f.fid,
             num_vertices: f.num_vertices.min(4).min(N),
         };
-        let Some((hull, first, count)) = long else {
-            let n = out.num_vertices;
-            out.vertices[..n].copy_from_slice(&f.vertices[..n]);
-            out.vids[..n].copy_from_slice(&f.vids[..n]);
-            out.eids[..n].copy_from_slice(&f.eids[..n]);
-            return out;
-        };
+        match whole {
+            None => {
+                let n = out.num_vertices;
+                out.vertices[..n].copy_from_slice(&f.vertices[..n]);
+                out.vids[..n].copy_from_slice(&f.vids[..n]);
+                out.eids[..n].copy_from_slice(&f.eids[..n]);
+            }
+            Some(Whole::Hull(hull, first, count)) => out.hull_face(hull, first, count),
+            Some(Whole::Cap) => out.cap(f),
+        }
+        out
+    }
+
+    /// Every corner of a hull's face (`first`, `count`: see [`Whole::Hull`]), evenly sampled
+    /// beyond `N`.
+    fn hull_face(&mut self, hull: &ConvexPolyhedron, first: usize, count: usize) {
         let take = count.min(N);
         let (vs, es) = (hull.vertices_adj_to_face(), hull.edges_adj_to_face());
         for k in 0..take {
@@ -132,24 +165,59 @@ impl<const N: usize> FullFeature<N> {
             let Some(p) = hull.points().get(v as usize) else {
                 break;
             };
-            out.vertices[k] = *p;
-            out.vids[k] = PackedFeatureId::vertex(v);
-            out.eids[k] = PackedFeatureId::edge(e);
-            out.num_vertices = k + 1;
+            self.vertices[k] = *p;
+            self.vids[k] = PackedFeatureId::vertex(v);
+            self.eids[k] = PackedFeatureId::edge(e);
+            self.num_vertices = k + 1;
         }
-        out
+    }
+
+    /// The regular polygon of `N` (a multiple of 4) corners inscribed in the circle of parry's
+    /// cap square `f` (corners `c + u`, `c + w`, `c - u`, `c - w`), its corner `k` at
+    /// `c + cos(t) u + sin(t) w`, `t = 2 pi k / N`. The quarter turns are exact sign swaps, so
+    /// parry's 4 corners are among these exactly and keep their ids.
+    fn cap(&mut self, f: &PolygonalFeature) {
+        if !N.is_multiple_of(4) {
+            return;
+        }
+        let [p0, p1, p2, _] = f.vertices;
+        let c = nalgebra::center(&p0, &p2);
+        let (u, w) = (p0 - c, p1 - c);
+        let base = match f.fid.unpack() {
+            FeatureId::Face(19) => 2 * CAP_IDS,
+            _ => CAP_IDS,
+        };
+        let quarter = N / 4;
+        for j in 0..quarter {
+            let (s, co) = (std::f64::consts::TAU * j as f64 / N as f64).sin_cos();
+            // the same angle in each quarter turn: (co, s), (-s, co), (-co, -s), (s, -co)
+            for (q, (x, y)) in [(co, s), (-s, co), (-co, -s), (s, -co)]
+                .into_iter()
+                .enumerate()
+            {
+                let k = q * quarter + j;
+                self.vertices[k] = c + u * x + w * y;
+                self.vids[k] = if j == 0 {
+                    f.vids[q]
+                } else {
+                    PackedFeatureId::vertex(base + k as u32)
+                };
+                self.eids[k] = PackedFeatureId::edge(base + k as u32);
+            }
+        }
+        self.num_vertices = N;
     }
 }
 
-/// Calls `each(corner, id)` for every corner of the support feature `f` of `shape`, every
-/// corner of a long face of a convex polyhedron included (see [`long_face`]).
+/// Calls `each(corner, id)` for every corner of the support feature `f` of `shape`, its whole
+/// face where parry's feature cuts it short (see [`whole_face`]).
 pub(super) fn each_corner(
     shape: &dyn Shape,
     f: &PolygonalFeature,
     mut each: impl FnMut(Point3<f64>, PackedFeatureId),
 ) {
-    if let Some(long) = long_face(shape, f) {
-        let full = FullFeature::<MAX_CORNERS>::of(f, Some(long));
+    if let Some(whole) = whole_face(shape, f) {
+        let full = FullFeature::<MAX_CORNERS>::of(f, Some(whole));
         for i in 0..full.num_vertices {
             each(full.vertices[i], full.vids[i]);
         }
@@ -212,7 +280,7 @@ impl<const N: usize> Face<'_, N> {
 /// edge-on): the caller then uses parry's own contacts.
 ///
 /// `f1`, `f2` are parry's support features of shapes `a`, `b`; a convex polyhedron's face of
-/// more than 4 corners is taken whole (see [`FullFeature`]).
+/// more than 4 corners, or a cylinder's or cone's cap, is taken whole (see [`whole_face`]).
 pub(super) fn face_contacts(
     pos12: &Isometry3<f64>,
     gjk: &Unit<Vector3<f64>>,
@@ -221,7 +289,7 @@ pub(super) fn face_contacts(
     (b, f2): (&dyn Shape, &PolygonalFeature),
     m: &mut ContactManifold<Reference, ()>,
 ) -> Option<Unit<Vector3<f64>>> {
-    let (long1, long2) = (long_face(a, f1), long_face(b, f2));
+    let (long1, long2) = (whole_face(a, f1), whole_face(b, f2));
     // boxes and the faces parry keeps whole on buffers sized for 4 corners
     if long1.is_none() && long2.is_none() {
         let (g1, g2) = (
