@@ -1,8 +1,8 @@
 //! Allocations of touching narrow-phase queries: every pair of convex shapes with polygonal
 //! features (boxes, hulls, capsules, cylinders, cones; 2D polygons, segments, capsules), and
-//! each against a half-space, allocates nothing once its cache is warm, touching or
-//! overlapping (EPA) alike; and the answers are the analytic ones (a face on a face at the
-//! gap asked, its four or two corners).
+//! each against a half-space, a triangle mesh and a heightfield, allocates nothing once its
+//! cache is warm, touching or overlapping (EPA) alike; and the answers are the analytic ones
+//! (a face on a face at the gap asked, its four or two corners).
 
 use coulomb::geometry::{contacts2, contacts3, ContactCache2, ContactCache3, Shape2, Shape3};
 use nalgebra::{Isometry2, Isometry3, Vector2, Vector3};
@@ -93,6 +93,43 @@ fn touching_and_overlapping_convex_queries_allocate_nothing_when_warm() {
                 (deepest - gap).abs() <= 1e-6 * h,
                 "{name} on a box: deepest gap {deepest}, asked {gap}"
             );
+        }
+    }
+    // a flat triangle mesh (4 x 4 cells) and a flat heightfield (up turned from y to z) over
+    // [-1, 1]^2 at z = 0
+    let mut verts = vec![];
+    for i in 0..=4 {
+        for j in 0..=4 {
+            verts.push([-1.0 + 0.5 * i as f64, -1.0 + 0.5 * j as f64, 0.0]);
+        }
+    }
+    let mut tris = vec![];
+    for i in 0..4u32 {
+        for j in 0..4u32 {
+            let (a, b) = (i * 5 + j, (i + 1) * 5 + j);
+            tris.push([a, b, b + 1]);
+            tris.push([a, b + 1, a + 1]);
+        }
+    }
+    let mesh = ok(Shape3::triangle_mesh(&verts, &tris));
+    let field = ok(Shape3::heightfield(5, 5, &[0.0; 25], [2.0, 1.0, 2.0]));
+    let field_pose = Isometry3::rotation(Vector3::new(std::f64::consts::FRAC_PI_2, 0.0, 0.0));
+    for (name, s, h) in shapes3() {
+        for gap in [0.0, 1e-4, -1e-4] {
+            // off the cells' corners, so that faces cross the triangles' edges
+            let pose = Isometry3::translation(0.13, -0.07, h + gap);
+            for (floor, at, what) in [
+                (&mesh, &origin, "mesh"),
+                (&field, &field_pose, "heightfield"),
+            ] {
+                let (n, gaps) = warm3(&s, &pose, floor, at);
+                assert_eq!(n, 0, "{name} on a {what} at gap {gap}: {n} allocations");
+                let deepest = gaps.iter().fold(f64::INFINITY, |m, g| m.min(*g));
+                assert!(
+                    (deepest - gap).abs() <= 1e-12,
+                    "{name} on a {what}: deepest gap {deepest}, asked {gap}"
+                );
+            }
         }
     }
     // a box face to face on a box: its four corners, at the gap asked

@@ -13,9 +13,16 @@
 //! A cylinder's or a cone's flat cap touches at the 32 corners of its inscribed regular
 //! polygon (parry's feature is the inscribed square), and rocking on its rim at the rim's
 //! lowest point.
+//!
+//! On a triangle mesh or a heightfield the same faces touch each triangle they cross at the
+//! corners of the face's part over it: the support polygon is the whole face's (parry's
+//! composite paths took 4 corners of a face per triangle).
 
 use coulomb::geometry::{contacts3, ContactCache3, ContactPoint3, Shape3};
 use nalgebra::{Isometry3, Point3, UnitQuaternion, Vector3};
+
+#[path = "step_solids/scenes.rs"]
+mod scenes;
 
 fn contacts(
     a: &Shape3,
@@ -372,4 +379,127 @@ fn a_round_cap_touches_at_the_corners_of_its_inscribed_polygon() {
             );
         }
     }
+}
+
+/// Prisms of 5 to 40 sides, a cylinder and a cone standing on a flat triangle mesh and on a
+/// flat heightfield (either order), their faces across the triangles' edges: every point at
+/// gap 0 with the normal +z, and the centre inside the support polygon by the inradius of the
+/// face's taken corners.
+#[test]
+fn a_face_on_a_mesh_touches_every_triangle_it_covers_at_its_part_s_corners() {
+    let (r, h) = (0.05, 0.05);
+    let mesh = scenes::flat_mesh(7, 0.3);
+    // a flat heightfield over the x-z square of side 0.6 (7 x 7 cells), turned so that its
+    // up (y) is z
+    let field =
+        Shape3::heightfield(8, 8, &[0.0; 64], [0.6, 1.0, 0.6]).unwrap_or_else(|e| panic!("{e}"));
+    let field_pose = Isometry3::from_parts(
+        Vector3::zeros().into(),
+        UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::FRAC_PI_2),
+    );
+    let id = Isometry3::identity();
+    let upright = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::FRAC_PI_2);
+    let mut bodies: Vec<(String, Shape3, UnitQuaternion<f64>, f64)> = [5usize, 8, 40]
+        .into_iter()
+        .map(|n| {
+            let skip = n.div_ceil(32) as f64;
+            let inner = r * (std::f64::consts::PI * skip / n as f64).cos();
+            (
+                format!("prism of {n} sides"),
+                prism(n, r, h),
+                UnitQuaternion::identity(),
+                inner,
+            )
+        })
+        .collect();
+    let inner = r * (std::f64::consts::PI / 32.0).cos();
+    let cylinder = Shape3::cylinder(h, r).unwrap_or_else(|e| panic!("{e}"));
+    let cone = Shape3::cone(h, r).unwrap_or_else(|e| panic!("{e}"));
+    bodies.push(("cylinder".into(), cylinder, upright, inner));
+    bodies.push(("cone".into(), cone, upright, inner));
+    for (name, body, turn, inner) in &bodies {
+        for (cx, cy) in [(0.0, 0.0), (0.013, -0.021), (0.17, 0.09)] {
+            let on = Isometry3::from_parts(Vector3::new(cx, cy, h).into(), *turn);
+            let cases = [
+                ("mesh", world_b(&contacts(&mesh, &id, body, &on), &on)),
+                (
+                    "mesh second",
+                    world_a(&contacts(body, &on, &mesh, &id), &on),
+                ),
+                (
+                    "heightfield",
+                    world_b(&contacts(&field, &field_pose, body, &on), &on),
+                ),
+                (
+                    "heightfield second",
+                    world_a(&contacts(body, &on, &field, &field_pose), &on),
+                ),
+            ];
+            for (what, pts) in cases {
+                let case = format!("{name} at ({cx}, {cy}) on the {what}");
+                for p in &pts {
+                    assert!(p.z.abs() <= 1e-12, "{case}: {p:?} off the floor");
+                }
+                let centred: Vec<Point3<f64>> = pts
+                    .iter()
+                    .map(|p| Point3::new(p.x - cx, p.y - cy, p.z))
+                    .collect();
+                let margin = hull_margin(&centred);
+                assert!(
+                    margin >= inner * (1.0 - 1e-9),
+                    "{case}: the centre is {margin:e} inside the support polygon ({} points), inradius {inner:e}",
+                    pts.len()
+                );
+            }
+            // gaps and normals
+            for p in contacts(&mesh, &id, body, &on) {
+                assert!(p.gap.abs() <= 1e-12, "{name}: gap {p:?}");
+                assert!(
+                    (p.normal - Vector3::z()).norm() <= 1e-12,
+                    "{name}: normal {p:?}"
+                );
+            }
+        }
+    }
+}
+
+/// The distance from `(0, 0)` to the boundary of the convex hull of the points' `(x, y)`,
+/// positive inside (Andrew's monotone chain, then each edge's distance).
+fn hull_margin(points: &[Point3<f64>]) -> f64 {
+    let mut p: Vec<[f64; 2]> = points.iter().map(|q| [q.x, q.y]).collect();
+    p.sort_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
+    p.dedup();
+    if p.len() < 3 {
+        return f64::NEG_INFINITY;
+    }
+    let cross = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| {
+        (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+    };
+    let mut hull: Vec<[f64; 2]> = Vec::new();
+    for pass in 0..2 {
+        let start = hull.len();
+        let seq: Vec<[f64; 2]> = if pass == 0 {
+            p.clone()
+        } else {
+            p.iter().rev().copied().collect()
+        };
+        for q in seq {
+            while hull.len() >= start + 2
+                && cross(hull[hull.len() - 2], hull[hull.len() - 1], q) <= 0.0
+            {
+                hull.pop();
+            }
+            hull.push(q);
+        }
+        hull.pop();
+    }
+    let mut margin = f64::INFINITY;
+    for k in 0..hull.len() {
+        let (a, b) = (hull[k], hull[(k + 1) % hull.len()]);
+        let len = (b[0] - a[0]).hypot(b[1] - a[1]);
+        if len > 0.0 {
+            margin = margin.min(cross(a, b, [0.0, 0.0]) / len);
+        }
+    }
+    margin
 }

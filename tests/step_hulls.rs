@@ -11,6 +11,9 @@
 //! through its centre meets the base within the inscribed polygon of 32 corners, and tips
 //! over beyond the base's circle. parry gives a cap as its inscribed square: the body tipped
 //! over at `r / sqrt 2`.
+//!
+//! The same shapes stand still on a triangle mesh whose edges cross their faces (parry's
+//! composite path took 4 corners of a face per triangle).
 
 use coulomb::contact::ContactStatus;
 use coulomb::geometry::Shape3;
@@ -158,5 +161,59 @@ fn a_cylinder_or_a_cone_on_a_slope_tips_over_at_the_edge_of_its_round_base() {
                 "{case}: beyond the base's edge, moved only {moved:e}"
             );
         }
+    }
+}
+
+#[test]
+fn prisms_and_a_cylinder_stand_still_on_a_mesh_floor_across_its_edges() {
+    // a flat mesh over [-0.3, 0.3]^2 at z = 0, 7 x 7 cells of two triangles
+    let mesh = flat_mesh(7, 0.3);
+    let (c, s) = (
+        std::f64::consts::FRAC_PI_4.cos(),
+        std::f64::consts::FRAC_PI_4.sin(),
+    );
+    let shapes = [
+        (
+            "prism of 5 sides",
+            prism(5),
+            vec![0.013, -0.021, 0.05, 1.0, 0.0, 0.0, 0.0],
+        ),
+        (
+            "prism of 8 sides",
+            prism(8),
+            vec![0.013, -0.021, 0.05, 1.0, 0.0, 0.0, 0.0],
+        ),
+        (
+            "cylinder",
+            SolidShape::Spatial(ok(Shape3::cylinder(0.05, 0.05))),
+            vec![0.013, -0.021, 0.05, c, s, 0.0, 0.0],
+        ),
+    ];
+    for (name, shape, q0) in shapes {
+        let mut scene = one_solid_on_floor(3, shape, q0, 0.5);
+        scene.half_spaces.clear();
+        scene
+            .solids
+            .push(static_solid(SolidShape::Spatial(mesh.clone())));
+        scene.pairs = vec![Pair::SolidSolid {
+            a: 0,
+            b: 1,
+            mu: 0.5,
+            e: 0.0,
+        }];
+        let tr = match simulate(&scene, &StepSettings::new(1e-3, 1000)) {
+            Ok(tr) => tr,
+            Err(e) => panic!("valid scene: {e}"),
+        };
+        for (k, st) in tr.steps.iter().enumerate() {
+            assert_eq!(st.status, Some(ContactStatus::Solved), "{name}: step {k}");
+        }
+        let last = &tr.q[tr.q.len() - tr.nq..];
+        let moved = tr.q[..tr.nq]
+            .iter()
+            .zip(last)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(moved < 1e-9, "{name} on the mesh: moved by {moved:e}");
     }
 }

@@ -21,9 +21,8 @@
 //!   `m · v - r <= prediction`, its partner `v - (m · v) m` on the plane.
 //!
 //! Both are the separating-axis construction of a manifold (Acary-Brogliato 2008, ch. 3;
-//! Stewart 2000, §2: the gap function along the normal). Compounds go part by part
-//! ([`convex3_or_parts`]); other pairs (balls, meshes, heightfields) go through parry's
-//! dispatcher.
+//! Stewart 2000, §2: the gap function along the normal). Compounds, meshes and heightfields go
+//! part by part (module `parts`); other pairs (balls) go through parry's dispatcher.
 
 use nalgebra::Unit;
 use parry2d_f64::query::ContactManifold as Manifold2;
@@ -64,16 +63,17 @@ macro_rules! convex_impl {
                 manifolds.clear();
                 manifolds.push(<$manifold>::new());
             }
-            $one(pos12, a, b, pn, &mut manifolds[0], ws)
+            $one(pos12, a, b, pn, &mut manifolds[0], ws, (None, None))
         }
 
-        /// Whether [`$one`] handles the pair: convex shapes with polygonal features, or one of
-        /// them and a half-space (parry's dispatcher has closed forms for balls, cuboids,
-        /// triangles and two capsules, and composites go through their parts).
+        /// Whether [`$one`] handles the pair: convex shapes with polygonal features (a mesh's
+        /// triangles among them), or one of them and a half-space (parry's dispatcher has
+        /// closed forms for balls, cuboids and two capsules, and composites go through their
+        /// parts).
         pub(super) fn $handles(a: &dyn $parry::shape::Shape, b: &dyn $parry::shape::Shape) -> bool {
             use $parry::shape::ShapeType as T;
             let (ta, tb) = (a.shape_type(), b.shape_type());
-            let special = |t| matches!(t, T::Ball | T::Cuboid | T::Triangle | T::HalfSpace);
+            let special = |t| matches!(t, T::Ball | T::Cuboid | T::HalfSpace);
             let featured = |s: &dyn $parry::shape::Shape, t| {
                 !special(t) && s.as_polygonal_feature_map().is_some()
             };
@@ -88,20 +88,35 @@ macro_rules! convex_impl {
             }
         }
 
-        /// The manifold of a pair [`$handles`] accepts into `m` (its points replaced).
-        fn $one(
+        /// The manifold of a pair [`$handles`] accepts into `m` (its points replaced). `nc`:
+        /// the normal constraints of a mesh's triangle on either side, which the contact
+        /// normal is projected on (no contact where they refuse it), as parry's convex-convex
+        /// manifold applies them.
+        pub(super) fn $one(
             pos12: &$parry::math::Isometry<f64>,
             a: &dyn $parry::shape::Shape,
             b: &dyn $parry::shape::Shape,
             (prediction, near): (f64, f64),
             m: &mut $manifold,
             ws: &mut $ws,
+            nc: (
+                Option<&dyn $parry::query::details::NormalConstraints>,
+                Option<&dyn $parry::query::details::NormalConstraints>,
+            ),
         ) -> bool {
             use $parry::shape::ShapeType as T;
             let (ta, tb) = (a.shape_type(), b.shape_type());
             // a half-space first: the same manifold with the roles swapped, then flipped back
             if ta == T::HalfSpace {
-                let done = $one(&pos12.inverse(), b, a, (prediction, near), m, ws);
+                let done = $one(
+                    &pos12.inverse(),
+                    b,
+                    a,
+                    (prediction, near),
+                    m,
+                    ws,
+                    (nc.1, nc.0),
+                );
                 std::mem::swap(&mut m.local_n1, &mut m.local_n2);
                 for p in &mut m.points {
                     std::mem::swap(&mut p.local_p1, &mut p.local_p2);
@@ -171,8 +186,14 @@ macro_rules! convex_impl {
                     r => r,
                 };
             match result {
-                GJKResult::ClosestPoints(p1, p2_1, n1) => {
-                    let n2 = pos12.inverse_transform_unit_vector(&-n1);
+                GJKResult::ClosestPoints(p1, p2_1, dir) => {
+                    use $parry::query::details::NormalConstraintsPair as _;
+                    let (mut n1, mut n2) = (*dir, pos12.inverse_transform_vector(&-*dir));
+                    if !nc.project_local_normals(pos12, &mut n1, &mut n2) {
+                        m.local_n1 = *dir;
+                        return true;
+                    }
+                    let (n1, n2) = (Unit::new_unchecked(n1), Unit::new_unchecked(n2));
                     let mut f1 = $parry::shape::PolygonalFeature::default();
                     let mut f2 = $parry::shape::PolygonalFeature::default();
                     pfm_a.local_support_feature(&n1, &mut f1);
@@ -192,15 +213,23 @@ macro_rules! convex_impl {
                             );
                             n1
                         });
-                    if $dim3 || m.points.is_empty() {
+                    let gjk_dist = (p2_1 - p1).dot(&dir);
+                    if ($dim3 || m.points.is_empty()) && n1 == dir {
                         let unknown = $parry::shape::PackedFeatureId::UNKNOWN;
                         m.points.push($parry::query::TrackedContact::new(
                             p1,
                             pos12.inverse_transform_point(&p2_1),
                             unknown,
                             unknown,
-                            (p2_1 - p1).dot(&n1),
+                            gjk_dist,
                         ));
+                    }
+                    if nc.0.is_some() || nc.1.is_some() {
+                        // parry's rule: with a corrected normal, no point much deeper than
+                        // GJK's own distance
+                        m.points.retain(|p| {
+                            gjk_dist >= 0.0 || p.dist >= 0.0 || p.dist >= 5.0 * gjk_dist
+                        });
                     }
                     let (n1, n2) = (axis, pos12.inverse_transform_unit_vector(&-axis));
                     if ra != 0.0 || rb != 0.0 {
@@ -271,97 +300,4 @@ fn parry_contacts2(
     _: &mut Manifold2<super::contact::Reference, ()>,
 ) -> Option<Unit<nalgebra::Vector2<f64>>> {
     None
-}
-
-/// [`convex3`], and compounds of convex parts against convex shapes, half-spaces and other
-/// compounds part by part: each pair of parts whose bounding boxes (grown by the prediction)
-/// meet gets its manifold from [`convex3`]'s construction where it applies (a polyhedron's
-/// face whole), from parry's convex-convex manifold otherwise (balls, boxes of parry's own
-/// kind). parry's composite path took every part pair through its own convex-convex manifold,
-/// which keeps only 4 corners of a face. `false`, with `manifolds` untouched, for any other
-/// pair (meshes, heightfields: parry's dispatcher).
-pub(super) fn convex3_or_parts(
-    pos12: &nalgebra::Isometry3<f64>,
-    a: &dyn parry3d_f64::shape::Shape,
-    b: &dyn parry3d_f64::shape::Shape,
-    pn: (f64, f64),
-    manifolds: &mut Vec<Manifold3<super::contact::Reference, ()>>,
-    ws: &mut Convex3,
-) -> bool {
-    use parry3d_f64::bounding_volume::BoundingVolume as _;
-    use parry3d_f64::query::PersistentQueryDispatcher as _;
-    use parry3d_f64::shape::ShapeType as T;
-    let (ca, cb) = (a.as_compound(), b.as_compound());
-    if ca.is_none() && cb.is_none() {
-        return convex3(pos12, a, b, pn, manifolds, ws);
-    }
-    let whole = |s: &dyn parry3d_f64::shape::Shape| s.is_convex() || s.shape_type() == T::HalfSpace;
-    if (ca.is_none() && !whole(a)) || (cb.is_none() && !whole(b)) {
-        return false;
-    }
-    let identity = nalgebra::Isometry3::identity();
-    let (na, nb) = (
-        ca.map_or(1, |c| c.shapes().len()),
-        cb.map_or(1, |c| c.shapes().len()),
-    );
-    let prediction = pn.0;
-    // b's bounding box in a's frame: a's parts away from it are skipped before any pairing
-    let whole_b = b.compute_aabb(pos12).loosened(prediction);
-    let mut used = 0;
-    for ia in 0..na {
-        let Some((pa, sa)) = part(ca, a, ia, identity) else {
-            return false;
-        };
-        if !sa.compute_aabb(&pa).intersects(&whole_b) {
-            continue;
-        }
-        let box_a = sa.compute_local_aabb().loosened(prediction);
-        for ib in 0..nb {
-            let Some((pb, sb)) = part(cb, b, ib, identity) else {
-                return false;
-            };
-            let pos = pa.inv_mul(&(pos12 * pb));
-            if !box_a.intersects(&sb.compute_aabb(&pos)) {
-                continue;
-            }
-            if used == manifolds.len() {
-                manifolds.push(Manifold3::new());
-            }
-            let m = &mut manifolds[used];
-            used += 1;
-            m.points.clear();
-            m.subshape1 = ia as u32;
-            m.subshape2 = ib as u32;
-            m.subshape_pos1 = ca.map(|_| pa);
-            m.subshape_pos2 = cb.map(|_| pb);
-            let done = if handles3(sa, sb) {
-                one3(&pos, sa, sb, pn, m, ws)
-            } else {
-                parry3d_f64::query::DefaultQueryDispatcher
-                    .contact_manifold_convex_convex(&pos, sa, sb, None, None, prediction, m)
-                    .is_ok()
-            };
-            if !done {
-                return false;
-            }
-        }
-    }
-    for m in &mut manifolds[used..] {
-        m.points.clear();
-    }
-    true
-}
-
-/// Part `k` of compound `c` with its pose in the compound's frame, or `s` itself (at
-/// `identity`) where `s` is not a compound.
-fn part<'a>(
-    c: Option<&'a parry3d_f64::shape::Compound>,
-    s: &'a dyn parry3d_f64::shape::Shape,
-    k: usize,
-    identity: nalgebra::Isometry3<f64>,
-) -> Option<(nalgebra::Isometry3<f64>, &'a dyn parry3d_f64::shape::Shape)> {
-    match c {
-        Some(c) => c.shapes().get(k).map(|(p, sh)| (*p, &**sh)),
-        None => Some((identity, s)),
-    }
 }

@@ -162,6 +162,38 @@ def test_a_prism_of_many_sides_stands_still_on_the_floor(sides: int, compound: b
     assert np.max(np.abs(tr.q - tr.q[0])) < 1e-9
 
 
+@pytest.mark.parametrize("kind", ["Cylinder", "Cone"])
+@pytest.mark.parametrize("azimuth", [0.05, 0.4, math.pi / 4])
+def test_a_cylinder_or_cone_on_a_slope_tips_at_its_base_s_edge(kind: str, azimuth: float) -> None:
+    """A flat end touches at the 32 corners of its inscribed polygon: standing on its base
+    under gravity tilted to 0.99 of that polygon's edge it stands still, beyond the circle
+    (5 % past tan = r / half height) it tips over. parry's inscribed square tipped it at
+    0.71 of the circle."""
+    hh, r = 0.1, 0.05
+    inner = r / hh * math.cos(math.pi / 32)
+
+    def moved(tan: float) -> tuple[float, bool]:
+        slope = math.atan(tan)
+        g = 9.81
+        gravity = (g * math.sin(slope) * math.cos(azimuth), g * math.sin(slope) * math.sin(azimuth),
+                   -g * math.cos(slope))
+        scene = coulomb.Scene(dim=3, gravity=gravity)
+        floor = scene.add(coulomb.HalfSpace(normal=(0, 0, 1), point=(0, 0, 0)))
+        c = math.cos(math.pi / 4)
+        body = scene.add(coulomb.RigidBody3D(mass=1.0, inertia=(1e-3, 1e-3, 1e-3),
+                                             position=(0.0, 0.0, hh), orientation=(c, c, 0.0, 0.0)))
+        shape = getattr(coulomb, kind)(half_height=hh, radius=r)
+        scene.contact(scene.attach(body, shape), floor, mu=2.0)
+        tr = scene.simulate(t_end=0.5, h=1e-3)
+        return float(np.max(np.abs(tr.q[:, :3] - tr.q[0, :3]))), bool(tr.success)
+
+    still, solved = moved(0.99 * inner)
+    assert solved
+    assert still < 1e-9
+    falling, _ = moved(1.05 * r / hh)
+    assert falling > 1e-3
+
+
 @pytest.mark.parametrize(
     ("make", "exc"),
     [

@@ -294,3 +294,24 @@ pub fn dropped_box(dim: usize, tilt: [f64; 2], e: f64) -> Scene {
         solids: vec![on_body(0, box_shape(dim, half)), lower],
     }
 }
+
+/// A flat triangle mesh over `[-half, half]^2` at z = 0: `n x n` square cells of two
+/// triangles each, wound so that the normals are +z.
+pub fn flat_mesh(n: u32, half: f64) -> Shape3 {
+    let mut verts = vec![];
+    for i in 0..=n {
+        for j in 0..=n {
+            let f = |k: u32| -half + 2.0 * half * k as f64 / n as f64;
+            verts.push([f(i), f(j), 0.0]);
+        }
+    }
+    let mut tris = vec![];
+    for i in 0..n {
+        for j in 0..n {
+            let (a, b) = (i * (n + 1) + j, (i + 1) * (n + 1) + j);
+            tris.push([a, b, b + 1]);
+            tris.push([a, b + 1, a + 1]);
+        }
+    }
+    ok(Shape3::triangle_mesh(&verts, &tris))
+}
