@@ -11,8 +11,9 @@
 //! sampled evenly beyond): parry's support feature keeps a face's first 4 corners only.
 //!
 //! A cylinder's or a cone's flat cap touches at the 32 corners of its inscribed regular
-//! polygon (parry's feature is the inscribed square), and rocking on its rim at the rim's
-//! lowest point.
+//! polygon (parry's feature is the inscribed square), fixed on the body up to a tilt of 1e-7
+//! (two equal stacked caps touch at its 32 corners, whatever the rounding of the pose), and
+//! rocking on its rim at the rim's lowest point.
 //!
 //! On a triangle mesh or a heightfield the same faces touch each triangle they cross at the
 //! corners of the face's part over it: the support polygon is the whole face's (parry's
@@ -502,4 +503,46 @@ fn hull_margin(points: &[Point3<f64>]) -> f64 {
         }
     }
     margin
+}
+
+/// An upright cylinder on the floor and on another one turned the same way, tilted by 0 to
+/// 1e-8 rad (the rounding of a pose, and more): the cap's points stay where they are on the
+/// body, and two stacked caps touch at 32 points (parry turns its square with the rounding).
+#[test]
+fn a_cap_s_polygon_stays_on_the_body_under_tiny_tilts() {
+    let (r, h) = (0.05, 0.1);
+    let cylinder = Shape3::cylinder(h, r).unwrap_or_else(|e| panic!("{e}"));
+    let floor = Shape3::half_space([0.0, 0.0, 1.0]).unwrap_or_else(|e| panic!("{e}"));
+    let id = Isometry3::identity();
+    let upright = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::FRAC_PI_2);
+    let mut reference: Option<Vec<Point3<f64>>> = None;
+    for tilt in [0.0, 1e-17, 1e-15, 1e-12, 1e-8] {
+        for azimuth in [0.0, 0.3, 2.0, -1.2] {
+            let axis = Vector3::new(f64::cos(azimuth), f64::sin(azimuth), 0.0);
+            let turn = UnitQuaternion::from_axis_angle(&nalgebra::Unit::new_normalize(axis), tilt)
+                * upright;
+            let lower = Isometry3::from_parts(Vector3::new(0.0, 0.0, h).into(), turn);
+            let mut pts: Vec<Point3<f64>> = contacts(&cylinder, &lower, &floor, &id)
+                .iter()
+                .map(|p| p.point_a)
+                .collect();
+            pts.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.z.total_cmp(&b.z)));
+            let case = format!("tilt {tilt} toward {azimuth}");
+            assert_eq!(pts.len(), 32, "{case}");
+            match &reference {
+                None => reference = Some(pts),
+                Some(first) => {
+                    for (p, q) in pts.iter().zip(first) {
+                        assert!(
+                            (p - q).norm() <= 1e-12 * r,
+                            "{case}: {p:?} moved from {q:?}"
+                        );
+                    }
+                }
+            }
+            let upper = Isometry3::from_parts(Vector3::new(0.0, 0.0, 3.0 * h).into(), turn);
+            let on = contacts(&cylinder, &lower, &cylinder, &upper);
+            assert_eq!(on.len(), 32, "{case}: cap on cap");
+        }
+    }
 }

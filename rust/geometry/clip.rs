@@ -88,39 +88,73 @@ enum Whole<'a> {
     Hull(&'a ConvexPolyhedron, usize, usize),
     /// a cylinder's or a cone's flat cap, which parry gives as the square inscribed in the
     /// cap's circle with a corner toward the support direction: here the regular polygon of
-    /// [`MAX_CORNERS`] corners inscribed in it, with the same first corner (a body standing
-    /// on the square tipped over at `r / sqrt 2` of its radius instead of `r`; rocking on the
-    /// rim, the deepest point of the rim is still a corner).
-    Cap,
+    /// [`MAX_CORNERS`] corners inscribed in it (a body standing on the square tipped over at
+    /// `r / sqrt 2` of its radius instead of `r`).
+    Cap(Cap),
 }
 
-/// Where the whole face of `shape`'s support feature `f` comes from, when parry's feature
-/// cuts it short: a convex polyhedron's face of more than 4 corners, or a cylinder's or a
-/// cone's flat cap.
-fn whole_face<'a>(shape: &'a dyn Shape, f: &PolygonalFeature) -> Option<Whole<'a>> {
+/// A round cap in its shape's frame (axis y): its height `y`, its radius, and the unit
+/// direction `(x, z)` of its polygon's first corner.
+#[derive(Clone, Copy)]
+struct Cap {
+    y: f64,
+    radius: f64,
+    anchor: [f64; 2],
+}
+
+/// Below this tilt (the sine of the angle between the support direction and the cap's axis)
+/// a cap's polygon keeps its first corner on the shape's x axis; above it the first corner is
+/// toward the support direction, the deepest point of the rim. parry turns its square toward
+/// the direction's horizontal part even where that is rounding (a cylinder standing upright:
+/// components of 1e-17), so two stacked caps' polygons turned from step to step, crossing
+/// each other at 64 points, and no contact kept its place for a warm start. Below the tilt the
+/// rim's deepest point is missed by at most `1e-7 r (1 - cos(pi / 32)) = 5e-10 r` in depth.
+const CAP_TILT: f64 = 1e-7;
+
+/// Where the whole face of `shape`'s support feature `f` along the unit direction `dir`
+/// (shape's frame) comes from, when parry's feature cuts it short: a convex polyhedron's face
+/// of more than 4 corners, or a cylinder's or a cone's flat cap.
+fn whole_face<'a>(
+    shape: &'a dyn Shape,
+    f: &PolygonalFeature,
+    dir: &Vector3<f64>,
+) -> Option<Whole<'a>> {
     if f.num_vertices < 4 {
         return None;
     }
     let FeatureId::Face(i) = f.fid.unpack() else {
         return None;
     };
-    match shape.shape_type() {
+    let radius = match shape.shape_type() {
+        ShapeType::Cylinder => shape.as_cylinder().map(|c| c.radius),
+        ShapeType::Cone => shape.as_cone().map(|c| c.radius),
+        _ => None,
+    };
+    if let Some(radius) = radius {
         // parry's cap faces: 9 (the bottom), 19 (a cylinder's top)
-        ShapeType::Cylinder | ShapeType::Cone => matches!(i, 9 | 19).then_some(Whole::Cap),
-        _ => {
-            let hull = shape.as_convex_polyhedron()?;
-            hull.faces()
-                .get(i as usize)
-                .filter(|face| face.num_vertices_or_edges > 4)
-                .map(|face| {
-                    Whole::Hull(
-                        hull,
-                        face.first_vertex_or_edge as usize,
-                        face.num_vertices_or_edges as usize,
-                    )
-                })
+        if !matches!(i, 9 | 19) {
+            return None;
         }
+        let side = dir.x.hypot(dir.z);
+        let anchor = if side > CAP_TILT * dir.norm() {
+            [dir.x / side, dir.z / side]
+        } else {
+            [1.0, 0.0]
+        };
+        let y = f.vertices[0].y;
+        return Some(Whole::Cap(Cap { y, radius, anchor }));
     }
+    let hull = shape.as_convex_polyhedron()?;
+    hull.faces()
+        .get(i as usize)
+        .filter(|face| face.num_vertices_or_edges > 4)
+        .map(|face| {
+            Whole::Hull(
+                hull,
+                face.first_vertex_or_edge as usize,
+                face.num_vertices_or_edges as usize,
+            )
+        })
 }
 
 /// The first of the ids given to a cap's corners and edges (bottom cap; the top one 100
@@ -146,7 +180,7 @@ impl<const N: usize> FullFeature<N> {
                 out.eids[..n].copy_from_slice(&f.eids[..n]);
             }
             Some(Whole::Hull(hull, first, count)) => out.hull_face(hull, first, count),
-            Some(Whole::Cap) => out.cap(f),
+            Some(Whole::Cap(cap)) => out.cap(f, cap),
         }
         out
     }
@@ -172,17 +206,18 @@ impl<const N: usize> FullFeature<N> {
         }
     }
 
-    /// The regular polygon of `N` (a multiple of 4) corners inscribed in the circle of parry's
-    /// cap square `f` (corners `c + u`, `c + w`, `c - u`, `c - w`), its corner `k` at
-    /// `c + cos(t) u + sin(t) w`, `t = 2 pi k / N`. The quarter turns are exact sign swaps, so
-    /// parry's 4 corners are among these exactly and keep their ids.
-    fn cap(&mut self, f: &PolygonalFeature) {
+    /// The regular polygon of `N` (a multiple of 4) corners inscribed in the cap's circle,
+    /// its corner `k` at `c + cos(t) u + sin(t) w`, `t = 2 pi k / N`, with `c` the cap's centre,
+    /// `u` the radius toward the anchor and `w` the radius a quarter turn on (the quarter
+    /// turns exact sign swaps).
+    fn cap(&mut self, f: &PolygonalFeature, cap: Cap) {
         if !N.is_multiple_of(4) {
             return;
         }
-        let [p0, p1, p2, _] = f.vertices;
-        let c = nalgebra::center(&p0, &p2);
-        let (u, w) = (p0 - c, p1 - c);
+        let Cap { y, radius, anchor } = cap;
+        let c = Point3::new(0.0, y, 0.0);
+        let u = Vector3::new(anchor[0], 0.0, anchor[1]) * radius;
+        let w = Vector3::new(-anchor[1], 0.0, anchor[0]) * radius;
         let base = match f.fid.unpack() {
             FeatureId::Face(19) => 2 * CAP_IDS,
             _ => CAP_IDS,
@@ -191,17 +226,13 @@ impl<const N: usize> FullFeature<N> {
         for j in 0..quarter {
             let (s, co) = (std::f64::consts::TAU * j as f64 / N as f64).sin_cos();
             // the same angle in each quarter turn: (co, s), (-s, co), (-co, -s), (s, -co)
-            for (q, (x, y)) in [(co, s), (-s, co), (-co, -s), (s, -co)]
+            for (q, (x, z)) in [(co, s), (-s, co), (-co, -s), (s, -co)]
                 .into_iter()
                 .enumerate()
             {
                 let k = q * quarter + j;
-                self.vertices[k] = c + u * x + w * y;
-                self.vids[k] = if j == 0 {
-                    f.vids[q]
-                } else {
-                    PackedFeatureId::vertex(base + k as u32)
-                };
+                self.vertices[k] = c + u * x + w * z;
+                self.vids[k] = PackedFeatureId::vertex(base + k as u32);
                 self.eids[k] = PackedFeatureId::edge(base + k as u32);
             }
         }
@@ -209,14 +240,16 @@ impl<const N: usize> FullFeature<N> {
     }
 }
 
-/// Calls `each(corner, id)` for every corner of the support feature `f` of `shape`, its whole
-/// face where parry's feature cuts it short (see [`whole_face`]).
+/// Calls `each(corner, id)` for every corner of the support feature `f` of `shape` along the
+/// direction `dir` (shape's frame), its whole face where parry's feature cuts it short (see
+/// [`whole_face`]).
 pub(super) fn each_corner(
     shape: &dyn Shape,
     f: &PolygonalFeature,
+    dir: &Vector3<f64>,
     mut each: impl FnMut(Point3<f64>, PackedFeatureId),
 ) {
-    if let Some(whole) = whole_face(shape, f) {
+    if let Some(whole) = whole_face(shape, f, dir) {
         let full = FullFeature::<MAX_CORNERS>::of(f, Some(whole));
         for i in 0..full.num_vertices {
             each(full.vertices[i], full.vids[i]);
@@ -289,7 +322,8 @@ pub(super) fn face_contacts(
     (b, f2): (&dyn Shape, &PolygonalFeature),
     m: &mut ContactManifold<Reference, ()>,
 ) -> Option<Unit<Vector3<f64>>> {
-    let (long1, long2) = (whole_face(a, f1), whole_face(b, f2));
+    let dir2 = pos12.inverse_transform_vector(&-gjk.into_inner());
+    let (long1, long2) = (whole_face(a, f1, gjk), whole_face(b, f2, &dir2));
     // boxes and the faces parry keeps whole on buffers sized for 4 corners
     if long1.is_none() && long2.is_none() {
         let (g1, g2) = (

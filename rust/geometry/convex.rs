@@ -148,7 +148,7 @@ macro_rules! convex_impl {
                 pfm_a.local_support_feature(&-n_a, &mut feature);
                 let pos21 = pos12.inverse();
                 let points = &mut m.points;
-                $corners(a, &feature, |v, vid| {
+                $corners(a, &feature, &-*n_a, |v, vid| {
                     let v_b = pos21 * v;
                     let d = v_b.coords.dot(&n);
                     if d - ra <= prediction {
@@ -277,6 +277,7 @@ convex_impl!(
 fn each_corner2(
     _: &dyn parry2d_f64::shape::Shape,
     f: &parry2d_f64::shape::PolygonalFeature,
+    _: &nalgebra::Vector2<f64>,
     mut each: impl FnMut(nalgebra::Point2<f64>, parry2d_f64::shape::PackedFeatureId),
 ) {
     for i in 0..f.num_vertices.min(2) {
