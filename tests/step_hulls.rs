@@ -40,17 +40,14 @@ fn prism(n: usize) -> SolidShape {
     SolidShape::Spatial(ok(Shape3::convex_hull(&pts)))
 }
 
-/// `count` prisms of `n` sides stacked on the floor (the broad phase finds their pairs).
-fn stack(n: usize, count: usize) -> Scene {
+/// `count` equal solids of height 0.1 (`shape()`, turned by the unit quaternion `turn`)
+/// stacked on the floor (the broad phase finds their pairs).
+fn stack(count: usize, shape: impl Fn() -> SolidShape, turn: [f64; 4]) -> Scene {
     let bodies = (0..count)
         .map(|k| {
-            box_body(
-                3,
-                1.0,
-                [0.05; 3],
-                at(3, 0.0, 0.05 * (2 * k + 1) as f64),
-                moving(3, 0.0),
-            )
+            let mut q = at(3, 0.0, 0.05 * (2 * k + 1) as f64);
+            q[3..].copy_from_slice(&turn);
+            box_body(3, 1.0, [0.05; 3], q, moving(3, 0.0))
         })
         .collect();
     Scene {
@@ -68,7 +65,7 @@ fn stack(n: usize, count: usize) -> Scene {
                 e: 0.0,
             },
         ],
-        solids: (0..count).map(|k| on_body(k, prism(n))).collect(),
+        solids: (0..count).map(|k| on_body(k, shape())).collect(),
     }
 }
 
@@ -76,7 +73,7 @@ fn stack(n: usize, count: usize) -> Scene {
 fn prisms_of_many_sides_stand_still_on_the_floor_and_on_each_other() {
     for n in [5, 6, 8, 12, 40] {
         for count in [1, 2] {
-            let scene = stack(n, count);
+            let scene = stack(count, || prism(n), [1.0, 0.0, 0.0, 0.0]);
             let tr = match simulate(&scene, &StepSettings::new(1e-3, 1000)) {
                 Ok(tr) => tr,
                 Err(e) => panic!("valid scene: {e}"),
@@ -85,13 +82,7 @@ fn prisms_of_many_sides_stand_still_on_the_floor_and_on_each_other() {
             for (k, s) in tr.steps.iter().enumerate() {
                 assert_eq!(s.status, Some(ContactStatus::Solved), "{case}: step {k}");
             }
-            let first = &tr.q[..tr.nq];
-            let last = &tr.q[tr.q.len() - tr.nq..];
-            let moved = first
-                .iter()
-                .zip(last)
-                .map(|(a, b)| (a - b).abs())
-                .fold(0.0, f64::max);
+            let moved = largest_move(&tr);
             assert!(moved < 1e-9, "{case}: moved by {moved:e}");
         }
     }
@@ -213,12 +204,7 @@ fn prisms_and_a_cylinder_stand_still_on_a_mesh_floor_across_its_edges() {
         for (k, st) in tr.steps.iter().enumerate() {
             assert_eq!(st.status, Some(ContactStatus::Solved), "{name}: step {k}");
         }
-        let last = &tr.q[tr.q.len() - tr.nq..];
-        let moved = tr.q[..tr.nq]
-            .iter()
-            .zip(last)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
+        let moved = largest_move(&tr);
         assert!(moved < 1e-9, "{name} on the mesh: moved by {moved:e}");
     }
 }
@@ -230,32 +216,8 @@ fn stacked_cylinders_stand_still_at_a_few_sweeps_a_step() {
         std::f64::consts::FRAC_PI_4.sin(),
     );
     for count in [2usize, 5] {
-        let bodies = (0..count)
-            .map(|k| {
-                let mut q = at(3, 0.0, 0.05 * (2 * k + 1) as f64);
-                (q[3], q[4]) = (c, s);
-                box_body(3, 1.0, [0.05; 3], q, moving(3, 0.0))
-            })
-            .collect();
-        let scene = Scene {
-            dim: 3,
-            gravity: gravity(3),
-            bodies,
-            shapes: vec![],
-            half_spaces: vec![floor(3)],
-            pairs: vec![
-                Pair::Solids { mu: 0.5, e: 0.0 },
-                Pair::SolidHalfSpace {
-                    solid: 0,
-                    half_space: 0,
-                    mu: 0.5,
-                    e: 0.0,
-                },
-            ],
-            solids: (0..count)
-                .map(|k| on_body(k, SolidShape::Spatial(ok(Shape3::cylinder(0.05, 0.05)))))
-                .collect(),
-        };
+        let cylinder = || SolidShape::Spatial(ok(Shape3::cylinder(0.05, 0.05)));
+        let scene = stack(count, cylinder, [c, s, 0.0, 0.0]);
         let steps = 500;
         let tr = match simulate(&scene, &StepSettings::new(1e-3, steps)) {
             Ok(tr) => tr,
@@ -269,12 +231,17 @@ fn stacked_cylinders_stand_still_at_a_few_sweeps_a_step() {
         }
         let sweeps: usize = tr.steps[50..].iter().map(|s| s.iterations).sum();
         assert!(sweeps <= 10 * (steps - 50), "{case}: {sweeps} sweeps");
-        let last = &tr.q[tr.q.len() - tr.nq..];
-        let moved = tr.q[..tr.nq]
-            .iter()
-            .zip(last)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
+        let moved = largest_move(&tr);
         assert!(moved < 1e-9, "{case}: moved by {moved:e}");
     }
+}
+
+/// The largest change of a coordinate from the first state to the last.
+fn largest_move(tr: &coulomb::step::Trajectory) -> f64 {
+    let last = &tr.q[tr.q.len() - tr.nq..];
+    tr.q[..tr.nq]
+        .iter()
+        .zip(last)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max)
 }
