@@ -14,6 +14,8 @@ mod alloc_count;
 mod boxes;
 #[path = "geometry/invariance.rs"]
 mod invariance;
+#[path = "geometry/lines.rs"]
+mod lines;
 
 fn ok<T>(r: coulomb::Result<T>) -> T {
     match r {

@@ -135,7 +135,9 @@ pub(super) fn box_pair(
     let mut f2 = PolygonalFeature::default();
     pfm_a.local_support_feature(&n1, &mut f1);
     pfm_b.local_support_feature(&n2, &mut f2);
-    let Some(axis) = face_contacts(pos12, &n1, sep <= near, (a, &f1), (b, &f2), m) else {
+    // two edges: GJK's (the separating axes here are the faces')
+    let Some((axis, _)) = face_contacts(pos12, &n1, (sep <= near, false), (a, &f1), (b, &f2), m)
+    else {
         m.points.clear();
         return BoxPair::Gjk;
     };

@@ -308,20 +308,29 @@ impl<const N: usize> Face<'_, N> {
 /// `pos12` in the first's frame) along the unit normal `gjk` (first shape's frame, from the
 /// first shape to the second) or a face's normal near it (module docs), `near` when the shapes
 /// are within `NEAR` of touching; pushed into `m` with parry's conventions (`local_p1`,
-/// `local_p2` in each shape's frame, `dist = (p2 - p1) · n`). Returns the normal `n` used, or
-/// `None`, pushing nothing, where clipping does not apply (a vertex, two edges, or a face seen
-/// edge-on): the caller then uses parry's own contacts.
+/// `local_p2` in each shape's frame, `dist = (p2 - p1) · n`). Returns the normal `n` used and
+/// whether GJK's own pair may be added to the points, or `None`, pushing nothing, where
+/// clipping does not apply (a vertex, or a face seen edge-on): the caller then uses parry's
+/// own contacts. Two segments (`lines`: where no mesh's normal constraint applies) are two
+/// lines crossing, module `crossing`, or `None`.
 ///
 /// `f1`, `f2` are parry's support features of shapes `a`, `b`; a convex polyhedron's face of
 /// more than 4 corners, or a cylinder's or cone's cap, is taken whole (see [`whole_face`]).
 pub(super) fn face_contacts(
     pos12: &Isometry3<f64>,
     gjk: &Unit<Vector3<f64>>,
-    near: bool,
+    (near, lines): (bool, bool),
     (a, f1): (&dyn Shape, &PolygonalFeature),
     (b, f2): (&dyn Shape, &PolygonalFeature),
     m: &mut ContactManifold<Reference, ()>,
-) -> Option<Unit<Vector3<f64>>> {
+) -> Option<(Unit<Vector3<f64>>, bool)> {
+    if f1.num_vertices == 2 && f2.num_vertices == 2 {
+        return if lines {
+            super::crossing::line_crossing(pos12, gjk, a, b, m).map(|n| (n, false))
+        } else {
+            None
+        };
+    }
     let dir2 = pos12.inverse_transform_vector(&-gjk.into_inner());
     let (long1, long2) = (whole_face(a, f1, gjk), whole_face(b, f2, &dir2));
     // boxes and the faces parry keeps whole on buffers sized for 4 corners
@@ -330,11 +339,12 @@ pub(super) fn face_contacts(
             FullFeature::<4>::of(f1, None),
             FullFeature::<4>::of(f2, None),
         );
-        face_contacts_of::<4, { 3 * 4 }>(pos12, gjk, near, &g1, &g2, m)
+        face_contacts_of::<4, { 3 * 4 }>(pos12, gjk, near, &g1, &g2, m).map(|n| (n, true))
     } else {
         let g1 = FullFeature::<MAX_CORNERS>::of(f1, long1);
         let g2 = FullFeature::<MAX_CORNERS>::of(f2, long2);
         face_contacts_of::<MAX_CORNERS, { 2 * MAX_CORNERS }>(pos12, gjk, near, &g1, &g2, m)
+            .map(|n| (n, true))
     }
 }
 

@@ -280,7 +280,7 @@ macro_rules! contacts_impl {
     ($(#[$doc:meta])* $name:ident, $raw:ident, $shape:ty, $iso:ident, $vec:ident, $point:ident,
      $cache:ident, $dispatcher:ident, $check_pose:ident, $manifold:ty, $workspace:ty,
      $dynshape:ty, $tracked:ident, $face:ident, $part_face:ident, $convex:ident,
-     $convex_ws:ty, $pair:ident, $boxes:ident) => {
+     $convex_ws:ty, $pair:ident, $boxes:ident, $bound:ident) => {
         /// parry's manifolds of `a` at `pose_a` and `b` at `pose_b` translated by `shift`,
         /// converted; gaps taken back to the unshifted poses (`g - n · shift`, exact while the
         /// same features touch), kept when `<= prediction`. `boxes`: both shapes are boxes,
@@ -467,11 +467,24 @@ macro_rules! contacts_impl {
             if $raw(shapes, boxes, (unit, size_q), pose_a, pose_b, zero, prediction, manifolds, ws, out)? {
                 return Ok(());
             }
-            let first = deepest_gap(out, |p| p.gap);
             // a half-space's points are its support feature's vertices: no GJK to go wrong
             if a.is_half_space() || b.is_half_space() {
                 return Ok(());
             }
+            // an answer's deepest gap, or the separation along its normal where that is less:
+            // at touch GJK can return a wrong direction between curved shapes, and its closest
+            // pair's distance along it overstates the gap (two crossed cylinders at gap 0
+            // came back at 1.6e-11 with a normal 60 degrees off); the separation along any
+            // direction is a lower bound of the gap, so such an answer is taken as touching
+            let score = |pts: &[$point]| {
+                let gap = deepest_gap(pts, |p| p.gap);
+                match pts.iter().min_by(|p, q| p.gap.total_cmp(&q.gap)) {
+                    Some(p) => $bound((a.parry(), pose_a), (b.parry(), pose_b), &p.normal)
+                        .map_or(gap, |s| s.min(gap)),
+                    None => gap,
+                }
+            };
+            let first = score(out);
             // no point at all, yet the bounding boxes (grown by the prediction) meet: GJK can
             // also fail outright at exact touch (two equal rectangles stacked face to face,
             // turned by 1e-14 rad, come back with no point in one order of the pair and two in
@@ -496,7 +509,7 @@ macro_rules! contacts_impl {
             let shift = along * (PULL * size);
             let ws = (&mut *workspace, &mut *convex);
             $raw(shapes, false, (unit, size_q), pose_a, pose_b, shift, prediction, manifolds, ws, retry)?;
-            let second = deepest_gap(retry, |p| p.gap);
+            let second = score(retry);
             if (empty && !retry.is_empty()) || first <= second + PREFER * size {
                 std::mem::swap(out, retry);
             }
@@ -518,18 +531,45 @@ contacts_impl!(
     /// axis). So when the first answer's deepest gap is `<= 1e-10 L` (`L` the smaller shape's
     /// size), the query is made again with b pulled apart by `1e-8 L` (its gaps taken back by
     /// `n · shift`), and the answer with the larger deepest gap is kept (the second one unless
-    /// the first beats it by more than `1e-12 L`).
+    /// the first beats it by more than `1e-12 L`). An answer's deepest gap counts as the
+    /// separation `s(n)` along its normal where that is less (shapes with support maps): GJK's
+    /// closest pair between curved shapes at touch, along a wrong direction, overstates the gap.
     contacts3, raw3, Shape3, Isometry3, Vector3, ContactPoint3, ContactCache3, Dispatcher3,
     check_pose3, Manifold3<Reference, ()>, Workspace3, dyn Parry3, Tracked3, face_normal3, part_normal3,
-    convex3_or_parts, Convex3, box_pair3, boxes3
+    convex3_or_parts, Convex3, box_pair3, boxes3, separation3
 );
 
 contacts_impl!(
     /// [`contacts3`] in 2D.
     contacts2, raw2, Shape2, Isometry2, Vector2, ContactPoint2, ContactCache2, Dispatcher2,
     check_pose2, Manifold2<Reference, ()>, Workspace2, dyn Parry2, Tracked2, face_normal2, part_normal2,
-    convex2, Convex2, box_pair2, boxes2
+    convex2, Convex2, box_pair2, boxes2, separation2
 );
+
+/// The separation of two convex shapes along the unit direction `n` (world frame, from a to
+/// b), `min_{y in B} n · y - max_{x in A} n · x` (a lower bound of their signed distance, the
+/// separating hyperplane theorem), by their support maps; `None` for a shape without one
+/// (half-spaces, compounds, meshes).
+fn separation3(
+    (a, pa): (&dyn Parry3, &Isometry3<f64>),
+    (b, pb): (&dyn Parry3, &Isometry3<f64>),
+    n: &Vector3<f64>,
+) -> Option<f64> {
+    let x = a.as_support_map()?.support_point(pa, n);
+    let y = b.as_support_map()?.support_point(pb, &-n);
+    Some(n.dot(&(y - x)))
+}
+
+/// [`separation3`] in 2D.
+fn separation2(
+    (a, pa): (&dyn Parry2, &Isometry2<f64>),
+    (b, pb): (&dyn Parry2, &Isometry2<f64>),
+    n: &Vector2<f64>,
+) -> Option<f64> {
+    let x = a.as_support_map()?.support_point(pa, n);
+    let y = b.as_support_map()?.support_point(pb, &-n);
+    Some(n.dot(&(y - x)))
+}
 
 /// Whether both shapes are boxes.
 fn boxes3(a: &Shape3, b: &Shape3) -> bool {

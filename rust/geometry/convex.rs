@@ -199,8 +199,10 @@ macro_rules! convex_impl {
                     pfm_a.local_support_feature(&n1, &mut f1);
                     pfm_b.local_support_feature(&n2, &mut f2);
                     let near = (p2_1 - p1).dot(&n1) - ra - rb <= near;
-                    let axis =
-                        $faces(pos12, &n1, near, (a, &f1), (b, &f2), m).unwrap_or_else(|| {
+                    // two crossing lines' exact normal only where no mesh constrains it
+                    let lines = nc.0.is_none() && nc.1.is_none();
+                    let (axis, with_gjk) = $faces(pos12, &n1, (near, lines), (a, &f1), (b, &f2), m)
+                        .unwrap_or_else(|| {
                             $parry::shape::PolygonalFeature::contacts(
                                 pos12,
                                 &pos12.inverse(),
@@ -211,10 +213,10 @@ macro_rules! convex_impl {
                                 m,
                                 false,
                             );
-                            n1
+                            (n1, true)
                         });
                     let gjk_dist = (p2_1 - p1).dot(&dir);
-                    if ($dim3 || m.points.is_empty()) && n1 == dir {
+                    if with_gjk && ($dim3 || m.points.is_empty()) && n1 == dir {
                         let unknown = $parry::shape::PackedFeatureId::UNKNOWN;
                         m.points.push($parry::query::TrackedContact::new(
                             p1,
@@ -289,7 +291,7 @@ fn each_corner2(
 fn parry_contacts2(
     _: &nalgebra::Isometry2<f64>,
     _: &Unit<nalgebra::Vector2<f64>>,
-    _: bool,
+    _: (bool, bool),
     _: (
         &dyn parry2d_f64::shape::Shape,
         &parry2d_f64::shape::PolygonalFeature,
@@ -299,6 +301,6 @@ fn parry_contacts2(
         &parry2d_f64::shape::PolygonalFeature,
     ),
     _: &mut Manifold2<super::contact::Reference, ()>,
-) -> Option<Unit<nalgebra::Vector2<f64>>> {
+) -> Option<(Unit<nalgebra::Vector2<f64>>, bool)> {
     None
 }

@@ -46,6 +46,7 @@ pub mod broad;
 mod clip;
 pub mod contact;
 mod convex;
+mod crossing;
 mod parts;
 pub mod shape2;
 pub mod shape3;
