@@ -29,6 +29,8 @@ use parry3d_f64::shape::{PolygonalFeature, Shape};
 
 use super::clip::face_contacts;
 use super::contact::Reference;
+use super::shape2::Shape2;
+use super::shape3::{Shape3, ShapeKind3};
 
 /// Cross products of edge directions shorter than this are skipped: two edges parallel to
 /// within it span no axis of their own (their axis is, to within it, a face axis), and the
@@ -154,6 +156,46 @@ pub(super) fn box_pair(
     m.local_n1 = *axis;
     m.local_n2 = *pos12.inverse_transform_unit_vector(&-axis);
     BoxPair::Exact
+}
+
+/// Whether both shapes are boxes.
+pub(super) fn boxes3(a: &Shape3, b: &Shape3) -> bool {
+    a.kind() == ShapeKind3::Cuboid && b.kind() == ShapeKind3::Cuboid
+}
+
+/// 2D has no box kind (a rectangle is a convex polygon).
+pub(super) fn boxes2(_: &Shape2, _: &Shape2) -> bool {
+    false
+}
+
+/// Two boxes' manifold by their separating axes into `manifolds` (one
+/// manifold), `true` when it decided the pair.
+pub(super) fn box_pair3(
+    pos12: &Isometry3<f64>,
+    a: &dyn Shape,
+    b: &dyn Shape,
+    prediction: (f64, f64),
+    manifolds: &mut Vec<ContactManifold<Reference, ()>>,
+) -> bool {
+    if manifolds.len() != 1 {
+        manifolds.clear();
+        manifolds.push(ContactManifold::new());
+    }
+    // a box's polyhedron has its corners at exactly +-half extents
+    let half = |s: &dyn Shape| s.compute_local_aabb().maxs.coords;
+    let (ha, hb) = (half(a), half(b));
+    box_pair(pos12, (a, ha), (b, hb), prediction, &mut manifolds[0]) == BoxPair::Exact
+}
+
+/// In 2D rectangles go through GJK (a polygon clip is already exact there).
+pub(super) fn box_pair2(
+    _: &nalgebra::Isometry2<f64>,
+    _: &dyn parry2d_f64::shape::Shape,
+    _: &dyn parry2d_f64::shape::Shape,
+    _: (f64, f64),
+    _: &mut Vec<parry2d_f64::query::ContactManifold<Reference, ()>>,
+) -> bool {
+    false
 }
 
 #[cfg(test)]

@@ -59,11 +59,11 @@ use parry3d_f64::query::{
 use parry2d_f64::shape::Shape as Parry2;
 use parry3d_f64::shape::Shape as Parry3;
 
-use super::box_pair::{box_pair, BoxPair};
+use super::box_pair::{box_pair2, box_pair3, boxes2, boxes3};
 use super::convex::{convex2, Convex2, Convex3};
 use super::parts::convex3_or_parts;
 use super::shape2::{check_pose2, Shape2};
-use super::shape3::{check_pose3, Shape3, ShapeKind3};
+use super::shape3::{check_pose3, Shape3};
 use crate::error::{CoulombError, Result};
 
 /// Which features touch: the parts of a and b (index of a compound's part, of a mesh's or a
@@ -476,8 +476,12 @@ macro_rules! contacts_impl {
             // pair's distance along it overstates the gap (two crossed cylinders at gap 0
             // came back at 1.6e-11 with a normal 60 degrees off); the separation along any
             // direction is a lower bound of the gap, so such an answer is taken as touching
+            // (GJK's overstatement is of its tolerance: only answers near touch are checked)
             let score = |pts: &[$point]| {
                 let gap = deepest_gap(pts, |p| p.gap);
+                if gap > NEAR * size {
+                    return gap;
+                }
                 match pts.iter().min_by(|p, q| p.gap.total_cmp(&q.gap)) {
                     Some(p) => $bound((a.parry(), pose_a), (b.parry(), pose_b), &p.normal)
                         .map_or(gap, |s| s.min(gap)),
@@ -569,44 +573,4 @@ fn separation2(
     let x = a.as_support_map()?.support_point(pa, n);
     let y = b.as_support_map()?.support_point(pb, &-n);
     Some(n.dot(&(y - x)))
-}
-
-/// Whether both shapes are boxes.
-fn boxes3(a: &Shape3, b: &Shape3) -> bool {
-    a.kind() == ShapeKind3::Cuboid && b.kind() == ShapeKind3::Cuboid
-}
-
-/// 2D has no box kind (a rectangle is a convex polygon).
-fn boxes2(_: &Shape2, _: &Shape2) -> bool {
-    false
-}
-
-/// Two boxes' manifold by their separating axes (module `box_pair`) into `manifolds` (one
-/// manifold), `true` when it decided the pair.
-fn box_pair3(
-    pos12: &Isometry3<f64>,
-    a: &dyn Parry3,
-    b: &dyn Parry3,
-    prediction: (f64, f64),
-    manifolds: &mut Vec<Manifold3<Reference, ()>>,
-) -> bool {
-    if manifolds.len() != 1 {
-        manifolds.clear();
-        manifolds.push(Manifold3::new());
-    }
-    // a box's polyhedron has its corners at exactly +-half extents
-    let half = |s: &dyn Parry3| s.compute_local_aabb().maxs.coords;
-    let (ha, hb) = (half(a), half(b));
-    box_pair(pos12, (a, ha), (b, hb), prediction, &mut manifolds[0]) == BoxPair::Exact
-}
-
-/// In 2D rectangles go through GJK (a polygon clip is already exact there).
-fn box_pair2(
-    _: &Isometry2<f64>,
-    _: &dyn Parry2,
-    _: &dyn Parry2,
-    _: (f64, f64),
-    _: &mut Vec<Manifold2<Reference, ()>>,
-) -> bool {
-    false
 }
