@@ -335,6 +335,15 @@ impl Stepper {
                 negative += 1;
             }
         }
+        // a far group's gaps are above its floor, itself above the gap tolerance: its points
+        // are measured only where they could hold the smallest gap
+        for (g, floor) in self.point_groups.iter().zip(&self.group_floors) {
+            if matches!(floor, Some(f) if *f < min_gap) {
+                for c in g.start..g.end {
+                    min_gap = min_gap.min(self.geometry(c).gap);
+                }
+            }
+        }
         (min_gap, negative)
     }
 }

@@ -23,6 +23,18 @@ pub(super) struct CandState {
     pub(super) basis: u64,
 }
 
+impl CandState {
+    /// whether it carries nothing (equal to the default, a far candidate's state).
+    #[inline]
+    pub(super) fn is_blank(&self) -> bool {
+        // bitwise: a warm start of -0.0 is kept as the search would keep it
+        self.warm.iter().all(|w| w.to_bits() == 0)
+            && !self.corrected
+            && self.basis == 0
+            && self.impact == ImpactMemory::default()
+    }
+}
+
 /// The broad phase's spheres of a scene asking for [`Pair::Spheres`]: its `(mu, e)`, every
 /// point of every single-point shape as (body, body-frame centre, radius), and the sphere
 /// pairs `(i, j)`, `i < j`, declared explicitly (they keep their own mu and e).

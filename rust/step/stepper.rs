@@ -15,6 +15,8 @@ mod drift;
 mod driver;
 #[path = "event.rs"]
 mod event;
+#[path = "far.rs"]
+mod far;
 #[path = "generalized.rs"]
 pub mod generalized;
 #[path = "joints.rs"]
@@ -139,8 +141,13 @@ pub struct Stepper {
     /// the step index whose state `prepare` has done (M, v_free, speed bounds, pairs,
     /// geometry), so the record of a state and the step from it share that work.
     prepared: Option<usize>,
-    /// every candidate's geometry at the prepared state.
+    /// every candidate's geometry at the prepared state (a placeholder for the candidates of
+    /// a far point group, module `far`).
     geo_cache: Vec<Geometry>,
+    /// the declared point-half-space runs of one body against one plane (module `far`), and
+    /// at the prepared state each one's gap floor where it was skipped as far.
+    point_groups: Vec<far::PointGroup>,
+    group_floors: Vec<Option<f64>>,
     speed_bounds: Vec<[f64; 2]>,
     qc: Vec<f64>,
     /// each active contact's curvature term in `qc` (module `curvature`).
@@ -202,6 +209,7 @@ impl Stepper {
         let (off_q, off_v) = (q.len(), v.len());
         let candidates = declared_candidates(scene);
         let nc = candidates.len();
+        let point_groups = far::point_groups(&candidates);
         let (auto, balls, declared_balls) = sphere_points(scene);
         let solid_pairs = solid_pairs::SolidPairs::of(scene, nc, nc + balls.len() * balls.len());
         Ok(Self {
@@ -225,6 +233,8 @@ impl Stepper {
             proj_rows: Vec::new(),
             prepared: None,
             geo_cache: Vec::new(),
+            group_floors: vec![None; point_groups.len()],
+            point_groups,
             speed_bounds: vec![[0.0; 2]; scene.bodies.len()],
             qc: Vec::new(),
             curvature: Vec::new(),
@@ -295,12 +305,37 @@ impl Stepper {
             self.broad_phase();
         }
         self.solid_phase();
-        self.geo_cache.clear();
-        for c in 0..self.candidates.len() {
-            let geo = self.geometry(c);
-            self.geo_cache.push(geo);
-        }
+        self.candidate_geometry();
         self.prepared = Some(self.step_index);
+    }
+
+    /// every candidate's geometry into `geo_cache`, a far point group's as placeholders
+    /// (module `far`).
+    fn candidate_geometry(&mut self) {
+        let mut cache = std::mem::take(&mut self.geo_cache);
+        cache.clear();
+        let mut next = 0;
+        for gi in 0..self.point_groups.len() {
+            let g = self.point_groups[gi];
+            for c in next..g.start {
+                cache.push(self.geometry(c));
+            }
+            let floor = self.far_floor(&g, &self.state);
+            self.group_floors[gi] = floor;
+            if floor.is_some() {
+                let far = far::far_geometry(self.candidates[g.start].a.0);
+                cache.extend(std::iter::repeat_n(far, g.end - g.start));
+            } else {
+                for c in g.start..g.end {
+                    cache.push(self.geometry(c));
+                }
+            }
+            next = g.end;
+        }
+        for c in next..self.candidates.len() {
+            cache.push(self.geometry(c));
+        }
+        self.geo_cache = cache;
     }
 
     /// the record of a step with `active` contacts before its solve.
@@ -340,51 +375,74 @@ impl Stepper {
     /// rebound, or open but closing within the step by its speed bound becomes an active
     /// contact with its G and `M^{-1} G` columns; the others forget their state.
     fn search_contacts(&mut self) {
-        let h = self.settings.h;
-        let tol_gap = self.settings.gap_tolerance;
         // filled in place (an active contact carries its G and M^{-1} G columns)
         let mut active = std::mem::take(&mut self.active);
         active.clear();
-        for c in 0..self.candidates.len() {
-            let geo = &self.geo_cache[c];
-            let reach = self.reach(geo);
-            // a contact owed a rebound stays active whatever its gap (module impact); the
-            // search again on the step's velocity (module settle) only adds contacts, since
-            // `v_free` may have changed in between (a joint retargeted) and must not
-            // release one the solve relied on
-            let pending = self.state[c].impact.pending;
-            let kept = self.trial_search
-                && self
-                    .active_kept
-                    .binary_search_by_key(&c, |a| a.cand)
-                    .is_ok();
-            let far = geo.gap > tol_gap + 2.0 * h * reach && !pending && !kept;
-            let (vn_k, vn_free) = if far {
-                (0.0, 0.0)
-            } else {
-                let vn_free = self.normal_velocity(geo, &self.v_free);
-                let vn_trial = if self.trial_search {
-                    self.normal_velocity(geo, &self.v_trial)
-                } else {
-                    vn_free
-                };
-                (self.normal_velocity(geo, &self.v), vn_free.min(vn_trial))
-            };
-            let mut verdict =
-                driver::search_verdict(&self.settings, geo.gap, vn_k, vn_free, pending);
-            if kept && verdict.is_none() {
-                verdict = Some(geo.gap <= tol_gap || pending);
+        let mut gi = 0;
+        let mut c = 0;
+        while c < self.candidates.len() {
+            // a far point group (module `far`): its candidates forget their state, as far
+            // ones do, without their placeholders being looked at one by one
+            if gi < self.point_groups.len() && self.point_groups[gi].start == c {
+                let (g, floor) = (self.point_groups[gi], self.group_floors[gi]);
+                gi += 1;
+                if floor.is_some() {
+                    for st in &mut self.state[g.start..g.end] {
+                        if !st.is_blank() {
+                            *st = CandState::default();
+                        }
+                    }
+                    c = g.end;
+                    continue;
+                }
             }
-            let (false, Some(closed)) = (far, verdict) else {
-                self.state[c] = CandState::default();
-                continue;
-            };
-            active.push(Active::default());
-            if let Some(act) = active.last_mut() {
-                self.active_contact(act, c, geo, vn_k, closed);
-            }
+            self.search_candidate(c, &mut active);
+            c += 1;
         }
         self.active = active;
+    }
+
+    /// the search's verdict on candidate c (see [`Stepper::search_contacts`]): an active
+    /// contact pushed onto `active`, or its state forgotten.
+    fn search_candidate(&mut self, c: usize, active: &mut Vec<Active>) {
+        let h = self.settings.h;
+        let tol_gap = self.settings.gap_tolerance;
+        let geo = &self.geo_cache[c];
+        let reach = self.reach(geo);
+        // a contact owed a rebound stays active whatever its gap (module impact); the
+        // search again on the step's velocity (module settle) only adds contacts, since
+        // `v_free` may have changed in between (a joint retargeted) and must not
+        // release one the solve relied on
+        let pending = self.state[c].impact.pending;
+        let kept = self.trial_search
+            && self
+                .active_kept
+                .binary_search_by_key(&c, |a| a.cand)
+                .is_ok();
+        let far = geo.gap > tol_gap + 2.0 * h * reach && !pending && !kept;
+        let (vn_k, vn_free) = if far {
+            (0.0, 0.0)
+        } else {
+            let vn_free = self.normal_velocity(geo, &self.v_free);
+            let vn_trial = if self.trial_search {
+                self.normal_velocity(geo, &self.v_trial)
+            } else {
+                vn_free
+            };
+            (self.normal_velocity(geo, &self.v), vn_free.min(vn_trial))
+        };
+        let mut verdict = driver::search_verdict(&self.settings, geo.gap, vn_k, vn_free, pending);
+        if kept && verdict.is_none() {
+            verdict = Some(geo.gap <= tol_gap || pending);
+        }
+        let (false, Some(closed)) = (far, verdict) else {
+            self.state[c] = CandState::default();
+            return;
+        };
+        active.push(Active::default());
+        if let Some(act) = active.last_mut() {
+            self.active_contact(act, c, geo, vn_k, closed);
+        }
     }
 
     /// a bound on how fast a candidate's gap can close: the speed bounds of its sides' bodies
