@@ -33,8 +33,9 @@ pub(super) struct PointGroup {
     reach_radius: f64,
 }
 
-/// the runs of consecutive point-half-space candidates with the same body and plane, in
-/// candidate order (a sphere's single point is a run of one: its search is skipped too).
+/// the runs of two or more consecutive point-half-space candidates with the same body and
+/// plane, in candidate order (a single point's own geometry costs what the group's test
+/// costs: measured, 10,000 spheres as runs of one took 5 % more instructions).
 pub(super) fn point_groups(candidates: &[Candidate]) -> Vec<PointGroup> {
     let mut groups: Vec<PointGroup> = Vec::new();
     for (c, cand) in candidates.iter().enumerate() {
@@ -57,7 +58,7 @@ pub(super) fn point_groups(candidates: &[Candidate]) -> Vec<PointGroup> {
             }),
         }
     }
-    groups.retain(|g| g.reach_radius.is_finite());
+    groups.retain(|g| g.end - g.start >= 2 && g.reach_radius.is_finite());
     groups
 }
 
