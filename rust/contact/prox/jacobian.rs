@@ -4,7 +4,7 @@
 
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
-use faer::sparse::{SparseColMat, Triplet};
+use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat, Triplet};
 
 use super::super::projection::tangent_norm;
 use super::super::ContactProblem;
@@ -73,6 +73,12 @@ pub(super) struct Jacobian {
     /// (i, j, W_ij), with every diagonal block present.
     blocks: Vec<(usize, usize, [[f64; 3]; 3])>,
     triplets: Vec<Triplet<usize, usize, f64>>,
+    /// the triplets' sparse pattern and the order their values are read in, made on the
+    /// first solve: the pattern is the same in every Newton step, so later steps place the
+    /// values without sorting the triplets again (faer's triplet constructor is this pair of
+    /// steps, so the matrix is the same to the bit).
+    pattern: Option<(SymbolicSparseColMat<usize>, Argsort<usize>)>,
+    values: Vec<f64>,
     symbolic: Option<SymbolicLu<usize>>,
 }
 
@@ -102,6 +108,8 @@ impl Jacobian {
             dim,
             blocks,
             triplets,
+            pattern: None,
+            values: Vec::new(),
             symbolic: None,
         }
     }
@@ -130,8 +138,24 @@ impl Jacobian {
     /// solves `J x = rhs` in place; `false` when the factorization fails or gives a
     /// non-finite answer.
     pub(super) fn solve(&mut self, n: usize, rhs: &mut [f64]) -> bool {
-        let Ok(mat) = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &self.triplets)
-        else {
+        if self.pattern.as_ref().is_some_and(|(p, _)| p.nrows() != n) {
+            (self.pattern, self.symbolic) = (None, None);
+        }
+        if self.pattern.is_none() {
+            let idx: Vec<Pair<usize, usize>> = (self.triplets.iter())
+                .map(|t| Pair::new(t.row, t.col))
+                .collect();
+            match SymbolicSparseColMat::try_new_from_indices(n, n, &idx) {
+                Ok(p) => self.pattern = Some(p),
+                Err(_) => return false,
+            }
+        }
+        let Some((pattern, argsort)) = &self.pattern else {
+            return false;
+        };
+        self.values.clear();
+        self.values.extend(self.triplets.iter().map(|t| t.val));
+        let Ok(mat) = SparseColMat::new_from_argsort(pattern.clone(), argsort, &self.values) else {
             return false;
         };
         let symbolic = match &self.symbolic {
