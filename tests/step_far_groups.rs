@@ -19,10 +19,14 @@ fn bin(wall: f64) -> Vec<([f64; 3], [f64; 3])> {
 }
 
 fn corners() -> Vec<[f64; 3]> {
+    corners_of(HALF)
+}
+
+fn corners_of(half: f64) -> Vec<[f64; 3]> {
     let mut out = vec![];
-    for sx in [-HALF, HALF] {
-        for sy in [-HALF, HALF] {
-            for sz in [-HALF, HALF] {
+    for sx in [-half, half] {
+        for sy in [-half, half] {
+            for sz in [-half, half] {
                 out.push([sx, sy, sz]);
             }
         }
@@ -32,8 +36,12 @@ fn corners() -> Vec<[f64; 3]> {
 
 /// a cube of corners in the bin, every corner against every plane.
 fn cube_in_bin(gravity: f64, wall: f64, q0: [f64; 7], v0: [f64; 6], e: f64) -> Scene {
+    cube_in_bin_of(HALF, gravity, wall, q0, v0, e)
+}
+
+fn cube_in_bin_of(half: f64, gravity: f64, wall: f64, q0: [f64; 7], v0: [f64; 6], e: f64) -> Scene {
     let m = 2.0;
-    let i = m * (2.0 * HALF) * (2.0 * HALF) / 6.0;
+    let i = m * (2.0 * half) * (2.0 * half) / 6.0;
     let planes = bin(wall);
     Scene {
         dim: 3,
@@ -48,7 +56,7 @@ fn cube_in_bin(gravity: f64, wall: f64, q0: [f64; 7], v0: [f64; 6], e: f64) -> S
         }],
         shapes: vec![Shape {
             body: 0,
-            points: corners().iter().map(|p| p.to_vec()).collect(),
+            points: corners_of(half).iter().map(|p| p.to_vec()).collect(),
             radius: 0.0,
         }],
         half_spaces: planes
@@ -95,8 +103,12 @@ fn rotate(q: &[f64], p: [f64; 3]) -> [f64; 3] {
 
 /// the smallest gap over every corner and plane at the body coordinates q.
 fn smallest_gap(q: &[f64], wall: f64) -> f64 {
+    smallest_gap_of(HALF, q, wall)
+}
+
+fn smallest_gap_of(half: f64, q: &[f64], wall: f64) -> f64 {
     let mut g = f64::INFINITY;
-    for p in corners() {
+    for p in corners_of(half) {
         let r = rotate(&q[3..7], p);
         let x = [q[0] + r[0], q[1] + r[1], q[2] + r[2]];
         for (p0, n) in bin(wall) {
@@ -191,4 +203,113 @@ fn a_cube_thrown_fast_at_a_wall_lands_on_it() {
             -e * 20.0
         );
     }
+}
+
+#[test]
+fn the_smallest_gap_and_the_landing_hold_in_every_unit_of_length() {
+    // the spinning cube of the first test with lengths in units 1e-8..1e8 (gravity, speeds,
+    // inertia and the gap tolerance with them): the recorded smallest gap is the corners'
+    // exact one, and the cube never passes a plane by more than the tolerance
+    let a: f64 = 0.7;
+    let (s, c) = (a / 2.0).sin_cos();
+    let norm = (c * c + 2.0 * s * s).sqrt();
+    for k in [-8, -4, 0, 4, 8] {
+        let unit = 10f64.powi(k);
+        let wall = 0.6 * unit;
+        let q0 = [
+            0.1 * unit,
+            -0.2 * unit,
+            unit,
+            c / norm,
+            s / norm,
+            s / norm,
+            0.0,
+        ];
+        let v0 = [2.0 * unit, unit, 0.5 * unit, 3.0, -5.0, 2.0];
+        let scene = cube_in_bin_of(HALF * unit, 9.81 * unit, wall, q0, v0, 0.5);
+        let mut settings = StepSettings::new(1e-3, 800);
+        settings.gap_tolerance *= unit;
+        let tr = simulate(&scene, &settings).expect("valid scene");
+        assert!(tr.stopped.is_none(), "unit {unit}: {:?}", tr.stopped);
+        for i in 0..tr.t.len() {
+            let q = &tr.q[i * tr.nq..(i + 1) * tr.nq];
+            let exact = smallest_gap_of(HALF * unit, q, wall);
+            assert!(
+                (tr.min_gap[i] - exact).abs() <= 1e-14 * unit,
+                "unit {unit}, state {i}: recorded {}, corners {exact}",
+                tr.min_gap[i]
+            );
+        }
+        let lowest = tr.min_gap.iter().copied().fold(f64::INFINITY, f64::min);
+        assert!(
+            lowest >= -1e-9 * unit && lowest < 1e-6 * unit,
+            "unit {unit}: smallest gap {lowest}"
+        );
+    }
+}
+
+#[test]
+fn a_planar_box_in_a_bin_keeps_the_exact_smallest_gap_and_lands() {
+    // 2D: a square of four corners thrown spinning into a bin of a floor and two walls
+    let (half, wall) = (0.1, 0.6);
+    let planes = [
+        ([0.0, 0.0], [0.0, 1.0]),
+        ([-wall, 0.0], [1.0, 0.0]),
+        ([wall, 0.0], [-1.0, 0.0]),
+    ];
+    let corners = [[-half, -half], [half, -half], [half, half], [-half, half]];
+    let m = 2.0;
+    let scene = Scene {
+        dim: 2,
+        gravity: vec![0.0, -9.81],
+        bodies: vec![Body {
+            kind: BodyKind::Planar,
+            mass: m,
+            inertia: vec![m * (2.0 * half) * (2.0 * half) / 6.0],
+            q0: vec![0.1, 1.0, 0.3],
+            v0: vec![3.0, 0.5, -6.0],
+            force: vec![0.0; 2],
+        }],
+        shapes: vec![Shape {
+            body: 0,
+            points: corners.iter().map(|p| p.to_vec()).collect(),
+            radius: 0.0,
+        }],
+        half_spaces: planes
+            .iter()
+            .map(|(p, n)| HalfSpace {
+                point: p.to_vec(),
+                normal: n.to_vec(),
+            })
+            .collect(),
+        pairs: (0..planes.len())
+            .map(|w| Pair::ShapeHalfSpace {
+                shape: 0,
+                half_space: w,
+                mu: 0.3,
+                e: 0.5,
+            })
+            .collect(),
+        solids: Vec::new(),
+    };
+    let tr = simulate(&scene, &StepSettings::new(1e-3, 1500)).expect("valid scene");
+    assert!(tr.stopped.is_none(), "{:?}", tr.stopped);
+    for i in 0..tr.t.len() {
+        let q = &tr.q[i * tr.nq..(i + 1) * tr.nq];
+        let (s, c) = q[2].sin_cos();
+        let mut exact = f64::INFINITY;
+        for p in corners {
+            let x = [q[0] + c * p[0] - s * p[1], q[1] + s * p[0] + c * p[1]];
+            for (p0, n) in planes {
+                exact = exact.min(n[0] * (x[0] - p0[0]) + n[1] * (x[1] - p0[1]));
+            }
+        }
+        assert!(
+            (tr.min_gap[i] - exact).abs() <= 1e-14,
+            "state {i}: recorded {}, corners {exact}",
+            tr.min_gap[i]
+        );
+    }
+    let lowest = tr.min_gap.iter().copied().fold(f64::INFINITY, f64::min);
+    assert!((-1e-9..1e-6).contains(&lowest), "smallest gap {lowest}");
 }
