@@ -18,10 +18,6 @@ fn bin(wall: f64) -> Vec<([f64; 3], [f64; 3])> {
     ]
 }
 
-fn corners() -> Vec<[f64; 3]> {
-    corners_of(HALF)
-}
-
 fn corners_of(half: f64) -> Vec<[f64; 3]> {
     let mut out = vec![];
     for sx in [-half, half] {
