@@ -2,9 +2,11 @@
 //! Coulomb cone (closed form) and `J_eta`, assembled on W's block pattern and factored by a
 //! sparse LU (see the [module notes](super)).
 
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
-use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat, Triplet};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuSymbolicParams, NumericLu, SymbolicLu};
+use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::{Pair, SparseColMat, SymbolicSparseColMat, Triplet};
+use faer::{Conj, Par};
 
 use super::super::projection::tangent_norm;
 use super::super::ContactProblem;
@@ -73,13 +75,17 @@ pub(super) struct Jacobian {
     /// (i, j, W_ij), with every diagonal block present.
     blocks: Vec<(usize, usize, [[f64; 3]; 3])>,
     triplets: Vec<Triplet<usize, usize, f64>>,
-    /// the triplets' sparse pattern and the order their values are read in, made on the
-    /// first solve: the pattern is the same in every Newton step, so later steps place the
-    /// values without sorting the triplets again (faer's triplet constructor is this pair of
-    /// steps, so the matrix is the same to the bit).
-    pattern: Option<(SymbolicSparseColMat<usize>, Argsort<usize>)>,
-    values: Vec<f64>,
+    /// the matrix, made on the first solve by faer's triplet constructor (its pattern sorted
+    /// once), and where each triplet's value lies in it: the pattern is the same in every
+    /// Newton step, so later steps write the values in place (W's blocks are distinct, so
+    /// each value is written once: the matrix the constructor would make, to the bit).
+    mat: Option<SparseColMat<usize, f64>>,
+    slot: Vec<usize>,
+    /// whether two triplets share a place (then their values are summed in triplet order).
+    repeated: bool,
     symbolic: Option<SymbolicLu<usize>>,
+    numeric: NumericLu<usize, f64>,
+    mem: Option<MemBuffer>,
 }
 
 impl Jacobian {
@@ -108,9 +114,12 @@ impl Jacobian {
             dim,
             blocks,
             triplets,
-            pattern: None,
-            values: Vec::new(),
+            mat: None,
+            slot: Vec::new(),
+            repeated: false,
             symbolic: None,
+            numeric: NumericLu::new(),
+            mem: None,
         }
     }
 
@@ -135,43 +144,96 @@ impl Jacobian {
         }
     }
 
+    /// the matrix of the current triplets by faer's constructor, and each triplet's place in
+    /// its values (`slot`); None when faer refuses the pattern.
+    fn first_matrix(&mut self, n: usize) -> Option<SparseColMat<usize, f64>> {
+        let idx: Vec<Pair<usize, usize>> = (self.triplets.iter())
+            .map(|t| Pair::new(t.row, t.col))
+            .collect();
+        let (pattern, argsort) = SymbolicSparseColMat::try_new_from_indices(n, n, &idx).ok()?;
+        self.repeated = pattern.compute_nnz() != idx.len();
+        let values: Vec<f64> = self.triplets.iter().map(|t| t.val).collect();
+        let mat = SparseColMat::new_from_argsort(pattern, &argsort, &values).ok()?;
+        self.slot.clear();
+        let (ptr, rows) = (mat.symbolic().col_ptr(), mat.symbolic().row_idx());
+        for t in &self.triplets {
+            let start = ptr[t.col];
+            let at = rows[start..ptr[t.col + 1]].binary_search(&t.row).ok()?;
+            self.slot.push(start + at);
+        }
+        Some(mat)
+    }
+
     /// solves `J x = rhs` in place; `false` when the factorization fails or gives a
     /// non-finite answer.
     pub(super) fn solve(&mut self, n: usize, rhs: &mut [f64]) -> bool {
-        if self.pattern.as_ref().is_some_and(|(p, _)| p.nrows() != n) {
-            (self.pattern, self.symbolic) = (None, None);
+        if self.mat.as_ref().is_some_and(|m| m.nrows() != n) {
+            (self.mat, self.symbolic) = (None, None);
         }
-        if self.pattern.is_none() {
-            let idx: Vec<Pair<usize, usize>> = (self.triplets.iter())
-                .map(|t| Pair::new(t.row, t.col))
-                .collect();
-            match SymbolicSparseColMat::try_new_from_indices(n, n, &idx) {
-                Ok(p) => self.pattern = Some(p),
+        match &mut self.mat {
+            Some(mat) => {
+                let values = mat.val_mut();
+                if self.repeated {
+                    values.fill(0.0);
+                    for (t, &k) in self.triplets.iter().zip(&self.slot) {
+                        values[k] += t.val;
+                    }
+                } else {
+                    for (t, &k) in self.triplets.iter().zip(&self.slot) {
+                        values[k] = t.val;
+                    }
+                }
+            }
+            None => match self.first_matrix(n) {
+                Some(mat) => self.mat = Some(mat),
+                None => return false,
+            },
+        }
+        let Some(mat) = &self.mat else {
+            return false;
+        };
+        if self.symbolic.is_none() {
+            // supernodal: W's pattern is made of whole dim x dim blocks, so its columns come
+            // in groups with one pattern, and the dense kernels on those groups beat the
+            // column-by-column factorization faer's own rule picks for the stepper's sparse
+            // piles (BENCHMARKS.md, "The robust mode's sparse LU")
+            let params = LuSymbolicParams {
+                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+                ..Default::default()
+            };
+            match factorize_symbolic_lu(mat.symbolic(), params) {
+                Ok(s) => {
+                    let req = s
+                        .factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default())
+                        .or(s.solve_in_place_scratch::<f64>(1, Par::Seq));
+                    match MemBuffer::try_new(req) {
+                        Ok(m) => self.mem = Some(m),
+                        Err(_) => return false,
+                    }
+                    self.symbolic = Some(s);
+                }
                 Err(_) => return false,
             }
         }
-        let Some((pattern, argsort)) = &self.pattern else {
+        let (Some(symbolic), Some(mem)) = (&self.symbolic, &mut self.mem) else {
             return false;
         };
-        self.values.clear();
-        self.values.extend(self.triplets.iter().map(|t| t.val));
-        let Ok(mat) = SparseColMat::new_from_argsort(pattern.clone(), argsort, &self.values) else {
+        let stack = MemStack::new(mem);
+        let Ok(lu) = symbolic.factorize_numeric_lu(
+            &mut self.numeric,
+            mat.as_ref(),
+            Par::Seq,
+            stack,
+            Default::default(),
+        ) else {
             return false;
         };
-        let symbolic = match &self.symbolic {
-            Some(s) => s.clone(),
-            None => match SymbolicLu::try_new(mat.symbolic()) {
-                Ok(s) => {
-                    self.symbolic = Some(s.clone());
-                    s
-                }
-                Err(_) => return false,
-            },
-        };
-        let Ok(lu) = Lu::try_new_with_symbolic(symbolic, mat.as_ref()) else {
-            return false;
-        };
-        lu.solve_in_place(faer::MatMut::from_column_major_slice_mut(rhs, n, 1));
+        lu.solve_in_place_with_conj(
+            Conj::No,
+            faer::MatMut::from_column_major_slice_mut(rhs, n, 1),
+            Par::Seq,
+            MemStack::new(mem),
+        );
         rhs.iter().all(|v| v.is_finite())
     }
 }

@@ -30,8 +30,8 @@
 //! accepts the step; eta is divided by 10 after a full step, left after a damped one, and
 //! multiplied by 10 when no step length decreases `||F||`. J_eta has the block pattern of W
 //! plus the diagonal; it is assembled from [`ContactProblem::for_each_block`] once into a
-//! block list and factored by faer's sparse LU (partial pivoting) with the symbolic analysis
-//! done once.
+//! block list and factored by faer's supernodal sparse LU (partial pivoting), its symbolic
+//! analysis and workspace made once per solve.
 //!
 //! When 25 Newton steps pass without a tenfold decrease of `||F||` (or no step length helps
 //! even with eta at 1e10 times W's scale) the iterate is moved by 100 NSGS sweeps and Newton
