@@ -80,11 +80,19 @@ impl Stepper {
         if let Some(js) = joints {
             js.register(w, nb);
         }
-        let dim = self.dim;
-        w.assemble(dim, nc, nc >= SPARSE_FROM, |i, j| match joints {
-            Some(js) if i.1 >= 2 => js.coupling(i.1 - 2, i.0, j.0),
-            _ => side_product(dim, active, i, j),
-        });
+        let (dim, sparse) = (self.dim, nc >= SPARSE_FROM);
+        // the products unrolled for the dimension
+        if dim == 3 {
+            w.assemble(3, nc, sparse, |i, j| match joints {
+                Some(js) if i.1 >= 2 => js.coupling(i.1 - 2, i.0, j.0),
+                _ => side_product::<3>(active, i, j),
+            });
+        } else {
+            w.assemble(dim, nc, sparse, |i, j| match joints {
+                Some(js) if i.1 >= 2 => js.coupling(i.1 - 2, i.0, j.0),
+                _ => side_product::<2>(active, i, j),
+            });
+        }
     }
 
     /// `q_c = G^T v_free` plus each contact's restitution, bias or gap term and the gap's
@@ -431,16 +439,15 @@ pub(super) fn solve_phases(
 
 /// `G_{i,b}^T M_b^{-1} G_{j,b}` of side ki of contact i and side kj of contact j (same body).
 #[inline(always)]
-fn side_product(
-    dim: usize,
+fn side_product<const D: usize>(
     active: &[Active],
     (i, ki): (usize, usize),
     (j, kj): (usize, usize),
 ) -> [[f64; 3]; 3] {
     let (si, sj) = (&active[i].sides[ki], &active[j].sides[kj]);
     let mut blk = [[0.0; 3]; 3];
-    for al in 0..dim {
-        for be in 0..dim {
+    for al in 0..D {
+        for be in 0..D {
             blk[al][be] = dot6(&si.g[al], &sj.b[be]);
         }
     }

@@ -45,8 +45,10 @@ use crate::error::{check_finite, CoulombError, Result};
 /// (`O(Σ_b k_b^2)` products, not `O(nc^2)`) by the caller's `dim x dim` product and mirrored
 /// (the blocks between two contacts are symmetric by construction; a contact's own block is
 /// the caller's product, symmetric to rounding). W is stored dense (row-major) or as COO triplets for
-/// [`BlockCsr`]. The workspaces are kept from one assembly to the next: assembling a W of a
-/// size seen before allocates nothing.
+/// [`BlockCsr`]; a sparse assembly over the same sides as the one the block CSR was last built
+/// from (a stepper's contacts unchanged from one step to the next) sums its tiles straight into
+/// the block CSR's values, in the order a rebuild would. The workspaces are kept from one
+/// assembly to the next: assembling a W of a size seen before allocates nothing.
 ///
 /// Used by the time stepper (rigid bodies: sides are body blocks of at most 6 velocities), by
 /// the generalized-coordinate stepper (one block) and by [`assemble_with`] (G and M given).
@@ -63,6 +65,14 @@ pub struct WAssembly {
     sparse: bool,
     csr: Option<BlockCsr>,
     scratch: TileScratch,
+    /// the sides `(block, contact, side)` of the last sparse assembly made of tiles, and of
+    /// the one the block CSR was last rebuilt from: an assembly with these same sides makes
+    /// its tiles at the same places, so it sums them straight into the block CSR's values.
+    assembled: Vec<(usize, usize, usize)>,
+    built: Vec<(usize, usize, usize)>,
+    /// whether the block CSR holds the last sparse assembly (its tiles summed in place, or
+    /// rebuilt from them).
+    in_place: bool,
     dim: usize,
     n: usize,
 }
@@ -103,6 +113,7 @@ impl WAssembly {
         F: FnMut((usize, usize), (usize, usize)) -> [[f64; 3]; 3],
     {
         let n = nc * dim;
+        let in_place = sparse && self.sparse && self.same_sides_as_built(dim, nc);
         self.dim = dim;
         self.n = n;
         self.w.clear();
@@ -111,6 +122,16 @@ impl WAssembly {
         }
         self.sparse = sparse;
         self.tiles.clear();
+        self.in_place = in_place && self.sum_in_place(&mut product);
+        if self.in_place {
+            return;
+        }
+        if sparse {
+            self.assembled.clear();
+            for (b, list) in self.incidence[..self.blocks].iter().enumerate() {
+                self.assembled.extend(list.iter().map(|&(i, k)| (b, i, k)));
+            }
+        }
         for list in &self.incidence[..self.blocks] {
             for (p, &(i, ki)) in list.iter().enumerate() {
                 for &(j, kj) in &list[p..] {
@@ -142,6 +163,85 @@ impl WAssembly {
         }
     }
 
+    /// whether the current sides are those the block CSR was last rebuilt from, at the same
+    /// shape (then every tile falls at the place it had).
+    fn same_sides_as_built(&self, dim: usize, nc: usize) -> bool {
+        let shape = self.scratch.last_slots().map(|(shape, _)| shape);
+        if self.csr.is_none() || shape != Some((dim, nc)) {
+            return false;
+        }
+        let mut built = self.built.iter();
+        for (b, list) in self.incidence[..self.blocks].iter().enumerate() {
+            for &(i, k) in list {
+                if built.next() != Some(&(b, i, k)) {
+                    return false;
+                }
+            }
+        }
+        built.next().is_none()
+    }
+
+    /// the tiles summed straight into the block CSR's values at their places of the last
+    /// rebuild, in the order a rebuild sums them (so the same values to the bit); false,
+    /// with the values left to a rebuild, when an entry is not finite (the rebuild names it).
+    fn sum_in_place<F>(&mut self, product: &mut F) -> bool
+    where
+        F: FnMut((usize, usize), (usize, usize)) -> [[f64; 3]; 3],
+    {
+        match self.dim {
+            1 => self.sum_in_place_of::<1, F>(product),
+            2 => self.sum_in_place_of::<2, F>(product),
+            _ => self.sum_in_place_of::<3, F>(product),
+        }
+    }
+
+    /// [`Self::sum_in_place`] for contacts of D components.
+    // index loops mirror W's layout (α: a component of contact i, β: of contact j)
+    #[allow(clippy::needless_range_loop)]
+    fn sum_in_place_of<const D: usize, F>(&mut self, product: &mut F) -> bool
+    where
+        F: FnMut((usize, usize), (usize, usize)) -> [[f64; 3]; 3],
+    {
+        let (Some(csr), Some((_, slots))) = (self.csr.as_mut(), self.scratch.last_slots()) else {
+            return false;
+        };
+        let values = csr.values_mut();
+        values.fill(0.0);
+        let mut slots = slots.iter();
+        // v * 0 is 0 exactly when v is finite
+        let mut finite = 0.0;
+        for list in &self.incidence[..self.blocks] {
+            for (p, &(i, ki)) in list.iter().enumerate() {
+                for &(j, kj) in &list[p..] {
+                    let blk = product((i, ki), (j, kj));
+                    let Some(tile) = slots.next().and_then(|&at| values.get_mut(at..at + D * D))
+                    else {
+                        return false;
+                    };
+                    for al in 0..D {
+                        for be in 0..D {
+                            tile[al * D + be] += blk[al][be];
+                            finite += blk[al][be] * 0.0;
+                        }
+                    }
+                    if i != j {
+                        let Some(tile) =
+                            slots.next().and_then(|&at| values.get_mut(at..at + D * D))
+                        else {
+                            return false;
+                        };
+                        for be in 0..D {
+                            for al in 0..D {
+                                tile[be * D + al] += blk[al][be];
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        slots.next().is_none() && finite == 0.0
+    }
+
     /// the dense W of the last assembly (row-major `n x n`; empty after a sparse one).
     pub fn dense(&self) -> &[f64] {
         &self.w
@@ -157,7 +257,13 @@ impl WAssembly {
     pub fn block_csr(&mut self) -> Result<&BlockCsr> {
         let nc = self.n.checked_div(self.dim).unwrap_or(0);
         let csr = self.csr.get_or_insert_with(BlockCsr::empty);
-        csr.rebuild_from_tiles(self.dim.max(1), nc, &self.tiles, &mut self.scratch)?;
+        if !self.in_place {
+            csr.rebuild_from_tiles(self.dim.max(1), nc, &self.tiles, &mut self.scratch)?;
+            // the tiles are summed in place from now on while the sides stay these
+            std::mem::swap(&mut self.built, &mut self.assembled);
+            self.assembled.clear();
+            self.in_place = true;
+        }
         Ok(csr)
     }
 

@@ -183,3 +183,93 @@ fn a_dense_w_over_the_memory_budget_is_refused_before_any_work() {
     let err = assemble_with(&factor, 1, &g, free, None).unwrap_err();
     assert!(matches!(err, CoulombError::TooLarge(_)), "{err}");
 }
+
+/// a block CSR's tiles by block row: (block column, the tile's bits).
+type TileBits = Vec<Vec<(usize, Vec<u64>)>>;
+
+/// contacts (1 or 2 sides on `nb` blocks), and W's tiles as a function of the pair and a
+/// draw, for the in-place assembly below.
+struct Drawn {
+    nb: usize,
+    sides: Vec<Vec<usize>>,
+}
+
+impl Drawn {
+    fn new(rng: &mut crate::testing::SplitMix64, nc: usize, nb: usize) -> Self {
+        let sides = (0..nc)
+            .map(|_| {
+                let a = rng.below(nb);
+                let b = rng.below(nb);
+                if rng.below(2) == 0 || a == b {
+                    vec![a]
+                } else {
+                    vec![a, b]
+                }
+            })
+            .collect();
+        Self { nb, sides }
+    }
+
+    /// assembles with tiles drawn from `seed` (contact 0's own tile NaN when `nan`); the block
+    /// CSR's tiles by block row, or the error.
+    fn assemble(&self, asm: &mut WAssembly, dim: usize, seed: u64, nan: bool) -> Result<TileBits> {
+        asm.begin(self.nb);
+        for (c, list) in self.sides.iter().enumerate() {
+            for (k, &b) in list.iter().enumerate() {
+                asm.side(c, k, b);
+            }
+        }
+        asm.assemble(dim, self.sides.len(), true, |(i, ki), (j, kj)| {
+            let mut rng = crate::testing::SplitMix64::new(
+                seed ^ (i as u64) << 40 ^ (j as u64) << 20 ^ (ki as u64) << 10 ^ kj as u64,
+            );
+            let mut blk = [[0.0; 3]; 3];
+            for row in blk.iter_mut() {
+                for x in row.iter_mut() {
+                    *x = rng.range(-1.0, 1.0);
+                }
+            }
+            // contact 0's own tile (the product is a function of the pair)
+            if nan && (i, ki, j, kj) == (0, 0, 0, 0) {
+                blk[1][0] = f64::NAN;
+            }
+            blk
+        });
+        let csr = asm.block_csr()?;
+        Ok((0..csr.nc())
+            .map(|i| {
+                csr.row_cols(i)
+                    .iter()
+                    .map(|&j| {
+                        let t = csr.block(i, j).unwrap_or(&[]);
+                        (j, t.iter().map(|v| v.to_bits()).collect())
+                    })
+                    .collect()
+            })
+            .collect())
+    }
+}
+
+/// A sparse assembly with the sides of the one before sums its tiles in place: the block
+/// CSR is the one a fresh assembly builds, to the bit, through changes of the values, of
+/// the sides, of the dimension, and a NaN (refused, then recovered from).
+#[test]
+fn sparse_assemblies_in_place_match_fresh_ones_to_the_bit() {
+    let mut rng = crate::testing::SplitMix64::new(7);
+    let mut asm = WAssembly::new();
+    for round in 0..40u64 {
+        let (nc, nb) = (1 + rng.below(30), 1 + rng.below(8));
+        let drawn = Drawn::new(&mut rng, nc, nb);
+        let dim = 2 + rng.below(2);
+        for seed in 0..4u64 {
+            let nan = seed == 2 && round % 3 == 0;
+            let kept = drawn.assemble(&mut asm, dim, 100 * round + seed, nan);
+            let fresh = drawn.assemble(&mut WAssembly::new(), dim, 100 * round + seed, nan);
+            match (kept, fresh) {
+                (Ok(a), Ok(b)) => assert_eq!(a, b, "round {round}, seed {seed}"),
+                (Err(_), Err(_)) => assert!(nan),
+                (a, b) => panic!("round {round}: {:?} vs {:?}", a.is_ok(), b.is_ok()),
+            }
+        }
+    }
+}

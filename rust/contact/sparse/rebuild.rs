@@ -23,6 +23,12 @@ pub(crate) struct TileScratch {
 }
 
 impl TileScratch {
+    /// the shape `(dim, nc)` of the last completed rebuild, and each of its tiles' first
+    /// value in the W's values (in the order the tiles were given).
+    pub(crate) fn last_slots(&self) -> Option<((usize, usize), &[usize])> {
+        self.last.map(|shape| (shape, self.slots.as_slice()))
+    }
+
     /// whether `tiles` fall at the places of the last rebuild, of the same shape.
     fn same_places(&self, dim: usize, nc: usize, tiles: &[(usize, usize, [[f64; 3]; 3])]) -> bool {
         self.last == Some((dim, nc))
@@ -156,6 +162,12 @@ impl BlockCsr {
         places.extend(tiles.iter().map(|t| (t.0, t.1)));
         scratch.last = Some((dim, nc));
         Ok(())
+    }
+
+    /// the values, for a caller summing tiles into the places of the last rebuild
+    /// ([`TileScratch::last_slots`]).
+    pub(crate) fn values_mut(&mut self) -> &mut [f64] {
+        &mut self.values
     }
 
     /// an empty W (no contacts), a buffer for [`Self::rebuild_from_tiles`].
