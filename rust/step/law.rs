@@ -9,8 +9,8 @@ use super::driver::contact_term;
 use super::persistence::CandState;
 use super::solve::{solve_step_problem, step_problem, SolveBuffers, SPARSE_FROM};
 use super::{
-    dot6, dot_v, Active, Drift, PolyhedralSettings, Restitution, StepRecord, StepSettings,
-    StepSolver, Stepper,
+    dot_v, Active, Drift, PolyhedralSettings, Restitution, StepRecord, StepSettings, StepSolver,
+    Stepper,
 };
 use crate::contact::assembly::WAssembly;
 use crate::contact::{BlockCsr, ContactProblem, Delassus};
@@ -446,10 +446,20 @@ fn side_product<const D: usize>(
 ) -> [[f64; 3]; 3] {
     let (si, sj) = (&active[i].sides[ki], &active[j].sides[kj]);
     let mut blk = [[0.0; 3]; 3];
-    for al in 0..D {
-        for be in 0..D {
-            blk[al][be] = dot6(&si.g[al], &sj.b[be]);
+    // entry (α, β) is `g_α . b_β` summed from k = 0 up as `dot6` sums it, for the three β
+    // at once (lanes of `bt[k]`)
+    for (al, out) in blk.iter_mut().enumerate().take(D) {
+        let g = &si.g[al];
+        let mut acc = [0.0; 4];
+        for (a, b) in acc.iter_mut().zip(&sj.bt[0]) {
+            *a = g[0] * b;
         }
+        for k in 1..6 {
+            for (a, b) in acc.iter_mut().zip(&sj.bt[k]) {
+                *a += g[k] * b;
+            }
+        }
+        out[..D].copy_from_slice(&acc[..D]);
     }
     blk
 }

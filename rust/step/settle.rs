@@ -64,7 +64,7 @@ impl Stepper {
             for s in &a.sides[..a.nsides] {
                 let b = &self.bodies[s.body];
                 for k in 0..b.nv {
-                    let dv: f64 = (0..dim).map(|j| s.b[j][k] * p[j]).sum();
+                    let dv: f64 = (0..dim).map(|j| s.bt[k][j] * p[j]).sum();
                     vt[b.off_v + k] += dv;
                 }
             }

@@ -62,8 +62,17 @@ struct Side {
     /// G block by contact direction: `g[j]` is the column of direction j over the body's
     /// velocities, zero past `nv` (so every product runs over 6 entries, unrolled).
     g: [[f64; 6]; 3],
-    /// `M^{-1}` times the G block, same layout.
-    b: [[f64; 6]; 3],
+    /// `M^{-1}` times the G block by velocity: `bt[k][j]` is entry k of direction j's column
+    /// (lane 3 zero), so that W's tiles are formed for three directions at once.
+    bt: [[f64; 4]; 6],
+}
+
+impl Side {
+    /// `M^{-1}` times direction j's column of G.
+    #[inline]
+    fn b(&self, j: usize) -> [f64; 6] {
+        std::array::from_fn(|k| self.bt[k][j])
+    }
 }
 
 /// `x . y` over 6 entries (zero-padded velocity columns).
@@ -476,7 +485,10 @@ impl Stepper {
                     *x *= sign;
                 }
                 side.g[j] = col;
-                side.b[j] = self.minv_times(body, &col);
+                let b = self.minv_times(body, &col);
+                for (row, x) in side.bt.iter_mut().zip(b) {
+                    row[j] = x;
+                }
             }
         }
     }
@@ -495,7 +507,8 @@ impl Stepper {
                 if dim == 3 {
                     // the same sums as below, from 0 in direction order, unrolled
                     for k in 0..b.nv {
-                        vn[k] += 0.0 + s.b[0][k] * p[0] + s.b[1][k] * p[1] + s.b[2][k] * p[2];
+                        let b = &s.bt[k];
+                        vn[k] += 0.0 + b[0] * p[0] + b[1] * p[1] + b[2] * p[2];
                         gp[k] += 0.0 + s.g[0][k] * p[0] + s.g[1][k] * p[1] + s.g[2][k] * p[2];
                     }
                     continue;
@@ -504,7 +517,7 @@ impl Stepper {
                     let mut dv = 0.0;
                     let mut g = 0.0;
                     for j in 0..dim {
-                        dv += s.b[j][k] * p[j];
+                        dv += s.bt[k][j] * p[j];
                         g += s.g[j][k] * p[j];
                     }
                     vn[k] += dv;

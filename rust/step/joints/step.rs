@@ -448,14 +448,15 @@ impl JointSystem {
                     isl.bmat.resize(isl.bmat.len() + 3 * m, 0.0);
                 }
                 let base = (isl.contacts.len() - 1) * 3 * m;
+                let sb = [s.b(0), s.b(1), s.b(2)];
                 for (r, row) in isl.rows.iter().enumerate() {
-                    for al in 0..3 {
+                    for (al, b) in sb.iter().enumerate() {
                         let mut x = 0.0;
                         if row.a == s.body {
-                            x += dot6(&row.ja, &s.b[al]);
+                            x += dot6(&row.ja, b);
                         }
                         if row.b == s.body {
-                            x += dot6(&row.jb, &s.b[al]);
+                            x += dot6(&row.jb, b);
                         }
                         isl.bmat[base + r * 3 + al] += x;
                     }
