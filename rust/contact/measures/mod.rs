@@ -175,14 +175,14 @@ impl std::fmt::Display for Shortfall {
 /// below this a norm counts as zero when forming the literature's relative residuals.
 const TINY: f64 = 1e-300;
 
-/// `W_nn` of contact i (the first entry of its diagonal block; 0 when the block is not
-/// stored).
+/// `W_nn` of contact i (the first entry of its diagonal block).
 #[inline]
 pub(crate) fn normal_diagonal(problem: &ContactProblem<'_>, i: usize) -> f64 {
     let d = problem.dim;
     match problem.storage() {
         Delassus::Dense(w) => w[(i * d) * problem.size() + i * d],
-        Delassus::BlockSparse(s) => s.block(i, i).map_or(0.0, |t| t[0]),
+        // every block row stores its diagonal tile (zero when W has none there)
+        Delassus::BlockSparse(s) => s.diag_values(i)[0],
     }
 }
 
