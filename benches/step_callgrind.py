@@ -4,7 +4,8 @@
 
 Builds ``target/release/examples/step_profile`` (benches/profile/step_profile.rs), runs it under
 ``valgrind --tool=callgrind`` on the stepper's benchmark scenes (the box down the ramp, the box
-resting on the floor, the ball's floor impact, the pile of 100 spheres) and reads, with
+resting on the floor, the ball's floor impact, the pile of 100 spheres, the tower of 10 boxes, the
+pile of 216 boxes dropped into a bin, the chain of 20 hinged links) and reads, with
 ``callgrind_annotate --inclusive=yes``, the program's total and the contact measure's inclusive
 count (``contact::measures::measure_into``, every step's verdict). Instruction counts do not
 depend on the machine's load, so they compare revisions where wall times on a shared machine
@@ -40,6 +41,9 @@ SCENES = [
     ("resting box, 5000 steps", ["resting", "5000"]),
     ("floor impact, 200 steps", ["impact", "200"]),
     ("pile of 100, 300 steps", ["pile", "100", "300"]),
+    ("tower of 10 boxes, 2000 steps", ["tower", "10", "2000"]),
+    ("pile of 216 boxes, 200 steps", ["box-pile", "216", "200"]),
+    ("chain of 20 links, 300 steps", ["chain", "20", "300"]),
 ]
 
 
