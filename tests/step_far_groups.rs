@@ -30,6 +30,27 @@ fn corners_of(half: f64) -> Vec<[f64; 3]> {
     out
 }
 
+/// the half-spaces of `planes` (point, inward normal, each of the scene's dimension) and shape
+/// 0 against every one of them, with mu 0.3 and restitution e.
+fn walls(planes: &[(Vec<f64>, Vec<f64>)], e: f64) -> (Vec<HalfSpace>, Vec<Pair>) {
+    let half_spaces = planes
+        .iter()
+        .map(|(p, n)| HalfSpace {
+            point: p.clone(),
+            normal: n.clone(),
+        })
+        .collect();
+    let pairs = (0..planes.len())
+        .map(|w| Pair::ShapeHalfSpace {
+            shape: 0,
+            half_space: w,
+            mu: 0.3,
+            e,
+        })
+        .collect();
+    (half_spaces, pairs)
+}
+
 /// a cube of corners in the bin, every corner against every plane.
 fn cube_in_bin(gravity: f64, wall: f64, q0: [f64; 7], v0: [f64; 6], e: f64) -> Scene {
     cube_in_bin_of(HALF, gravity, wall, q0, v0, e)
@@ -38,7 +59,10 @@ fn cube_in_bin(gravity: f64, wall: f64, q0: [f64; 7], v0: [f64; 6], e: f64) -> S
 fn cube_in_bin_of(half: f64, gravity: f64, wall: f64, q0: [f64; 7], v0: [f64; 6], e: f64) -> Scene {
     let m = 2.0;
     let i = m * (2.0 * half) * (2.0 * half) / 6.0;
-    let planes = bin(wall);
+    let planes: Vec<_> = (bin(wall).iter())
+        .map(|(p, n)| (p.to_vec(), n.to_vec()))
+        .collect();
+    let (half_spaces, pairs) = walls(&planes, e);
     Scene {
         dim: 3,
         gravity: vec![0.0, 0.0, -gravity],
@@ -55,21 +79,8 @@ fn cube_in_bin_of(half: f64, gravity: f64, wall: f64, q0: [f64; 7], v0: [f64; 6]
             points: corners_of(half).iter().map(|p| p.to_vec()).collect(),
             radius: 0.0,
         }],
-        half_spaces: planes
-            .iter()
-            .map(|(p, n)| HalfSpace {
-                point: p.to_vec(),
-                normal: n.to_vec(),
-            })
-            .collect(),
-        pairs: (0..planes.len())
-            .map(|w| Pair::ShapeHalfSpace {
-                shape: 0,
-                half_space: w,
-                mu: 0.3,
-                e,
-            })
-            .collect(),
+        half_spaces,
+        pairs,
         solids: Vec::new(),
     }
 }
@@ -254,6 +265,10 @@ fn a_planar_box_in_a_bin_keeps_the_exact_smallest_gap_and_lands() {
         ([wall, 0.0], [-1.0, 0.0]),
     ];
     let corners = [[-half, -half], [half, -half], [half, half], [-half, half]];
+    let as_vecs: Vec<_> = (planes.iter())
+        .map(|(p, n)| (p.to_vec(), n.to_vec()))
+        .collect();
+    let (half_spaces, pairs) = walls(&as_vecs, 0.5);
     let m = 2.0;
     let scene = Scene {
         dim: 2,
@@ -271,21 +286,8 @@ fn a_planar_box_in_a_bin_keeps_the_exact_smallest_gap_and_lands() {
             points: corners.iter().map(|p| p.to_vec()).collect(),
             radius: 0.0,
         }],
-        half_spaces: planes
-            .iter()
-            .map(|(p, n)| HalfSpace {
-                point: p.to_vec(),
-                normal: n.to_vec(),
-            })
-            .collect(),
-        pairs: (0..planes.len())
-            .map(|w| Pair::ShapeHalfSpace {
-                shape: 0,
-                half_space: w,
-                mu: 0.3,
-                e: 0.5,
-            })
-            .collect(),
+        half_spaces,
+        pairs,
         solids: Vec::new(),
     };
     let tr = simulate(&scene, &StepSettings::new(1e-3, 1500)).expect("valid scene");
@@ -296,7 +298,7 @@ fn a_planar_box_in_a_bin_keeps_the_exact_smallest_gap_and_lands() {
         let mut exact = f64::INFINITY;
         for p in corners {
             let x = [q[0] + c * p[0] - s * p[1], q[1] + s * p[0] + c * p[1]];
-            for (p0, n) in planes {
+            for (p0, n) in &planes {
                 exact = exact.min(n[0] * (x[0] - p0[0]) + n[1] * (x[1] - p0[1]));
             }
         }

@@ -81,8 +81,6 @@ pub(super) struct Jacobian {
     /// each value is written once: the matrix the constructor would make, to the bit).
     mat: Option<SparseColMat<usize, f64>>,
     slot: Vec<usize>,
-    /// whether two triplets share a place (then their values are summed in triplet order).
-    repeated: bool,
     symbolic: Option<SymbolicLu<usize>>,
     numeric: NumericLu<usize, f64>,
     mem: Option<MemBuffer>,
@@ -116,7 +114,6 @@ impl Jacobian {
             triplets,
             mat: None,
             slot: Vec::new(),
-            repeated: false,
             symbolic: None,
             numeric: NumericLu::new(),
             mem: None,
@@ -145,13 +142,16 @@ impl Jacobian {
     }
 
     /// the matrix of the current triplets by faer's constructor, and each triplet's place in
-    /// its values (`slot`); None when faer refuses the pattern.
+    /// its values (`slot`); None when faer refuses the pattern or two triplets share a place
+    /// (never: W's blocks are distinct and each diagonal block is added only where missing).
     fn first_matrix(&mut self, n: usize) -> Option<SparseColMat<usize, f64>> {
         let idx: Vec<Pair<usize, usize>> = (self.triplets.iter())
             .map(|t| Pair::new(t.row, t.col))
             .collect();
         let (pattern, argsort) = SymbolicSparseColMat::try_new_from_indices(n, n, &idx).ok()?;
-        self.repeated = pattern.compute_nnz() != idx.len();
+        if pattern.compute_nnz() != idx.len() {
+            return None;
+        }
         let values: Vec<f64> = self.triplets.iter().map(|t| t.val).collect();
         let mat = SparseColMat::new_from_argsort(pattern, &argsort, &values).ok()?;
         self.slot.clear();
@@ -173,15 +173,8 @@ impl Jacobian {
         match &mut self.mat {
             Some(mat) => {
                 let values = mat.val_mut();
-                if self.repeated {
-                    values.fill(0.0);
-                    for (t, &k) in self.triplets.iter().zip(&self.slot) {
-                        values[k] += t.val;
-                    }
-                } else {
-                    for (t, &k) in self.triplets.iter().zip(&self.slot) {
-                        values[k] = t.val;
-                    }
+                for (t, &k) in self.triplets.iter().zip(&self.slot) {
+                    values[k] = t.val;
                 }
             }
             None => match self.first_matrix(n) {
