@@ -146,8 +146,10 @@ def resting_box(h: float = 1e-3, t_end: float = 10.0) -> PeerRun:
     )
 
 
-def sphere_pile(count: int, h: float = 1e-3, t_end: float = 1.0, radius: float = 0.05) -> PeerRun:
-    """`count` spheres dropped on a grid into a box (floor and four walls), mu = 0.5."""
+def sphere_pile(count: int, h: float = 1e-3, t_end: float = 1.0, radius: float = 0.05,
+                lift: float = 0.0, repeats: int | None = None) -> PeerRun:
+    """`count` spheres dropped on a grid into a box (floor and four walls), mu = 0.5; the grid
+    raised by ``lift`` metres (high enough, nothing touches within the run: free fall)."""
     side = math.ceil(count ** (1 / 3))
     spacing = 2.2 * radius
     half = side * spacing / 2 + radius
@@ -156,7 +158,7 @@ def sphere_pile(count: int, h: float = 1e-3, t_end: float = 1.0, radius: float =
         i, j, l = k % side, (k // side) % side, k // (side * side)
         x = -half + radius + spacing * (i + 0.5)
         y = -half + radius + spacing * (j + 0.5)
-        z = radius + 0.01 + spacing * l
+        z = lift + radius + 0.01 + spacing * l
         bodies.append(
             f'<body pos="{x:.4f} {y:.4f} {z:.4f}"><freejoint/>'
             f'<geom type="sphere" size="{radius}" mass="0.1" friction="0.5 0.005 0.0001"/></body>'
@@ -178,7 +180,7 @@ def sphere_pile(count: int, h: float = 1e-3, t_end: float = 1.0, radius: float =
     {"".join(bodies)}
   </worldbody>
 </mujoco>"""
-    _t, _qpos, _qvel, n, sec = _rollout(xml, None, t_end, h)
+    _t, _qpos, _qvel, n, sec = _rollout(xml, None, t_end, h, repeats)
     return PeerRun(f"pile of {count} spheres", h, n, sec, {})
 
 

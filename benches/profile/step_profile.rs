@@ -128,7 +128,7 @@ fn impact() -> Scene {
 /// `count` spheres of radius 0.05 on a grid above a floor inside four walls, as in
 /// benches/peer_step.py; sphere pairs found by the stepper's broad phase, or declared (the
 /// pairs within 3 grid spacings at the start).
-fn pile(count: usize, declared: bool) -> Scene {
+fn pile(count: usize, declared: bool, lift: f64) -> Scene {
     let radius = 0.05;
     let side = (count as f64).cbrt().ceil() as usize;
     let spacing = 2.2 * radius;
@@ -159,7 +159,7 @@ fn pile(count: usize, declared: bool) -> Scene {
         let (i, j, l) = (k % side, (k / side) % side, k / (side * side));
         let x = -half + radius + spacing * (i as f64 + 0.5);
         let y = -half + radius + spacing * (j as f64 + 0.5);
-        let z = radius + 0.01 + spacing * l as f64;
+        let z = lift + radius + 0.01 + spacing * l as f64;
         scene.bodies.push(Body {
             kind: BodyKind::Spatial,
             mass: 0.1,
@@ -406,8 +406,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             arg(2, 10_000),
         ),
         "impact" => (impact(), arg(2, 200)),
-        "pile" => (pile(arg(2, 100), false), arg(3, 1000)),
-        "pile-declared" => (pile(arg(2, 100), true), arg(3, 1000)),
+        "pile" => (pile(arg(2, 100), false, 0.0), arg(3, 1000)),
+        "pile-declared" => (pile(arg(2, 100), true, 0.0), arg(3, 1000)),
+        // the pile's spheres 1000 m up: free fall, no contact within the run
+        "fall" => (pile(arg(2, 100), false, 1000.0), arg(3, 1000)),
         "tower" => (tower(arg(2, 10))?, arg(3, 2000)),
         "box-pile" => (box_pile(arg(2, 125))?, arg(3, 1000)),
         "dominoes" => (dominoes(arg(2, 10), 1.5 * 0.7362, unit)?, arg(3, 2000)),

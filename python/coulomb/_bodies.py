@@ -44,7 +44,7 @@ class Particle(Body):
     kind = "particle"
 
     def _spec(self, dim: int) -> dict[str, Any]:
-        v = self.velocity if self.velocity is not None else np.zeros(dim)
+        v = self.velocity if self.velocity is not None else [0.0] * dim
         return {
             "kind": "particle",
             "mass": _positive("mass", self.mass),
@@ -100,6 +100,20 @@ class RigidBody3D(Body):
     def _spec(self, dim: int) -> dict[str, Any]:
         if dim != 3:
             raise InvalidParameterError("a RigidBody3D needs a spatial scene (dim=3)")
+        moments = _positive_moments(self.inertia)
+        quat = _vector("orientation", self.orientation, 4) if moments is not None else []
+        if moments is not None and _unit_axis(quat):
+            # principal moments and an exactly unit quaternion: every check below holds by
+            # construction, and the spec is the same to the bit
+            a, b, c = moments
+            return {
+                "kind": "spatial",
+                "mass": _positive("mass", self.mass),
+                "inertia": [a, 0.0, 0.0, 0.0, b, 0.0, 0.0, 0.0, c],
+                "q0": _vector("position", self.position, 3) + quat,
+                "v0": _vector("velocity", self.velocity, 3)
+                + _vector("angular_velocity", self.angular_velocity, 3),
+            }
         j = np.asarray(self.inertia, dtype=np.float64)
         if j.shape == (3,):
             j = np.diag(j)
@@ -125,6 +139,22 @@ class RigidBody3D(Body):
         }
 
 
+def _positive_moments(inertia: Any) -> tuple[float, float, float] | None:
+    """three finite positive principal moments given as Python floats, or None (then the
+    general checks run)."""
+    if type(inertia) not in (tuple, list) or len(inertia) != 3:
+        return None
+    if all(type(x) is float and math.isfinite(x) and x > 0.0 for x in inertia):
+        return (inertia[0], inertia[1], inertia[2])
+    return None
+
+
+def _unit_axis(quat: list[float]) -> bool:
+    """whether a quaternion is +-1 on one entry and 0 on the others (exactly of unit norm,
+    so normalising it changes no bit)."""
+    return sorted(abs(x) for x in quat) == [0.0, 0.0, 0.0, 1.0]
+
+
 # --- shapes --------------------------------------------------------------------------------
 
 
@@ -135,7 +165,7 @@ class Point(Shape):
     offset: Sequence[float] | None = None
 
     def _points(self, dim: int) -> tuple[list[list[float]], float]:
-        off = self.offset if self.offset is not None else np.zeros(dim)
+        off = self.offset if self.offset is not None else [0.0] * dim
         return [_vector("offset", off, dim)], 0.0
 
 
@@ -147,7 +177,7 @@ class Sphere(Shape):
     center: Sequence[float] | None = None
 
     def _points(self, dim: int) -> tuple[list[list[float]], float]:
-        c = self.center if self.center is not None else np.zeros(dim)
+        c = self.center if self.center is not None else [0.0] * dim
         r = float(self.radius)
         if not math.isfinite(r) or r < 0.0:
             raise InvalidParameterError(f"radius must be finite and >= 0, got {r}")

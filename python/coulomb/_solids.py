@@ -22,7 +22,7 @@ def _pose(dim: int, center: Sequence[float] | None,
           orientation: float | Sequence[float] | None) -> list[float]:
     """A solid's pose in its body's frame: ``center`` (default the origin) and
     ``orientation`` (2D: an angle in rad; 3D: a quaternion ``(w, x, y, z)``, normalised)."""
-    c = _vector("center", center if center is not None else np.zeros(dim), dim)
+    c = _vector("center", center if center is not None else [0.0] * dim, dim)
     if dim == 2:
         th = 0.0 if orientation is None else orientation
         if isinstance(th, (Sequence, np.ndarray)):

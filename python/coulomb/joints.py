@@ -42,7 +42,7 @@ rows hold to 2.5e-14 over 10^5 steps with the projection (7.5e-4 without).
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -114,14 +114,16 @@ class Joint:
             )
         self.e = _validate.real("e", e, low=0.0, high=1.0, data=True)
 
-    def _spec(self, dim: int, bodies: list[Any]) -> dict[str, Any]:
-        """The joint as the stepper reads it, checked against the scene."""
+    def _spec(self, dim: int, body_index: Callable[[Any], int]) -> dict[str, Any]:
+        """The joint as the stepper reads it, checked against the scene (``body_index``: a
+        body's index in the scene)."""
 
         def index(body: Any) -> int:
-            for i, b in enumerate(bodies):
-                if b is body:
-                    return i
-            raise InvalidParameterError("a joint's body was not added to the scene")
+            try:
+                return body_index(body)
+            except InvalidParameterError:
+                raise InvalidParameterError(
+                    "a joint's body was not added to the scene") from None
 
         a = index(self.body_a)
         b = None if self.body_b is None else index(self.body_b)
