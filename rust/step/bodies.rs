@@ -155,9 +155,20 @@ pub(super) fn norm3(a: [f64; 3]) -> f64 {
 }
 
 impl Stepper {
-    /// M, M^{-1} and the rotation of every body at the current q.
+    /// M, M^{-1} and the rotation of every body at the current q. They depend on the body's
+    /// orientation alone (its mass and inertia are fixed), so a body whose orientation has
+    /// the same bits as at its last freeze keeps them: bitwise what they would be again.
     pub(super) fn freeze(&mut self) {
         for (bi, b) in self.bodies.iter().enumerate() {
+            let orientation = &self.q[b.off_q + b.lead..b.off_q + b.kind.nq(self.dim)];
+            let mut key = [0u64; 4];
+            for (k, x) in key.iter_mut().zip(orientation) {
+                *k = x.to_bits();
+            }
+            if self.frozen_at[bi] == Some(key) {
+                continue;
+            }
+            self.frozen_at[bi] = Some(key);
             let f = &mut self.frozen[bi];
             *f = Frozen::default();
             for a in 0..b.lead {

@@ -24,6 +24,10 @@
 //! All buffers are kept between calls: after the first call with the largest N, a rebuild
 //! allocates nothing (the output vector keeps its capacity too).
 
+mod kept;
+
+pub use kept::KeptBroadPhase;
+
 /// half of the 26 neighbour offsets: those after (0, 0, 0) in lexicographic order.
 const FORWARD: [[i64; 3]; 13] = [
     [0, 0, 1],

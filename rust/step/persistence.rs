@@ -127,9 +127,9 @@ impl Stepper {
             self.ball_centres.push(c);
             self.ball_radii.push(grown);
         }
+        // sorted, the grid's pairs whether or not it ran (module `broad::kept`)
         self.broad
             .pairs(&self.ball_centres, &self.ball_radii, &mut self.ball_pairs);
-        self.ball_pairs.sort_unstable();
         // carry the state of the previous step's pairs over by key (both lists sorted)
         std::mem::swap(&mut self.auto_keys, &mut self.old_keys);
         self.old_state.clear();

@@ -45,7 +45,7 @@ pub use self::record::{
     simulate, simulate_joints, simulate_recorded, ChunkedRun, ContactRecord, StepRecord, Trajectory,
 };
 use self::solve::SolveBuffers;
-use super::broad::BroadPhase;
+use super::broad::KeptBroadPhase;
 use super::poisson::routh;
 use super::{BodyKind, Drift, Pair, Restitution, Scene, StepSettings, StepSolver};
 use crate::contact::assembly::WAssembly;
@@ -141,6 +141,8 @@ pub struct Stepper {
     pub v: Vec<f64>,
     step_index: usize,
     frozen: Vec<Frozen>,
+    /// the bits of the orientation each body's `frozen` entry was made at (module `bodies`).
+    frozen_at: Vec<Option<[u64; 4]>>,
     v_free: Vec<f64>,
     active: Vec<Active>,
     /// the assembly of W (dense, or COO triplets for block CSR), kept from step to step.
@@ -185,7 +187,7 @@ pub struct Stepper {
     balls: Vec<(usize, [f64; 3], f64)>,
     /// sphere pairs `(i, j)`, `i < j`, declared explicitly (they keep their own mu and e).
     declared_balls: Vec<(u32, u32)>,
-    broad: BroadPhase,
+    broad: KeptBroadPhase,
     ball_centres: Vec<[f64; 3]>,
     ball_radii: Vec<f64>,
     ball_pairs: Vec<(u32, u32)>,
@@ -225,6 +227,7 @@ impl Stepper {
             dim,
             settings: settings.clone(),
             frozen: vec![Frozen::default(); bodies.len()],
+            frozen_at: vec![None; bodies.len()],
             bodies,
             nq: off_q,
             nv: off_v,
@@ -260,7 +263,7 @@ impl Stepper {
             auto,
             balls,
             declared_balls,
-            broad: BroadPhase::new(),
+            broad: KeptBroadPhase::new(),
             ball_centres: Vec::new(),
             ball_radii: Vec::new(),
             ball_pairs: Vec::new(),
