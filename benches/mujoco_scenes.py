@@ -172,8 +172,11 @@ def sphere_pile(count: int, h: float = 1e-3, t_end: float = 1.0, radius: float =
             (0, half, 0, -1),
         )
     )
+    # MuJoCo's default arena cannot hold 10^4 free bodies' contacts
+    size = '<size memory="4G"/>' if count > 2000 else ""
     xml = f"""
 <mujoco>
+  {size}
   <worldbody>
     <geom type="plane" size="{half} {half} 0.1" friction="0.5 0.005 0.0001"/>
     {walls}
