@@ -172,22 +172,29 @@ impl BroadPhase {
     }
 }
 
+/// every pair of balls with finite centres and radii that meet, by the O(N^2) test: the
+/// oracle of both broad phases' tests.
+#[cfg(test)]
+fn brute(centres: &[[f64; 3]], radii: &[f64]) -> Vec<(u32, u32)> {
+    let finite = |c: [f64; 3], r: f64| c.iter().all(|x| x.is_finite()) && r.is_finite();
+    let mut out = vec![];
+    for i in 0..centres.len() {
+        for j in i + 1..centres.len() {
+            if finite(centres[i], radii[i])
+                && finite(centres[j], radii[j])
+                && balls_meet(centres[i], radii[i], centres[j], radii[j])
+            {
+                out.push((i as u32, j as u32));
+            }
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::testing::SplitMix64;
-
-    fn brute(centres: &[[f64; 3]], radii: &[f64]) -> Vec<(u32, u32)> {
-        let mut out = vec![];
-        for i in 0..centres.len() {
-            for j in i + 1..centres.len() {
-                if balls_meet(centres[i], radii[i], centres[j], radii[j]) {
-                    out.push((i as u32, j as u32));
-                }
-            }
-        }
-        out
-    }
 
     fn check(centres: &[[f64; 3]], radii: &[f64]) -> usize {
         let mut bp = BroadPhase::new();

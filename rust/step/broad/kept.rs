@@ -133,23 +133,9 @@ fn finite(c: [f64; 3], r: f64) -> bool {
 
 #[cfg(test)]
 mod tests {
+    use super::super::brute;
     use super::*;
     use crate::testing::SplitMix64;
-
-    fn brute(centres: &[[f64; 3]], radii: &[f64]) -> Vec<(u32, u32)> {
-        let mut out = vec![];
-        for i in 0..centres.len() {
-            for j in i + 1..centres.len() {
-                if finite(centres[i], radii[i])
-                    && finite(centres[j], radii[j])
-                    && balls_meet(centres[i], radii[i], centres[j], radii[j])
-                {
-                    out.push((i as u32, j as u32));
-                }
-            }
-        }
-        out
-    }
 
     /// balls moving and growing over many calls, at scales 1e-4..1e4: at every call the
     /// kept broad phase gives the brute force's pairs in order, and the grid ran on few calls.
