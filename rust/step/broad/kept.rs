@@ -137,23 +137,25 @@ mod tests {
     use super::*;
     use crate::testing::SplitMix64;
 
-    /// balls moving and growing over many calls, at scales 1e-4..1e4: at every call the
+    /// balls moving and growing over many calls, at scales 1e-8..1e8: at every call the
     /// kept broad phase gives the brute force's pairs in order, and the grid ran on few calls.
     #[test]
     fn moving_balls_give_the_brute_force_pairs_at_every_call() {
         let mut rng = SplitMix64::new(17);
         let (mut calls, mut rebuilds, mut found) = (0, 0, 0);
-        for case in 0..40 {
+        for case in 0..51 {
             let n = 2 + case * 3;
             let extent = rng.range(0.5, 5.0);
-            let scale = 10f64.powi(case % 9 - 4);
+            let scale = 10f64.powi(case % 17 - 8);
             let flat = case % 5 == 0;
+            // a third of the scenes far from the origin: coordinates 10^6 times the balls
+            let offset = if case % 3 == 1 { 1e5 * scale } else { 0.0 };
             let mut centres: Vec<[f64; 3]> = (0..n)
                 .map(|_| {
                     let z = if flat { 0.0 } else { rng.range(0.0, extent) };
                     [
-                        rng.range(0.0, extent) * scale,
-                        rng.range(0.0, extent) * scale,
+                        offset + rng.range(0.0, extent) * scale,
+                        offset + rng.range(0.0, extent) * scale,
                         z * scale,
                     ]
                 })
