@@ -225,6 +225,20 @@ impl Stepper {
         }
     }
 
+    /// the world position of a body's centre (the first coordinates of its q; zero beyond).
+    #[inline]
+    pub(super) fn centre(&self, body: usize) -> [f64; 3] {
+        let b = &self.bodies[body];
+        let mut x = [0.0; 3];
+        let k = match b.kind {
+            BodyKind::Particle => self.dim,
+            BodyKind::Planar => 2,
+            BodyKind::Spatial => 3,
+        };
+        x[..k].copy_from_slice(&self.q[b.off_q..b.off_q + k]);
+        x
+    }
+
     /// the world position of a body's centre and of a body-frame point.
     pub(super) fn world_point(&self, body: usize, p: [f64; 3]) -> ([f64; 3], [f64; 3]) {
         let b = &self.bodies[body];

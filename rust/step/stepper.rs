@@ -327,15 +327,21 @@ impl Stepper {
         let mut cache = std::mem::take(&mut self.geo_cache);
         cache.clear();
         let mut next = 0;
+        let mut at: Option<far::BodyReach> = None;
         for gi in 0..self.point_groups.len() {
             let g = self.point_groups[gi];
             for c in next..g.start {
                 cache.push(self.geometry(c));
             }
-            let floor = self.far_floor(&g, &self.state);
+            let reach = match at {
+                Some(r) if r.body == g.body => r,
+                _ => self.body_reach(g.body),
+            };
+            at = Some(reach);
+            let floor = self.far_floor(&g, &reach);
             self.group_floors[gi] = floor;
             if floor.is_some() {
-                let far = far::far_geometry(self.candidates[g.start].a.0);
+                let far = far::far_geometry(g.body);
                 cache.extend(std::iter::repeat_n(far, g.end - g.start));
             } else {
                 for c in g.start..g.end {
