@@ -12,14 +12,15 @@ h = 1 ms, NSGS:
 - **free fall**: the same grid 1000 m up, where nothing touches within the run; the figure is
   the cost per body-step.
 
-coulomb runs ``Scene.simulate`` keeping every 10th step's record (``record_every=10``; the
-contacts per step are the mean over those steps), MuJoCo ``mujoco.rollout`` on the same
-scene (``benches/mujoco_scenes.sphere_pile``), up to 10^4 spheres (its model of 10^5 free
-bodies is not built here). Each case runs in its own process, so its peak resident memory
-(``ru_maxrss``) is its own; the scene's building in Python is timed apart (its own column;
-MuJoCo's model compile is not timed), and coulomb's per-step time leaves out the fixed cost
-of a call (the scene read from Python and checked, the stepper built: the time of a one-step
-call, given in its own column). Every figure of the table comes from the same run.
+coulomb runs ``Scene.simulate`` on all cores (and the pile again on one thread,
+``RAYON_NUM_THREADS=1``: its islands solved one after the other), keeping every 10th step's
+record (``record_every=10``; the contacts per step are the mean over those steps), MuJoCo
+``mujoco.rollout`` on the same scene (``benches/mujoco_scenes.sphere_pile``), up to 10^4 spheres
+(its model of 10^5 free bodies is not built here). Each case runs in its own process, so its
+peak resident memory (``ru_maxrss``) is its own; the scene's building in Python is timed apart
+(its own column; MuJoCo's model compile is not timed), and coulomb's per-step time leaves out
+the fixed cost of a call (the scene read from Python and checked, the stepper built: the time of
+a one-step call, given in its own column). Every figure of the table comes from the same run.
 """
 
 from __future__ import annotations
@@ -55,6 +56,8 @@ QUICK = [(100, 200, 200), (1000, 100, 200)]
 EVERY = 10
 #: the largest size MuJoCo runs
 PEER_MAX = 10_000
+#: coulomb's pile again on one thread (its islands solved one after the other)
+ONE_THREAD = "coulomb-1-thread"
 
 
 def coulomb_scene(count: int, lift: float):
@@ -87,7 +90,7 @@ def run_case(who: str, kind: str, count: int, steps: int, repeats: int) -> dict:
     lift = 1000.0 if kind == "fall" else 0.0
     h = 1e-3
     out: dict = {"who": who, "kind": kind, "bodies": count, "steps": steps}
-    if who == "coulomb":
+    if who.startswith("coulomb"):
         # the fixed costs of a call (the scene's data read from Python and checked, the
         # stepper built) are timed by a one-step call and taken out of the run's time
         build, setup, best, tr = math.inf, math.inf, math.inf, None
@@ -121,7 +124,13 @@ def run_case(who: str, kind: str, count: int, steps: int, repeats: int) -> dict:
 def case_in_child(who: str, kind: str, count: int, steps: int, repeats: int) -> dict:
     cmd = [sys.executable, __file__, "--case", who, kind, str(count), str(steps),
            "--repeats", str(repeats)]
-    done = subprocess.run(cmd, capture_output=True, text=True, check=False)
+    env = dict(os.environ)
+    if who == ONE_THREAD:
+        # the stepper's islands run on rayon's global pool, sized by this variable
+        env["RAYON_NUM_THREADS"] = "1"
+    else:
+        env.pop("RAYON_NUM_THREADS", None)
+    done = subprocess.run(cmd, capture_output=True, text=True, check=False, env=env)
     if done.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)} failed:\n{done.stderr[-2000:]}")
     return json.loads(done.stdout.strip().splitlines()[-1])
@@ -152,9 +161,10 @@ def table(results: list[dict], repeats: int) -> str:
         f"ended: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores.",
         "",
         "| spheres | scene | steps | contacts per step | coulomb us per step | us per "
-        "contact-step | us per body-step | MuJoCo us per step | vs MuJoCo | coulomb setup "
+        "contact-step | us per body-step | MuJoCo us per step | vs MuJoCo | coulomb on 1 "
+        "thread, us per step | all cores vs 1 thread | coulomb setup "
         "(s) | scene built in Python (s) | coulomb peak memory (MB) |",
-        "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+        "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for kind, name in (("pile", "pile"), ("fall", "free fall")):
         for n in sizes:
@@ -166,11 +176,15 @@ def table(results: list[dict], repeats: int) -> str:
             per_contact = fmt(per_step / contacts) if contacts > 0 else "-"
             m = by.get(("mujoco", kind, n))
             m_step = 1e6 * m["seconds"] / m["steps"] if m else None
+            one = by.get((ONE_THREAD, kind, n))
+            one_step = 1e6 * one["seconds"] / one["steps"] if one else None
             lines.append(
                 f"| {n:,} | {name} | {c['steps']} | {contacts:.1f} | {fmt(per_step)} | "
                 f"{per_contact} | {fmt(per_step / n)} | "
                 f"{fmt(m_step) if m_step else '-'} | "
-                f"{f'{m_step / per_step:.2f}x' if m_step else '-'} | {c['setup']:.3g} | "
+                f"{f'{m_step / per_step:.2f}x' if m_step else '-'} | "
+                f"{fmt(one_step) if one_step else '-'} | "
+                f"{f'{one_step / per_step:.2f}x' if one_step else '-'} | {c['setup']:.3g} | "
                 f"{c['build']:.3g} | "
                 f"{c['max_rss_mb']:,.0f} |")
     lines += ["", "![cost per body-step and per contact-step against the number of spheres]"
@@ -187,7 +201,7 @@ def plot(results: list[dict]) -> str:
     except ImportError:
         return "matplotlib missing: no plot"
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
-    for who, style in (("coulomb", "-o"), ("mujoco", "--s")):
+    for who, style in (("coulomb", "-o"), ("mujoco", "--s")):  # all cores
         for kind, label, per in (("fall", "free fall, per body-step", "body"),
                                  ("pile", "pile, per contact-step", "contact")):
             rows = sorted((r for r in results if r["who"] == who and r["kind"] == kind),
@@ -242,11 +256,11 @@ def main() -> int:
     results = []
     for n, pile_steps, fall_steps in (QUICK if args.quick else SIZES):
         for kind, steps in (("pile", pile_steps), ("fall", fall_steps)):
-            for who in ("coulomb", "mujoco"):
-                if who == "mujoco" and n > PEER_MAX:
+            for who in ("coulomb", ONE_THREAD, "mujoco"):
+                if (who == "mujoco" and n > PEER_MAX) or (who == ONE_THREAD and kind != "pile"):
                     continue
                 r = case_in_child(who, kind, n, steps, 1 if n >= 100_000 else repeats)
-                print(f"{who:8s} {kind:5s} {n:>7,} spheres: {r['seconds']:.3f} s for "
+                print(f"{who:16s} {kind:5s} {n:>7,} spheres: {r['seconds']:.3f} s for "
                       f"{r['steps']} steps, peak {r['max_rss_mb']:,.0f} MB", file=sys.stderr)
                 results.append(r)
     block = table(results, repeats)

@@ -22,8 +22,9 @@
 //! environment: `ORDER=symmetric|backward|forward`, `RELAX=1.3`, `MAXIT=100`; `STICK=1` turns on
 //! NSGS's sticking-set solve. `QUIET=1` lists no steps, `CONTACTS=K` prints the contacts of the
 //! first K steps; `UNIT=1e-4` builds the dominoes with lengths in that unit (gravity, inertia
-//! and the gap tolerance with them); the boxes' drift (largest displacement from the start) and the fallback count
-//! are printed.
+//! and the gap tolerance with them); `THREADS=k` solves each step's islands on k threads (all
+//! the cores by default); the boxes' drift (largest displacement from the start) and the
+//! fallback count are printed.
 use coulomb::geometry::Shape3;
 use coulomb::step::{
     simulate, simulate_joints, Body, BodyKind, HalfSpace, Joint, JointKind, Pair, Scene, Shape,
@@ -459,8 +460,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     {
         s.sticking = true;
     }
+    // THREADS=k: each step's islands on k threads (all the cores by default)
+    let threads = std::env::var("THREADS")
+        .ok()
+        .map(|t| t.parse())
+        .transpose()?;
     let start = std::time::Instant::now();
-    let tr = simulate(&scene, &settings)?;
+    let tr = coulomb::step::with_threads(threads, || simulate(&scene, &settings))??;
     let sec = start.elapsed().as_secs_f64();
     let active: usize = tr.steps.iter().map(|s| s.active).sum();
     let sweeps: usize = tr.steps.iter().map(|s| s.iterations).sum();

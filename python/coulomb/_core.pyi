@@ -312,6 +312,7 @@ def step_simulate(
     restitution: str = "newton",
     record_every: int = 1,
     locate_impacts: bool = False,
+    threads: int | None = None,
 ) -> _StepSimulateDict: ...
 def step_rollout(
     scenes: list[dict[str, Any]],

@@ -130,7 +130,7 @@ class Trajectory:
     solver_error_q_floor : ndarray, shape (N,)
         The rounding level of ``solver_error_q`` at the step's answer.
     iterations : ndarray of int, shape (N,)
-        Sweeps, Newton steps or pivots of step k's solve.
+        Sweeps, Newton steps or pivots of step k's solve (the most over its islands).
     momentum_residual : ndarray, shape (N,)
         ``||M (v_{k+1} - v_free) - G P||`` over ``max(||G P||, ||M v_free||, ||M v_{k+1}||)``.
     min_normal_impulse : ndarray, shape (N,)

@@ -21,8 +21,8 @@ use crate::contact::{ContactOrder, NsgsSettings};
 use crate::error::CoulombError;
 use crate::geometry::{Shape2, Shape3};
 use crate::step::{
-    simulate_joints, Body, BodyKind, HalfSpace, Pair, Scene, Shape, Solid, SolidShape,
-    StepSettings, StepSolver, Trajectory,
+    simulate_joints, with_threads, Body, BodyKind, HalfSpace, Pair, Scene, Shape, Solid,
+    SolidShape, StepSettings, StepSolver, Trajectory,
 };
 
 fn item<'py, T: FromPyObjectOwned<'py>>(d: &Bound<'py, PyDict>, key: &str) -> PyResult<T> {
@@ -500,12 +500,12 @@ pub(super) fn trajectory_dict<'py>(
                     facets=None, gap_tolerance=1e-9, warm_start=true, fallback=true,
                     drift=Keyword::Default("none"), drift_bias=Keyword::Default(0.2),
                     restitution=Keyword::Default("newton"), record_every=1,
-                    locate_impacts=false))]
+                    locate_impacts=false, threads=None))]
 #[pyo3(
     text_signature = "(scene, h, steps, solver='nsgs', tol=1e-12, max_iter=None, \
                          relaxation=1.0, facets=None, gap_tolerance=1e-09, warm_start=True, \
                          fallback=True, drift='none', drift_bias=0.2, restitution='newton', \
-                         record_every=1, locate_impacts=False)"
+                         record_every=1, locate_impacts=False, threads=None)"
 )]
 #[allow(clippy::too_many_arguments)]
 pub(super) fn step_simulate<'py>(
@@ -526,7 +526,9 @@ pub(super) fn step_simulate<'py>(
     restitution: Keyword<&'static str>,
     record_every: usize,
     locate_impacts: bool,
+    threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    crate::batch::thread_count(threads).map_err(|e| to_py(py, e))?;
     let joints = joints::joints_from_dict(scene)?;
     let scene = scene_from_dict(scene)?;
     let settings = settings_from(
@@ -549,7 +551,10 @@ pub(super) fn step_simulate<'py>(
     )?;
     let (tr, seconds) = guarded(py, usize::MAX, || {
         let start = std::time::Instant::now();
-        let tr = simulate_joints(&scene, &joints, &settings, record_every)?;
+        // each step's islands on `threads` threads (the answer is the same on any number)
+        let tr = with_threads(threads, || {
+            simulate_joints(&scene, &joints, &settings, record_every)
+        })??;
         Ok((tr, start.elapsed().as_secs_f64()))
     })?;
     trajectory_dict(py, tr, seconds)

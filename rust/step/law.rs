@@ -419,7 +419,7 @@ pub(super) fn solve_phases(
         &problem,
         input.warm,
         input.guess,
-        record,
+        &mut record.fallback,
         solve,
     )?;
     for (p, d) in solve.impulse.iter_mut().zip(p_impact.iter()) {
@@ -526,7 +526,7 @@ pub(super) fn poisson_phase(
         problem,
         input.warm,
         input.guess,
-        record,
+        &mut record.fallback,
         solve,
     )?;
     // restitution from the velocities after compression, u_c = q + W P_c

@@ -69,6 +69,12 @@
 //! each state from [`crate::geometry::contacts3`] / [`crate::geometry::contacts2`], named by
 //! their features so that warm starts and impact memory follow the same contact point.
 //!
+//! Islands: a step's contacts that no moving body links (the connected components of W's
+//! block pattern) are independent problems; with NSGS on a block-sparse W they are solved
+//! apart, each stopping on its own verdict and falling back alone, in parallel
+//! ([`with_threads`]), the answer judged on the whole problem and the same on any number of
+//! threads.
+//!
 //! Drift: a velocity-level condition does not enforce `g(q_{k+1}) >= 0` exactly
 //! (Stewart 2000). Each contact's normal condition carries the gap's second-order remainder over the step on
 //! `v_free`, `min(c, 0) / h` with `c = g(q_k ⊕ h v_free) - g(q_k) - h J_n v_free` (a turning
@@ -91,8 +97,8 @@ pub use stepper::generalized::{
     simulate_generalized, GeneralizedStepper, GeneralizedSystem, GeneralizedTrajectory,
 };
 pub use stepper::{
-    simulate, simulate_joints, simulate_recorded, ChunkedRun, ContactRecord, Joint, JointKind,
-    JointSystemInfo, StepRecord, Stepper, Trajectory,
+    simulate, simulate_joints, simulate_recorded, with_threads, ChunkedRun, ContactRecord, Joint,
+    JointKind, JointSystemInfo, StepRecord, Stepper, Trajectory,
 };
 
 use crate::error::{check_finite, CoulombError, Result};

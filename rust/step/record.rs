@@ -26,7 +26,8 @@ pub struct StepRecord {
     pub error_q: f64,
     /// the rounding level of `error_q` ([`crate::contact::ContactMeasures::error_q_floor`]).
     pub error_q_floor: f64,
-    /// the contact solver's sweeps or pivots.
+    /// the contact solver's sweeps or pivots (solved island by island: the most over the
+    /// step's islands).
     pub iterations: usize,
     /// `||M (v_{k+1} - v_free) - G P||` divided by `max(||G P||, ||M v_free||, ||M v_{k+1}||)`
     /// (the absolute norm when all are zero).

@@ -2,13 +2,14 @@
 //! polyhedral Lemke or the robust mode as fallback) or Lemke on the polyhedral cone
 //! (warm-started from the previous basis), over a dense or block-sparse W.
 
-use super::{StepRecord, StepSettings, StepSolver};
+use super::islands::{Islands, Split};
+use super::{StepSettings, StepSolver};
 use crate::contact::polyhedral::{LemkeVerdict, PolyhedralLcp};
 use crate::contact::{
     measure_into,
     prox::{solve_prox, ProxSettings},
     solve_nsgs, solve_nsgs_measured, BlockCsr, ContactMeasures, ContactProblem, ContactSolution,
-    ContactStatus, NsgsSettings, PolyhedralSettings,
+    ContactStatus, Delassus, NsgsSettings, PolyhedralSettings,
 };
 use crate::error::Result;
 use crate::lcp::lemke::spread;
@@ -92,6 +93,12 @@ pub(super) struct SolveBuffers {
     /// the warm start's measures, `velocity` holding its `W r + q`, when NSGS is to start
     /// from it (set by [`reuse_warm_start`], taken by the solve).
     warm_measures: Option<ContactMeasures>,
+    /// the islands of the problem and their buffers.
+    islands: Islands,
+    /// for an island's solve, the contacts of its step's whole problem (0 otherwise): the
+    /// sweep budget before the robust mode and the polish of nearly solved warm starts
+    /// follow the step's size, so a step's islands are solved as the whole step would be.
+    pub(super) step_nc: usize,
 }
 
 /// What a step's contact solve reports besides the impulses.
@@ -194,21 +201,22 @@ pub(super) fn solve_step_problem(
     problem: &ContactProblem<'_>,
     initial: Option<&[f64]>,
     guess: &[usize],
-    record: &mut StepRecord,
+    fallback: &mut bool,
     ws: &mut SolveBuffers,
 ) -> Result<Outcome> {
-    let out = solve_or_reuse(settings, problem, initial, guess, record, ws)?;
+    let out = solve_or_reuse(settings, problem, initial, guess, fallback, ws)?;
     ws.corrected = out.iterations > 0;
     Ok(out)
 }
 
-/// see [`solve_step_problem`].
-fn solve_or_reuse(
+/// see [`solve_step_problem`]: NSGS on a block-sparse W whose warm start does not solve it
+/// goes island by island (module `islands`) when the problem has more than one.
+pub(super) fn solve_or_reuse(
     settings: &StepSettings,
     problem: &ContactProblem<'_>,
     initial: Option<&[f64]>,
     guess: &[usize],
-    record: &mut StepRecord,
+    fallback: &mut bool,
     ws: &mut SolveBuffers,
 ) -> Result<Outcome> {
     ws.basis.clear();
@@ -221,14 +229,36 @@ fn solve_or_reuse(
     }
     match &settings.solver {
         StepSolver::Nsgs(s) => {
-            let start = match reuse_warm_start(s, problem, initial, ws)? {
+            let mut start = match reuse_warm_start(s, problem, initial, ws)? {
                 Warm::Done(out) => return Ok(out),
                 Warm::Start(start) => start,
             };
+            if let (Delassus::BlockSparse(w), 0) = (problem.storage(), ws.step_nc) {
+                let mut islands = std::mem::take(&mut ws.islands);
+                let split = islands.solve(
+                    settings,
+                    s,
+                    problem,
+                    w,
+                    start.as_deref(),
+                    guess,
+                    fallback,
+                    ws,
+                );
+                ws.islands = islands;
+                match split? {
+                    Split::One => {}
+                    Split::Solved(out) => return Ok(out),
+                    Split::Retry => {
+                        ws.warm_measures = None;
+                        start = Some(std::mem::take(&mut ws.impulse));
+                    }
+                }
+            }
             // many contacts: a sweep budget before the robust mode (a landing layer on a
             // tall pile needs sweeps growing with the pile's height, the robust mode a few
             // Newton steps at a cost linear in the contacts)
-            let large = problem.nc > LEMKE_FALLBACK_MAX && settings.fallback;
+            let large = problem.nc.max(ws.step_nc) > LEMKE_FALLBACK_MAX && settings.fallback;
             let budget = if large {
                 s.max_iter.min(NSGS_BUDGET)
             } else {
@@ -248,14 +278,14 @@ fn solve_or_reuse(
             if first.success() || !settings.fallback {
                 return Ok(ws.take(first));
             }
-            nsgs_fallback(s, problem, guess, first, budget, large, record, ws)
+            nsgs_fallback(s, problem, guess, first, budget, large, fallback, ws)
         }
         StepSolver::Lemke(s) => {
             let first = solve_polyhedral_warm(problem, s, guess, ws)?;
             if first.status == ContactStatus::Solved || !settings.fallback {
                 return Ok(first);
             }
-            lemke_fallback(s, problem, first, record, ws)
+            lemke_fallback(s, problem, first, fallback, ws)
         }
     }
 }
@@ -270,7 +300,7 @@ fn lemke_fallback(
     s: &PolyhedralSettings,
     problem: &ContactProblem<'_>,
     first: Outcome,
-    record: &mut StepRecord,
+    fallback: &mut bool,
     ws: &mut SolveBuffers,
 ) -> Result<Outcome> {
     let nsgs = NsgsSettings {
@@ -281,7 +311,7 @@ fn lemke_fallback(
     };
     let second = solve_nsgs(problem, &nsgs)?;
     if second.success() {
-        record.fallback = true;
+        *fallback = true;
         return Ok(ws.take(second));
     }
     Ok(first)
@@ -337,7 +367,7 @@ fn reuse_warm_start(
     let m = measure_into(problem, init, &mut ws.velocity);
     // up to LEMKE_FALLBACK_MAX contacts the polish below is tried; above, NSGS starts from
     // the warm start
-    let few = problem.nc <= LEMKE_FALLBACK_MAX;
+    let few = problem.nc.max(ws.step_nc) <= LEMKE_FALLBACK_MAX;
     if m.passes(s.tol) && m.cone_violation == 0.0 && !(ws.corrected && few) {
         ws.impulse.clear();
         ws.impulse.extend_from_slice(init);
@@ -384,7 +414,7 @@ fn nsgs_fallback(
     first: ContactSolution,
     budget: usize,
     large: bool,
-    record: &mut StepRecord,
+    fallback: &mut bool,
     ws: &mut SolveBuffers,
 ) -> Result<Outcome> {
     let tol = s.tol.max(1e-9);
@@ -399,7 +429,7 @@ fn nsgs_fallback(
     if large {
         let prox = solve_prox(problem, &prox_from(best.impulse(ws).to_vec()))?;
         if prox.success() {
-            record.fallback = true;
+            *fallback = true;
             return Ok(ws.take(prox));
         }
         best.offer(Best::Other(prox));
@@ -409,7 +439,7 @@ fn nsgs_fallback(
         lemke.lemke.tol = tol;
         let polygon = solve_polyhedral_warm(problem, &lemke, guess, ws)?;
         if polygon.measures.passes(tol) {
-            record.fallback = true;
+            *fallback = true;
             return Ok(Outcome {
                 status: ContactStatus::Solved,
                 ..polygon
@@ -418,7 +448,7 @@ fn nsgs_fallback(
         // onto the disk from the polygon's answer (in ws.impulse)
         let prox = solve_prox(problem, &prox_from(ws.impulse.clone()))?;
         if prox.success() {
-            record.fallback = true;
+            *fallback = true;
             return Ok(ws.take(prox));
         }
         best.offer(Best::Polygon(polygon));
@@ -436,12 +466,12 @@ fn nsgs_fallback(
             ..third
         };
         if third.success() {
-            record.fallback = !matches!(best, Best::Nsgs(_));
+            *fallback = !matches!(best, Best::Nsgs(_));
             return Ok(ws.take(third));
         }
         best.offer(Best::Nsgs(third));
     }
-    record.fallback = !matches!(best, Best::Nsgs(_));
+    *fallback = !matches!(best, Best::Nsgs(_));
     Ok(match best {
         Best::Nsgs(sol) | Best::Other(sol) => ws.take(sol),
         // NSGS's contract is the exact cone: a polygon's answer (3D) that misses it keeps

@@ -19,6 +19,9 @@ mod event;
 mod far;
 #[path = "generalized.rs"]
 pub mod generalized;
+#[path = "islands.rs"]
+mod islands;
+pub use islands::with_threads;
 #[path = "joints.rs"]
 mod joints;
 #[path = "law.rs"]

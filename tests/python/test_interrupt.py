@@ -50,6 +50,18 @@ SETUP = textwrap.dedent(
             s.contact(s.attach(b, coulomb.Sphere(radius=0.5)), floor, mu=0.5, e=0.0)
         s.contact_spheres(mu=0.5, e=0.0)
         return s
+
+    def bins():
+        # 8 groups of 25 spheres resting on the floor 3 m apart: 8 islands or more
+        s = coulomb.Scene(dim=3)
+        floor = s.add(coulomb.HalfSpace((0.0, 0.0, 0.0), (0.0, 0.0, 1.0)))
+        for g in range(8):
+            for k in range(25):
+                pos = (3.0 * g + 0.1 * (k % 5), 0.1 * (k // 5), 0.05)
+                b = s.add(coulomb.Particle(mass=1.0, position=pos))
+                s.contact(s.attach(b, coulomb.Sphere(radius=0.05)), floor, mu=0.5, e=0.0)
+        s.contact_spheres(mu=0.5, e=0.0)
+        return s
     """
 )
 
@@ -72,6 +84,9 @@ CASES = {
     "prox n=900": "W, q = redundant(300); coulomb.contact.solve(W, q, 0.5, dim=3, "
                   "method='prox', tol=1e-300, max_iter=10**9)",
     "simulate 40-sphere pile": "pile(10).simulate(10000.0, 1e-3, record_every=100)",
+    # tol below reach: every step's islands take their whole budget, in parallel
+    "simulate 8 islands in parallel": "bins().simulate(10000.0, 1e-3, tol=1e-300, "
+                                      "record_every=100)",
     "stream 40-sphere pile": ("import os, tempfile; pile(10).stream(os.path.join("
                               "tempfile.mkdtemp(), 'run.h5'), 10000.0, 1e-3, record_every=100)"),
 }

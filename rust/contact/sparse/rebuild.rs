@@ -170,6 +170,34 @@ impl BlockCsr {
         &mut self.values
     }
 
+    /// The principal submatrix of the block rows and columns `members` (increasing) into
+    /// `out` (its buffers reused), contact `c` at `local[c]`: every stored tile of a member's
+    /// row must lie in a member's column, as in a connected component of W's pattern. The
+    /// tiles keep their order and values, so a row product over the submatrix sums the same
+    /// terms in the same order as over W.
+    pub(crate) fn principal_into(&self, members: &[usize], local: &[usize], out: &mut BlockCsr) {
+        let bs = self.dim * self.dim;
+        out.dim = self.dim;
+        out.nc = members.len();
+        out.row_ptr.clear();
+        out.row_ptr.push(0);
+        out.cols.clear();
+        out.values.clear();
+        out.diag.clear();
+        for &i in members {
+            for t in self.row_ptr[i]..self.row_ptr[i + 1] {
+                let j = self.cols[t];
+                if j == i {
+                    out.diag.push(out.cols.len());
+                }
+                out.cols.push(local[j]);
+                out.values
+                    .extend_from_slice(&self.values[t * bs..(t + 1) * bs]);
+            }
+            out.row_ptr.push(out.cols.len());
+        }
+    }
+
     /// an empty W (no contacts), a buffer for [`Self::rebuild_from_tiles`].
     pub(crate) fn empty() -> Self {
         Self {

@@ -1,0 +1,176 @@
+//! A step's contact problem is solved island by island (groups of contacts no moving body
+//! links), the islands in parallel: the answer must not depend on the number of threads, and
+//! every step the islands' answer is judged on the whole problem.
+
+use coulomb::contact::ContactStatus;
+use coulomb::step::{
+    simulate, with_threads, Body, BodyKind, HalfSpace, Pair, Scene, Shape, StepSettings, Trajectory,
+};
+
+const RADIUS: f64 = 0.05;
+
+/// `groups` piles of spheres far apart on one floor, each in a bin of its own: a pile of
+/// `per_group` spheres dropped in a jittered grid (some land, roll and touch their
+/// neighbours, so islands merge and split as the run goes).
+fn piles(groups: usize, per_group: usize) -> Scene {
+    let mut scene = Scene {
+        dim: 3,
+        gravity: vec![0.0, 0.0, -9.81],
+        bodies: vec![],
+        shapes: vec![],
+        half_spaces: vec![HalfSpace {
+            point: vec![0.0, 0.0, 0.0],
+            normal: vec![0.0, 0.0, 1.0],
+        }],
+        pairs: vec![Pair::Spheres { mu: 0.5, e: 0.0 }],
+        solids: Vec::new(),
+    };
+    let side = (per_group as f64).cbrt().ceil() as usize;
+    let spacing = 2.2 * RADIUS;
+    let half = side as f64 * spacing / 2.0 + RADIUS;
+    let inertia = 0.4 * 0.1 * RADIUS * RADIUS;
+    // a deterministic jitter of a few percent of the radius
+    let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
+    let mut jitter = || {
+        seed = seed
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        ((seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 0.1 * RADIUS
+    };
+    for g in 0..groups {
+        // the bins' walls, 3 m apart
+        let cx = 3.0 * g as f64;
+        for (p, n) in [
+            ([cx - half, 0.0, 0.0], [1.0, 0.0, 0.0]),
+            ([cx + half, 0.0, 0.0], [-1.0, 0.0, 0.0]),
+            ([cx, -half, 0.0], [0.0, 1.0, 0.0]),
+            ([cx, half, 0.0], [0.0, -1.0, 0.0]),
+        ] {
+            scene.half_spaces.push(HalfSpace {
+                point: p.to_vec(),
+                normal: n.to_vec(),
+            });
+        }
+        let walls = scene.half_spaces.len() - 4;
+        for k in 0..per_group {
+            let (i, j, l) = (k % side, (k / side) % side, k / (side * side));
+            let x = cx - half + RADIUS + spacing * (i as f64 + 0.5) + jitter();
+            let y = -half + RADIUS + spacing * (j as f64 + 0.5) + jitter();
+            let z = RADIUS + 0.002 + spacing * l as f64;
+            let body = scene.bodies.len();
+            scene.bodies.push(Body {
+                kind: BodyKind::Spatial,
+                mass: 0.1,
+                inertia: vec![inertia, 0.0, 0.0, 0.0, inertia, 0.0, 0.0, 0.0, inertia],
+                q0: vec![x, y, z, 1.0, 0.0, 0.0, 0.0],
+                v0: vec![0.0; 6],
+                force: vec![0.0; 3],
+            });
+            scene.shapes.push(Shape {
+                body,
+                points: vec![vec![0.0; 3]],
+                radius: RADIUS,
+            });
+            for w in std::iter::once(0).chain(walls..walls + 4) {
+                scene.pairs.push(Pair::ShapeHalfSpace {
+                    shape: body,
+                    half_space: w,
+                    mu: 0.5,
+                    e: 0.0,
+                });
+            }
+        }
+    }
+    scene
+}
+
+/// the run with its islands on `threads` threads of coulomb's own pools.
+fn run_with(threads: usize, scene: &Scene, settings: &StepSettings) -> Trajectory {
+    with_threads(Some(threads), || simulate(scene, settings))
+        .expect("a thread count")
+        .expect("the run")
+}
+
+/// the run inside a caller's rayon pool of `threads` threads (as a rollout's worker runs).
+fn run_in_pool(threads: usize, scene: &Scene, settings: &StepSettings) -> Trajectory {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("a thread pool");
+    pool.install(|| simulate(scene, settings)).expect("the run")
+}
+
+#[test]
+fn the_answer_is_the_same_whatever_the_number_of_threads() {
+    let scene = piles(8, 27);
+    let settings = StepSettings::new(1e-3, 60);
+    let one = run_with(1, &scene, &settings);
+    // the parallel path is taken from 128 contacts in a step: the scene must reach it, with
+    // its contacts in many islands (8 bins at least)
+    let most = one.steps.iter().map(|r| r.active).max().unwrap_or(0);
+    assert!(most >= 128, "at most {most} active contacts in a step");
+    let runs = [
+        ("2 threads", run_with(2, &scene, &settings)),
+        ("3 threads", run_with(3, &scene, &settings)),
+        ("all cores", simulate(&scene, &settings).expect("the run")),
+        ("a pool of 1", run_in_pool(1, &scene, &settings)),
+        ("a pool of 2", run_in_pool(2, &scene, &settings)),
+    ];
+    for (threads, other) in runs {
+        assert_eq!(one.q.len(), other.q.len());
+        let same_bits =
+            |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits());
+        assert!(same_bits(&one.q, &other.q), "{threads} threads: q differs");
+        assert!(same_bits(&one.v, &other.v), "{threads} threads: v differs");
+        for (k, (a, b)) in one.steps.iter().zip(&other.steps).enumerate() {
+            assert_eq!(a.status, b.status, "step {k}");
+            assert_eq!(a.iterations, b.iterations, "step {k}");
+            assert_eq!(
+                a.scaled_error.to_bits(),
+                b.scaled_error.to_bits(),
+                "step {k}"
+            );
+            assert_eq!(a.error_q.to_bits(), b.error_q.to_bits(), "step {k}");
+            assert_eq!(a.fallback, b.fallback, "step {k}");
+        }
+    }
+}
+
+#[test]
+fn every_solved_step_passes_the_verdict_on_the_whole_problem() {
+    let scene = piles(4, 27);
+    let settings = StepSettings::new(1e-3, 100);
+    let tol = match &settings.solver {
+        coulomb::step::StepSolver::Nsgs(s) => s.tol,
+        coulomb::step::StepSolver::Lemke(_) => unreachable!("NSGS is the default"),
+    };
+    let traj = simulate(&scene, &settings).expect("the run");
+    assert!(traj.steps.iter().any(|r| r.active >= 24));
+    let mut solved = 0;
+    for (k, r) in traj.steps.iter().enumerate() {
+        if r.status == Some(ContactStatus::Solved) {
+            solved += 1;
+            // a fallback's answer passes at most at 1e-9 (the polygon's, see `nsgs_fallback`)
+            let t = if r.fallback { tol.max(1e-9) } else { tol };
+            assert!(
+                r.scaled_error <= t,
+                "step {k}: scaled_error {}",
+                r.scaled_error
+            );
+            assert!(
+                r.error_q <= t.max(1e-9) || r.error_q <= r.error_q_floor,
+                "step {k}: error_q {} (floor {})",
+                r.error_q,
+                r.error_q_floor
+            );
+        }
+    }
+    let with_contacts = traj.steps.iter().filter(|r| r.status.is_some()).count();
+    assert!(
+        with_contacts > 60 && solved == with_contacts,
+        "{solved} steps solved of {with_contacts} with contacts"
+    );
+    // the piles settle: no sphere sinks into the floor
+    let deepest = traj.min_gap.iter().copied().fold(f64::INFINITY, f64::min);
+    assert!(deepest > -1e-9, "deepest gap {deepest}");
+}
