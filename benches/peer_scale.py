@@ -13,7 +13,7 @@ h = 1 ms, NSGS:
   the cost per body-step.
 
 coulomb runs ``Scene.simulate`` on all cores (and the pile again on one thread,
-``RAYON_NUM_THREADS=1``: its islands solved one after the other), keeping every 10th step's
+``threads=1``: its islands solved one after the other), keeping every 10th step's
 record (``record_every=10``; the contacts per step are the mean over those steps), MuJoCo
 ``mujoco.rollout`` on the same scene (``benches/mujoco_scenes.sphere_pile``), up to 10^4 spheres
 (its model of 10^5 free bodies is not built here). Each case runs in its own process, so its
@@ -91,6 +91,8 @@ def run_case(who: str, kind: str, count: int, steps: int, repeats: int) -> dict:
     h = 1e-3
     out: dict = {"who": who, "kind": kind, "bodies": count, "steps": steps}
     if who.startswith("coulomb"):
+        # each step's islands on all the cores, or on one thread
+        threads = 1 if who == ONE_THREAD else None
         # the fixed costs of a call (the scene's data read from Python and checked, the
         # stepper built) are timed by a one-step call and taken out of the run's time
         build, setup, best, tr = math.inf, math.inf, math.inf, None
@@ -99,10 +101,10 @@ def run_case(who: str, kind: str, count: int, steps: int, repeats: int) -> dict:
             scene = coulomb_scene(count, lift)
             build = min(build, time.perf_counter() - start)
             start = time.perf_counter()
-            scene.simulate(h, h, "nsgs")
+            scene.simulate(h, h, "nsgs", threads=threads)
             setup = min(setup, time.perf_counter() - start)
             start = time.perf_counter()
-            tr = scene.simulate(steps * h, h, "nsgs", record_every=EVERY)
+            tr = scene.simulate(steps * h, h, "nsgs", record_every=EVERY, threads=threads)
             best = min(best, time.perf_counter() - start)
         assert tr is not None
         out["setup"] = setup
@@ -124,13 +126,7 @@ def run_case(who: str, kind: str, count: int, steps: int, repeats: int) -> dict:
 def case_in_child(who: str, kind: str, count: int, steps: int, repeats: int) -> dict:
     cmd = [sys.executable, __file__, "--case", who, kind, str(count), str(steps),
            "--repeats", str(repeats)]
-    env = dict(os.environ)
-    if who == ONE_THREAD:
-        # the stepper's islands run on rayon's global pool, sized by this variable
-        env["RAYON_NUM_THREADS"] = "1"
-    else:
-        env.pop("RAYON_NUM_THREADS", None)
-    done = subprocess.run(cmd, capture_output=True, text=True, check=False, env=env)
+    done = subprocess.run(cmd, capture_output=True, text=True, check=False)
     if done.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)} failed:\n{done.stderr[-2000:]}")
     return json.loads(done.stdout.strip().splitlines()[-1])
