@@ -174,3 +174,17 @@ fn every_solved_step_passes_the_verdict_on_the_whole_problem() {
     let deepest = traj.min_gap.iter().copied().fold(f64::INFINITY, f64::min);
     assert!(deepest > -1e-9, "deepest gap {deepest}");
 }
+
+#[test]
+fn a_thread_count_outside_1_to_1024_is_refused_before_the_work() {
+    for bad in [0, 1025] {
+        let mut ran = false;
+        let out = with_threads(Some(bad), || ran = true);
+        assert!(
+            matches!(out, Err(coulomb::CoulombError::InvalidParameter(_))),
+            "{bad}: {out:?}"
+        );
+        assert!(!ran, "{bad}: the work ran");
+    }
+    assert!(with_threads(Some(1024), || ()).is_ok());
+}
