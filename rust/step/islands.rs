@@ -23,6 +23,7 @@ use std::sync::Mutex;
 
 use rayon::prelude::*;
 
+use super::law::guess_from_bits;
 use super::solve::{solve_or_reuse, Outcome, SolveBuffers};
 use super::StepSettings;
 use crate::batch;
@@ -276,28 +277,13 @@ impl Islands {
             }
         }
         // the guess in the island's own layout
-        isl.guess.clear();
         let facets = PolyhedralSettings::for_dim(dim).facets;
-        let nf = members.iter().filter(|&&i| problem.mu[i] > 0.0).count();
-        let (mut beta, mut lambda) = (members.len(), members.len() + nf * facets);
-        for (l, &i) in members.iter().enumerate() {
-            let bits = self.bits[i];
-            if bits & 1 != 0 {
-                isl.guess.push(l);
-            }
-            if problem.mu[i] > 0.0 {
-                for f in 0..facets.min(62) {
-                    if bits & (1 << (2 + f)) != 0 {
-                        isl.guess.push(beta + f);
-                    }
-                }
-                if bits & 2 != 0 {
-                    isl.guess.push(lambda);
-                }
-                beta += facets;
-                lambda += 1;
-            }
-        }
+        let bits = &self.bits;
+        guess_from_bits(
+            facets,
+            members.iter().map(|&i| (bits[i], problem.mu[i] > 0.0)),
+            &mut isl.guess,
+        );
         isl.solve.corrected = corrected;
         isl.solve.step_nc = problem.nc;
         isl.fallback = false;

@@ -250,16 +250,33 @@ pub(super) fn basis_guess(
     if facets + 2 > 64 || !settings.warm_start {
         return;
     }
-    let nc = active.len();
-    let nf = active.iter().filter(|a| mu_of(a.cand) > 0.0).count();
+    let contacts = active
+        .iter()
+        .map(|a| (state[a.cand].basis, mu_of(a.cand) > 0.0));
+    guess_from_bits(facets, contacts, out);
+}
+
+/// Lemke's guessed basis into `out` from each contact's bits (bit 0 its normal, bit 1 its λ,
+/// bit 2 + k its k-th β) and whether it has friction, in the layout of
+/// [`crate::contact::polyhedral::PolyhedralLcp`]: normals `0..nc`, then each frictional
+/// contact's `facets` β, then their λ (the step's whole problem, or one island of it).
+pub(super) fn guess_from_bits(
+    facets: usize,
+    contacts: impl Iterator<Item = (u64, bool)> + Clone,
+    out: &mut Vec<usize>,
+) {
+    out.clear();
+    let (nc, nf) = contacts
+        .clone()
+        .fold((0, 0), |(n, f), (_, fr)| (n + 1, f + usize::from(fr)));
     let (mut beta, mut lambda) = (nc, nc + nf * facets);
-    for (i, a) in active.iter().enumerate() {
-        let bits = state[a.cand].basis;
+    for (i, (bits, frictional)) in contacts.enumerate() {
         if bits & 1 != 0 {
             out.push(i);
         }
-        if mu_of(a.cand) > 0.0 {
-            for k in 0..facets {
+        if frictional {
+            // bits past the 64th cannot be set (`basis_guess` gives none for so many facets)
+            for k in 0..facets.min(62) {
                 if bits & (1 << (2 + k)) != 0 {
                     out.push(beta + k);
                 }
