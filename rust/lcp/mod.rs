@@ -221,11 +221,16 @@ impl<'a> LcpRef<'a> {
 
     /// w and, per row, the scale `s_i` against which w_i is judged (see
     /// [`LcpMeasures::scaled_error`]), in one pass over M compiled for the CPU's vector
-    /// instructions.
-    fn evaluate_parts(&self, z: &[f64], scaling: &scaling::Equilibration) -> (Vec<f64>, Vec<f64>) {
+    /// instructions, written into `w` and `scale` (each of length n).
+    fn evaluate_parts(
+        &self,
+        z: &[f64],
+        scaling: &scaling::Equilibration,
+        w: &mut [f64],
+        scale: &mut [f64],
+    ) {
         let isa = kernel::detect();
-        kernel::dispatch!(isa, (Vec<f64>, Vec<f64>), || self
-            .evaluate_body(isa, z, scaling))
+        kernel::dispatch!(isa, (), || self.evaluate_body(isa, z, scaling, w, scale))
     }
 
     #[inline(always)]
@@ -234,16 +239,15 @@ impl<'a> LcpRef<'a> {
         isa: kernel::Isa,
         z: &[f64],
         scaling: &scaling::Equilibration,
-    ) -> (Vec<f64>, Vec<f64>) {
-        let n = self.n;
+        w: &mut [f64],
+        scale: &mut [f64],
+    ) {
         // max_k |z_k / c_k|: the size of z in the equilibrated column units
         let zsize = z
             .iter()
             .zip(&scaling.col)
             .fold(0.0f64, |m, (v, c)| m.max((v / c).abs()));
-        let mut w = vec![0.0; n];
-        let mut scale = vec![0.0; n];
-        kernel::matvec_and_abs(isa, self.m, z, &mut w, &mut scale);
+        kernel::matvec_and_abs(isa, self.m, z, w, scale);
         for (((wi, si), qi), reach) in w
             .iter_mut()
             .zip(scale.iter_mut())
@@ -256,35 +260,48 @@ impl<'a> LcpRef<'a> {
             let floor = reach * zsize;
             *si = (*si + qi.abs()).max(floor);
         }
-        (w, scale)
     }
 
     /// w and the error measures of z, computed from the original data.
     pub fn evaluate(&self, z: &[f64], scaling: &scaling::Equilibration) -> (Vec<f64>, LcpMeasures) {
-        let (w, terms) = self.evaluate_parts(z, scaling);
-        let m = self.measures_with_terms(z, &w, &terms, scaling);
+        self.evaluate_with(z, scaling, &mut Vec::new())
+    }
+
+    /// [`LcpRef::evaluate`] with the rows' scales in `terms` (resized to n), so a solver's
+    /// repeated measures allocate only the w they return.
+    pub(crate) fn evaluate_with(
+        &self,
+        z: &[f64],
+        scaling: &scaling::Equilibration,
+        terms: &mut Vec<f64>,
+    ) -> (Vec<f64>, LcpMeasures) {
+        let mut w = vec![0.0; self.n];
+        terms.resize(self.n, 0.0);
+        self.evaluate_parts(z, scaling, &mut w, terms);
+        let m = self.measures_with_terms(|i| z[i], &w, |i| terms[i], scaling);
         (w, m)
     }
 
-    /// `evaluate` at z = 0 without a pass over M (w = q, and the terms of w_i are |q_i|).
-    pub fn evaluate_zero(&self, scaling: &scaling::Equilibration) -> (Vec<f64>, LcpMeasures) {
-        let z = vec![0.0; self.n];
-        let terms: Vec<f64> = self.q.iter().map(|v| v.abs()).collect();
-        let m = self.measures_with_terms(&z, self.q, &terms, scaling);
-        (self.q.to_vec(), m)
+    /// the measures of z = 0 without a pass over M (w = q, and the terms of w_i are |q_i|).
+    pub fn measures_at_zero(&self, scaling: &scaling::Equilibration) -> LcpMeasures {
+        self.measures_with_terms(|_| 0.0, self.q, |i| self.q[i].abs(), scaling)
     }
 
     /// the error measures of z (see [`LcpMeasures`]).
     pub fn measures(&self, z: &[f64], w: &[f64], scaling: &scaling::Equilibration) -> LcpMeasures {
-        let (_, terms) = self.evaluate_parts(z, scaling);
-        self.measures_with_terms(z, w, &terms, scaling)
+        let mut wz = vec![0.0; self.n];
+        let mut terms = vec![0.0; self.n];
+        self.evaluate_parts(z, scaling, &mut wz, &mut terms);
+        self.measures_with_terms(|i| z[i], w, |i| terms[i], scaling)
     }
 
+    /// the measures of the answer whose i-th entry is `z(i)`, with `w` and the rows' scales
+    /// `terms(i)`: accessors rather than slices so z = 0 needs no vector of zeros.
     fn measures_with_terms(
         &self,
-        z: &[f64],
+        z: impl Fn(usize) -> f64,
         w: &[f64],
-        terms: &[f64],
+        terms: impl Fn(usize) -> f64,
         scaling: &scaling::Equilibration,
     ) -> LcpMeasures {
         let n = self.n;
@@ -292,29 +309,27 @@ impl<'a> LcpRef<'a> {
         // z in the equilibrated column units, u_i = z_i / (c_i σ): c_i and σ are powers of
         // two, so one exact reciprocal per entry replaces two divisions in each loop below
         let inv_sigma = 1.0 / scaling.sigma;
-        let u: Vec<f64> = z
-            .iter()
-            .zip(&scaling.col)
-            .map(|(zi, c)| zi * (inv_sigma / c))
-            .collect();
+        let u = |i: usize| z(i) * (inv_sigma / scaling.col[i]);
         let mut sq = 0.0;
         let mut min_z = f64::INFINITY;
         let mut min_w = f64::INFINITY;
         let mut comp: f64 = 0.0;
         let mut zscale: f64 = 1.0;
-        for ((zi, wi), ui) in z.iter().zip(w).zip(&u) {
+        for (i, wi) in w.iter().enumerate().take(n) {
+            let zi = z(i);
             let m = zi.min(*wi);
             sq += m * m;
-            min_z = min_z.min(*zi);
+            min_z = min_z.min(zi);
             min_w = min_w.min(*wi);
             comp = comp.max((zi * wi).abs());
-            zscale = zscale.max(ui.abs());
+            zscale = zscale.max(u(i).abs());
         }
         let inv_zscale = 1.0 / zscale;
         let mut scaled: f64 = 0.0;
-        for ((wi, ti), ui) in w.iter().zip(terms).zip(&u) {
-            let wu = if *ti > 0.0 { wi / ti } else { 0.0 };
-            scaled = scaled.max((ui * inv_zscale).min(wu).abs());
+        for (i, wi) in w.iter().enumerate().take(n) {
+            let ti = terms(i);
+            let wu = if ti > 0.0 { wi / ti } else { 0.0 };
+            scaled = scaled.max((u(i) * inv_zscale).min(wu).abs());
         }
         if n == 0 {
             min_z = 0.0;
@@ -325,7 +340,7 @@ impl<'a> LcpRef<'a> {
         let mnorm = if sq.is_finite() && sq > 1e-280 {
             sq.sqrt()
         } else {
-            robust_sqrt_sum(z.iter().zip(w).map(|(a, b)| a.min(*b)))
+            robust_sqrt_sum(w.iter().enumerate().map(|(i, b)| z(i).min(*b)))
         };
         LcpMeasures {
             error: mnorm / qnorm.max(1.0),

@@ -13,7 +13,7 @@
 use super::kernel;
 
 /// Row and column factors and the right-hand side normaliser.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub struct Equilibration {
     /// R: scales row i (the units of w_i).
     pub row: Vec<f64>,
@@ -24,6 +24,10 @@ pub struct Equilibration {
     /// `max_j |M_ij c_j|` per row with the final C: what row i can produce from a z of unit
     /// size in the equilibrated column units (the floor of the scaled error's row scale).
     pub row_reach: Vec<f64>,
+    /// the sweeps' row and column maxima, kept so that [`Equilibration::compute_into`]
+    /// allocates nothing once sized.
+    rowmax: Vec<f64>,
+    colmax: Vec<f64>,
 }
 
 /// Ruiz sweeps: each halves the log-distance of row and column maxima from 1.
@@ -48,32 +52,50 @@ fn pow2(x: f64) -> f64 {
 impl Equilibration {
     /// computes R, C and sigma for the row-major n x n matrix `m` and vector `q`.
     pub fn compute(n: usize, m: &[f64], q: &[f64]) -> Self {
+        let mut e = Self::default();
+        e.compute_into(n, m, q);
+        e
+    }
+
+    /// [`Equilibration::compute`] into this one's vectors (a solver's workspace keeps one).
+    pub fn compute_into(&mut self, n: usize, m: &[f64], q: &[f64]) {
         let isa = kernel::detect();
-        kernel::dispatch!(isa, Equilibration, || Self::compute_body(isa, n, m, q))
+        kernel::dispatch!(isa, (), || self.compute_body(isa, n, m, q))
     }
 
     /// Ruiz's simultaneous form: both factors of a sweep come from the same scaled matrix,
     /// so a sweep is one pass over M.
     #[inline(always)]
-    fn compute_body(isa: kernel::Isa, n: usize, m: &[f64], q: &[f64]) -> Self {
-        let mut row = vec![1.0; n];
-        let mut col = vec![1.0; n];
-        let mut rowmax = vec![0.0f64; n];
-        let mut colmax = vec![0.0f64; n];
+    fn compute_body(&mut self, isa: kernel::Isa, n: usize, m: &[f64], q: &[f64]) {
+        let reset = |v: &mut Vec<f64>, x: f64| {
+            v.clear();
+            v.resize(n, x);
+        };
+        reset(&mut self.row, 1.0);
+        reset(&mut self.col, 1.0);
+        reset(&mut self.rowmax, 0.0);
+        reset(&mut self.colmax, 0.0);
+        let Self {
+            row,
+            col,
+            rowmax,
+            colmax,
+            ..
+        } = self;
         let mut settled = false;
         for _ in 0..RUIZ_SWEEPS {
-            kernel::ruiz_sweep(isa, m, &row, &col, &mut rowmax, &mut colmax);
+            kernel::ruiz_sweep(isa, m, row, col, rowmax, colmax);
             settled = true;
             // only rows and columns off by more than a factor 4 are rescaled: equilibration is
             // for badly scaled data, and fine-tuning well-scaled data only costs sweeps
-            for (r, rm) in row.iter_mut().zip(&rowmax) {
+            for (r, rm) in row.iter_mut().zip(rowmax.iter()) {
                 if *rm > 0.0 && !(0.25..=4.0).contains(rm) {
                     let f = pow2(1.0 / rm.sqrt());
                     settled &= f == 1.0;
                     *r *= f;
                 }
             }
-            for (c, cm) in col.iter_mut().zip(&colmax) {
+            for (c, cm) in col.iter_mut().zip(colmax.iter()) {
                 let cm = cm * *c;
                 if cm > 0.0 && !(0.25..=4.0).contains(&cm) {
                     let f = pow2(1.0 / cm.sqrt());
@@ -87,23 +109,21 @@ impl Equilibration {
         }
         let qmax = q
             .iter()
-            .zip(&row)
+            .zip(row.iter())
             .map(|(qi, ri)| (qi * ri).abs())
             .fold(0.0f64, f64::max);
-        let sigma = if qmax > 0.0 { pow2(qmax) } else { 1.0 };
+        self.sigma = if qmax > 0.0 { pow2(qmax) } else { 1.0 };
         // a settled sweep changed no factor, so its row maxima already use the final C
-        let row_reach: Vec<f64> = if settled {
-            rowmax.iter().zip(&row).map(|(rm, r)| rm / r).collect()
+        self.row_reach.clear();
+        if settled {
+            let reach = self.rowmax.iter().zip(&self.row).map(|(rm, r)| rm / r);
+            self.row_reach.extend(reach);
         } else {
-            m.chunks_exact(n.max(1))
-                .map(|mrow| kernel::max_abs_scaled(mrow, &col))
-                .collect()
-        };
-        Self {
-            row,
-            col,
-            sigma,
-            row_reach,
+            let col = &self.col;
+            let reach = m
+                .chunks_exact(n.max(1))
+                .map(|mrow| kernel::max_abs_scaled(mrow, col));
+            self.row_reach.extend(reach);
         }
     }
 }

@@ -27,18 +27,29 @@ pub(super) struct Candidate {
     pub(super) measures: LcpMeasures,
 }
 
-/// z with its w and measures on the original data.
-pub(super) fn candidate(lcp: &LcpRef<'_>, eq: &Equilibration, z: Vec<f64>) -> Candidate {
-    let (w, measures) = lcp.evaluate(&z, eq);
+/// z with its w and measures on the original data (`terms` is scratch, see
+/// [`LcpRef::evaluate_with`]).
+pub(super) fn candidate(
+    lcp: &LcpRef<'_>,
+    eq: &Equilibration,
+    z: Vec<f64>,
+    terms: &mut Vec<f64>,
+) -> Candidate {
+    let (w, measures) = lcp.evaluate_with(&z, eq, terms);
     Candidate { z, w, measures }
 }
 
 /// the principal solution of basis `a` on the original data, clamped to z >= 0.
-pub(super) fn principal(lcp: &LcpRef<'_>, eq: &Equilibration, a: &[usize]) -> Option<Candidate> {
+pub(super) fn principal(
+    lcp: &LcpRef<'_>,
+    eq: &Equilibration,
+    a: &[usize],
+    terms: &mut Vec<f64>,
+) -> Option<Candidate> {
     let za = solve_principal(lcp.n, lcp.m, lcp.q, a)?;
     let mut z = vec![0.0; lcp.n];
     for (&i, v) in a.iter().zip(za) {
         z[i] = v.max(0.0);
     }
-    Some(candidate(lcp, eq, z))
+    Some(candidate(lcp, eq, z, terms))
 }

@@ -164,12 +164,15 @@ pub(crate) fn validate(lcp: &LcpRef<'_>, s: &LemkeSettings) -> Result<()> {
         )));
     }
     let entries = crate::limits::dense_lemke_entries(lcp.n).unwrap_or(usize::MAX);
-    crate::limits::check_bytes(
-        &format!("Lemke's workspace for n = {}", lcp.n),
-        entries / 2,
-        8,
-        "",
-    )?;
+    // the name is only formatted for a refusal: a batch validates every small problem
+    if (entries / 2).saturating_mul(8) > crate::limits::memory_budget() {
+        crate::limits::check_bytes(
+            &format!("Lemke's workspace for n = {}", lcp.n),
+            entries / 2,
+            8,
+            "",
+        )?;
+    }
     Ok(())
 }
 
@@ -283,6 +286,7 @@ fn follow_path(
 
 /// The answer reported for a path: the path's own z, or (with `polish`) a polished one kept
 /// when it passes or is better (see the module notes); `true` when the polished one is kept.
+#[allow(clippy::too_many_arguments)]
 fn best_answer(
     ws: &mut LemkeWorkspace,
     lcp: &LcpRef<'_>,
@@ -291,6 +295,7 @@ fn best_answer(
     path: &Path,
     z: &[f64],
     basis: &[usize],
+    terms: &mut Vec<f64>,
 ) -> (Candidate, bool) {
     let (n, tol) = (lcp.n, settings.tol);
     let ending = path.ending;
@@ -305,14 +310,15 @@ fn best_answer(
             let mut zr = vec![0.0; n];
             let mut br = Vec::with_capacity(basis.len());
             pf.extract(eq, &mut zr, &mut br);
-            Some(candidate(lcp, eq, zr))
+            Some(candidate(lcp, eq, zr, terms))
         } else {
             let mut zr = z.to_vec();
-            ws.refine(lcp, eq, &mut zr).then(|| candidate(lcp, eq, zr))
+            ws.refine(lcp, eq, &mut zr)
+                .then(|| candidate(lcp, eq, zr, terms))
         };
         match refined {
             Some(c) if passes(&c.measures, tol) => Some(c),
-            _ => principal(lcp, eq, basis),
+            _ => principal(lcp, eq, basis, terms),
         }
     } else {
         None
@@ -320,7 +326,7 @@ fn best_answer(
     match polished_answer {
         Some(p) if passes(&p.measures, tol) => (p, true),
         Some(p) => {
-            let t = candidate(lcp, eq, z.to_vec());
+            let t = candidate(lcp, eq, z.to_vec(), terms);
             if better(&p.measures, &t.measures) {
                 (p, true)
             } else {
@@ -331,14 +337,25 @@ fn best_answer(
         // z0 = 0 to rounding may still pick another leaving row; its answer, and the
         // principal solution of its basic z's, are judged like any other
         None if ending != Ending::NonFinite && settings.polish => {
-            let t = candidate(lcp, eq, z.to_vec());
-            match principal(lcp, eq, basis) {
+            let t = candidate(lcp, eq, z.to_vec(), terms);
+            match principal(lcp, eq, basis, terms) {
                 Some(p) if better(&p.measures, &t.measures) => (p, true),
                 _ => (t, false),
             }
         }
-        None => (candidate(lcp, eq, z.to_vec()), false),
+        None => (candidate(lcp, eq, z.to_vec(), terms), false),
     }
+}
+
+/// The vectors a solve needs besides its path's, kept in the workspace so that repeated
+/// solves (a batch's worker, a simulation's steps) allocate little more than their answers.
+#[derive(Default)]
+pub(super) struct Scratch {
+    eq: Equilibration,
+    cover: Vec<f64>,
+    z: Vec<f64>,
+    basis: Vec<usize>,
+    terms: Vec<f64>,
 }
 
 /// Solves the LCP by Lemke's method, reusing `ws` (resized if needed).
@@ -351,19 +368,33 @@ pub fn solve_lemke_with(
     settings: &LemkeSettings,
 ) -> Result<LcpSolution> {
     validate(lcp, settings)?;
-    let n = lcp.n;
-    if ws.size() != n {
-        *ws = LemkeWorkspace::new(n);
+    if ws.size() != lcp.n {
+        *ws = LemkeWorkspace::new(lcp.n);
     }
-    let eq = Equilibration::compute(n, lcp.m, lcp.q);
+    let mut scratch = std::mem::take(&mut ws.scratch);
+    let out = solve_on(ws, &mut scratch, lcp, settings);
+    ws.scratch = scratch;
+    Ok(out)
+}
+
+/// [`solve_lemke_with`] on validated input, with the scratch vectors taken out of `ws`.
+fn solve_on(
+    ws: &mut LemkeWorkspace,
+    sc: &mut Scratch,
+    lcp: &LcpRef<'_>,
+    settings: &LemkeSettings,
+) -> LcpSolution {
+    let n = lcp.n;
+    sc.eq.compute_into(n, lcp.m, lcp.q);
+    let eq = &sc.eq;
     let tol = settings.tol;
-    let (w0, m0) = lcp.evaluate_zero(&eq);
+    // z and w are filled where the answer is decided: every return below sets them
     let mut out = LcpSolution {
-        z: vec![0.0; n],
-        w: w0,
+        z: Vec::new(),
+        w: Vec::new(),
         status: LcpStatus::Solved,
         message: String::new(),
-        measures: m0,
+        measures: lcp.measures_at_zero(eq),
         pivots: 0,
         iterations: 0,
         basis: Vec::new(),
@@ -377,7 +408,7 @@ pub fn solve_lemke_with(
     if let Some(guess) = &settings.warm_start {
         let mut a = guess.clone();
         a.sort_unstable();
-        if let Some(c) = principal(lcp, &eq, &a) {
+        if let Some(c) = principal(lcp, eq, &a, &mut sc.terms) {
             if passes(&c.measures, tol) {
                 out.warm_start = WarmStart::Accepted;
                 out.pivots_saved = a.len() + 1;
@@ -386,15 +417,17 @@ pub fn solve_lemke_with(
                 out.w = c.w;
                 out.measures = c.measures;
                 out.message = "solved by the warm-start basis without pivoting".into();
-                return Ok(out);
+                return out;
             }
         }
         out.warm_start = WarmStart::Rejected;
     }
 
     if passes(&out.measures, tol) {
+        out.z = vec![0.0; n];
+        out.w = lcp.q.to_vec();
         out.message = "z = 0 solves the problem (q >= 0)".into();
-        return Ok(out);
+        return out;
     }
 
     let max_pivots = settings.max_pivots.unwrap_or_else(|| (50 * n).max(1000));
@@ -404,9 +437,9 @@ pub fn solve_lemke_with(
     } else {
         1 + settings.restarts
     };
-    let mut cover = vec![0.0; n];
-    let mut z = vec![0.0; n];
-    let mut basis = Vec::with_capacity(n);
+    sc.cover.resize(n, 0.0);
+    sc.z.resize(n, 0.0);
+    let (cover, z, basis) = (&mut sc.cover, &mut sc.z, &mut sc.basis);
     let mut abandoned = 0;
     // the best answer of a path that ended on a basis failing tol or cycled: reported over
     // a later path's ray or limit, which would otherwise claim more than rounding allows
@@ -415,22 +448,20 @@ pub fn solve_lemke_with(
         if attempt > 0 && crate::interrupt::poll(n * n) {
             break;
         }
-        covering(attempt, &eq, user, &mut cover);
-        let path = follow_path(
-            ws, lcp, &eq, &cover, settings, max_pivots, &mut z, &mut basis,
-        );
+        covering(attempt, eq, user, cover);
+        let path = follow_path(ws, lcp, eq, cover, settings, max_pivots, z, basis);
         let (ending, pivots) = (path.ending, path.pivots);
         abandoned += path.abandoned;
         out.pivots += pivots;
         out.restarts = attempt;
-        let (best, polished) = best_answer(ws, lcp, &eq, settings, &path, &z, &basis);
+        let (best, polished) = best_answer(ws, lcp, eq, settings, &path, z, basis, &mut sc.terms);
         out.z = best.z;
         out.w = best.w;
         out.measures = best.measures;
         out.basis = basis.clone();
         out.polished = polished;
         if verdict(&mut out, ending, polished, tol, max_pivots, attempt) {
-            return Ok(with_fallback_note(out, abandoned));
+            return with_fallback_note(out, abandoned);
         }
         let keep = matches!(ending, Ending::Terminal | Ending::Cycle)
             && failed_terminal
@@ -444,7 +475,7 @@ pub fn solve_lemke_with(
         (f.pivots, f.restarts) = (out.pivots, out.restarts);
         out = f;
     }
-    Ok(with_fallback_note(out, abandoned))
+    with_fallback_note(out, abandoned)
 }
 
 #[cfg(test)]

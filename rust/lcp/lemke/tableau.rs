@@ -62,6 +62,7 @@ pub struct LemkeWorkspace {
     ties_next: Vec<usize>,
     isa: Isa,
     pub(super) product_form: RevisedLemke,
+    pub(super) scratch: super::Scratch,
 }
 
 impl LemkeWorkspace {
@@ -99,6 +100,7 @@ impl LemkeWorkspace {
             ties_next: Vec::with_capacity(n),
             isa: kernel::detect(),
             product_form: RevisedLemke::new(if product_form { n } else { 0 }),
+            scratch: super::Scratch::default(),
         }
     }
 
