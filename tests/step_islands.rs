@@ -3,8 +3,10 @@
 //! every step the islands' answer is judged on the whole problem.
 
 use coulomb::contact::ContactStatus;
+use coulomb::geometry::Shape3;
 use coulomb::step::{
-    simulate, with_threads, Body, BodyKind, HalfSpace, Pair, Scene, Shape, StepSettings, Trajectory,
+    simulate, with_threads, Body, BodyKind, HalfSpace, Pair, Scene, Shape, Solid, SolidShape,
+    StepSettings, Trajectory,
 };
 
 const RADIUS: f64 = 0.05;
@@ -122,22 +124,186 @@ fn the_answer_is_the_same_whatever_the_number_of_threads() {
         ("a pool of 2", run_in_pool(2, &scene, &settings)),
     ];
     for (threads, other) in runs {
-        assert_eq!(one.q.len(), other.q.len());
-        let same_bits =
-            |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits());
-        assert!(same_bits(&one.q, &other.q), "{threads} threads: q differs");
-        assert!(same_bits(&one.v, &other.v), "{threads} threads: v differs");
-        for (k, (a, b)) in one.steps.iter().zip(&other.steps).enumerate() {
-            assert_eq!(a.status, b.status, "step {k}");
-            assert_eq!(a.iterations, b.iterations, "step {k}");
-            assert_eq!(
-                a.scaled_error.to_bits(),
-                b.scaled_error.to_bits(),
-                "step {k}"
-            );
-            assert_eq!(a.error_q.to_bits(), b.error_q.to_bits(), "step {k}");
-            assert_eq!(a.fallback, b.fallback, "step {k}");
+        assert_same(&one, &other, threads);
+    }
+}
+
+/// two runs bitwise alike: positions, velocities and every step's verdict.
+fn assert_same(one: &Trajectory, other: &Trajectory, threads: &str) {
+    assert_eq!(one.q.len(), other.q.len());
+    let same_bits = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits());
+    assert!(same_bits(&one.q, &other.q), "{threads}: q differs");
+    assert!(same_bits(&one.v, &other.v), "{threads}: v differs");
+    for (k, (a, b)) in one.steps.iter().zip(&other.steps).enumerate() {
+        assert_eq!(a.status, b.status, "{threads}: step {k}");
+        assert_eq!(a.iterations, b.iterations, "{threads}: step {k}");
+        assert_eq!(
+            a.scaled_error.to_bits(),
+            b.scaled_error.to_bits(),
+            "{threads}: step {k}"
+        );
+        assert_eq!(
+            a.error_q.to_bits(),
+            b.error_q.to_bits(),
+            "{threads}: step {k}"
+        );
+        assert_eq!(a.fallback, b.fallback, "{threads}: step {k}");
+    }
+}
+
+/// 3D: `count` pairs of cubes (10 cm, the upper turned 10 degrees about the vertical and
+/// set 0.1 mm above the lower), each pair 0.5 m from the next on one floor: the lower cube's
+/// face on the floor and the upper's on the lower are clipped polygons, each pair an island.
+fn cube_pairs(count: usize) -> Scene {
+    let half = 0.05;
+    let mut scene = Scene {
+        dim: 3,
+        gravity: vec![0.0, 0.0, -9.81],
+        bodies: vec![],
+        shapes: vec![],
+        half_spaces: vec![HalfSpace {
+            point: vec![0.0; 3],
+            normal: vec![0.0, 0.0, 1.0],
+        }],
+        pairs: vec![Pair::Solids { mu: 0.5, e: 0.0 }],
+        solids: Vec::new(),
+    };
+    let inertia = 0.1 * (2.0 * half) * (2.0 * half) / 6.0;
+    for k in 0..2 * count {
+        let (column, level) = (k / 2, k % 2);
+        let turn = 10f64.to_radians() * level as f64;
+        let z = half + level as f64 * (2.0 * half + 1e-4);
+        let body = scene.bodies.len();
+        scene.bodies.push(Body {
+            kind: BodyKind::Spatial,
+            mass: 0.1,
+            inertia: vec![inertia, 0.0, 0.0, 0.0, inertia, 0.0, 0.0, 0.0, inertia],
+            q0: vec![
+                0.5 * column as f64,
+                0.01 * level as f64,
+                z,
+                (turn / 2.0).cos(),
+                0.0,
+                0.0,
+                (turn / 2.0).sin(),
+            ],
+            v0: vec![0.0; 6],
+            force: vec![0.0; 3],
+        });
+        let mut points = Vec::new();
+        for c in 0..8 {
+            let sign = |b: usize| if c >> b & 1 == 1 { half } else { -half };
+            points.push(vec![sign(0), sign(1), sign(2)]);
         }
+        scene.shapes.push(Shape {
+            body,
+            points,
+            radius: 0.0,
+        });
+        scene.solids.push(Solid {
+            body: Some(body),
+            pose: vec![0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0],
+            shape: SolidShape::Spatial(Shape3::cuboid([half; 3]).expect("a cube")),
+        });
+        scene.pairs.push(Pair::ShapeHalfSpace {
+            shape: body,
+            half_space: 0,
+            mu: 0.5,
+            e: 0.0,
+        });
+    }
+    scene
+}
+
+/// 2D: `columns` columns of two disks (the upper 2 mm off centre, so it rolls off) and
+/// `plates` rectangles tipped by 2 degrees landing on a corner, 0.3 m apart on one floor.
+fn planar_scene(columns: usize, plates: usize) -> Scene {
+    let r = 0.05;
+    let mut scene = Scene {
+        dim: 2,
+        gravity: vec![0.0, -9.81],
+        bodies: vec![],
+        shapes: vec![],
+        half_spaces: vec![HalfSpace {
+            point: vec![0.0; 2],
+            normal: vec![0.0, 1.0],
+        }],
+        pairs: vec![Pair::Spheres { mu: 0.4, e: 0.0 }],
+        solids: Vec::new(),
+    };
+    let mut add = |scene: &mut Scene, q0: Vec<f64>, points: Vec<Vec<f64>>, radius: f64| {
+        let body = scene.bodies.len();
+        scene.bodies.push(Body {
+            kind: BodyKind::Planar,
+            mass: 0.1,
+            inertia: vec![0.5 * 0.1 * r * r],
+            q0,
+            v0: vec![0.0; 3],
+            force: vec![0.0; 2],
+        });
+        scene.shapes.push(Shape {
+            body,
+            points,
+            radius,
+        });
+        scene.pairs.push(Pair::ShapeHalfSpace {
+            shape: body,
+            half_space: 0,
+            mu: 0.4,
+            e: 0.0,
+        });
+    };
+    for c in 0..columns {
+        let x = 0.3 * c as f64;
+        add(&mut scene, vec![x, r, 0.0], vec![vec![0.0; 2]], r);
+        add(
+            &mut scene,
+            vec![x + 0.002, 3.0 * r, 0.0],
+            vec![vec![0.0; 2]],
+            r,
+        );
+    }
+    let corners = vec![
+        vec![-0.06, -0.02],
+        vec![0.06, -0.02],
+        vec![0.06, 0.02],
+        vec![-0.06, 0.02],
+    ];
+    for p in 0..plates {
+        let x = 0.3 * (columns + p) as f64;
+        let tip = 2f64.to_radians();
+        // the lower corner 0.5 mm above the floor
+        let y = 0.0005 + 0.06 * tip.sin() + 0.02 * tip.cos();
+        add(&mut scene, vec![x, y, tip], corners.clone(), 0.0);
+    }
+    scene
+}
+
+#[test]
+fn boxes_and_planar_bodies_give_the_same_answer_on_any_number_of_threads() {
+    let settings = StepSettings::new(1e-3, 12);
+    for (what, scene) in [
+        ("cube pairs", cube_pairs(60)),
+        ("disks and plates", planar_scene(200, 60)),
+    ] {
+        let one = run_with(1, &scene, &settings);
+        let most = one.steps.iter().map(|r| r.active).max().unwrap_or(0);
+        assert!(
+            most >= 400,
+            "{what}: at most {most} active contacts in a step"
+        );
+        assert!(
+            one.steps
+                .iter()
+                .all(|r| r.status.is_none_or(|s| s == ContactStatus::Solved)),
+            "{what}: a step unsolved"
+        );
+        for threads in [2, 3] {
+            let other = run_with(threads, &scene, &settings);
+            assert_same(&one, &other, &format!("{what}, {threads} threads"));
+        }
+        let pooled = run_in_pool(2, &scene, &settings);
+        assert_same(&one, &pooled, &format!("{what}, a pool of 2"));
     }
 }
 
