@@ -231,7 +231,7 @@ fn planar_scene(columns: usize, plates: usize) -> Scene {
         pairs: vec![Pair::Spheres { mu: 0.4, e: 0.0 }],
         solids: Vec::new(),
     };
-    let mut add = |scene: &mut Scene, q0: Vec<f64>, points: Vec<Vec<f64>>, radius: f64| {
+    let add = |scene: &mut Scene, q0: Vec<f64>, points: Vec<Vec<f64>>, radius: f64| {
         let body = scene.bodies.len();
         scene.bodies.push(Body {
             kind: BodyKind::Planar,
