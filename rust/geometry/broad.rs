@@ -184,6 +184,71 @@ impl AabbBroadPhase {
     }
 }
 
+/// [`AabbBroadPhase`] run on boxes grown by a margin, its pairs kept while every box stays
+/// inside its grown box.
+///
+/// With `G_i` box i grown by a quarter of its largest side at the last rebuild, and `K` the
+/// pairs whose grown boxes meet, a later set of boxes `B_i ⊂ G_i` (every i) has each of its
+/// meeting pairs in `K` (`B_i` and `B_j` meet, so `G_i` and `G_j` do), so filtering `K` by the
+/// exact test gives exactly the brute-force pairs of the `B_i`. A box that leaves its grown
+/// box (or a change in the number of boxes) rebuilds `K`. Boxes at rest, or moving less than a
+/// quarter of their size, cost one containment test each and a pass over `K` a call instead
+/// of a grid; the grown boxes scale with the data, so the rebuilds do not depend on its unit.
+#[derive(Clone, Debug, Default)]
+pub struct KeptAabbBroadPhase {
+    grid: AabbBroadPhase,
+    grown: Vec<Aabb>,
+    kept: Vec<(u32, u32)>,
+    rebuilds: usize,
+}
+
+/// Whether `b` lies inside `g` (false with a NaN).
+#[inline]
+fn contains(g: &Aabb, b: &Aabb) -> bool {
+    (0..3).all(|k| g.0[k] <= b.0[k] && b.1[k] <= g.1[k])
+}
+
+impl KeptAabbBroadPhase {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// how many times the kept pairs were rebuilt.
+    pub fn rebuilds(&self) -> usize {
+        self.rebuilds
+    }
+
+    /// Writes into `out` (cleared first) every pair `(i, j)`, `i < j`, of `boxes` that meet
+    /// ([`boxes_meet`]), in increasing order.
+    pub fn pairs(&mut self, boxes: &[Aabb], out: &mut Vec<(u32, u32)>) {
+        out.clear();
+        let inside = self.grown.len() == boxes.len()
+            && boxes.iter().zip(&self.grown).all(|(b, g)| contains(g, b));
+        if !inside {
+            self.rebuild(boxes);
+        }
+        out.extend(
+            self.kept
+                .iter()
+                .copied()
+                .filter(|&(i, j)| boxes_meet(&boxes[i as usize], &boxes[j as usize])),
+        );
+    }
+
+    fn rebuild(&mut self, boxes: &[Aabb]) {
+        self.grown.clear();
+        for b in boxes {
+            let side = (0..3).map(|k| b.1[k] - b.0[k]).fold(0.0f64, f64::max);
+            // an infinite box (a half-space's) is kept as it is
+            let m = if side.is_finite() { 0.25 * side } else { 0.0 };
+            self.grown.push((b.0.map(|x| x - m), b.1.map(|x| x + m)));
+        }
+        self.grid.pairs(&self.grown, &mut self.kept);
+        self.kept.sort_unstable();
+        self.rebuilds += 1;
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -216,5 +281,58 @@ mod tests {
         out.sort_unstable();
         assert_eq!(out, brute(&boxes));
         assert!(out.contains(&(0, 1)) && out.contains(&(3, 4)) && !out.contains(&(0, 5)));
+    }
+
+    #[test]
+    fn kept_pairs_are_the_brute_force_pairs_at_every_call() {
+        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+        let mut rand = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for scene in 0..40 {
+            let unit = 10f64.powi(scene % 17 - 8);
+            let n = 2 + (rand() * 60.0) as usize;
+            let mut centres: Vec<[f64; 3]> = (0..n)
+                .map(|_| [rand() * 3.0, rand() * 3.0, rand() * 3.0].map(|x| x * unit))
+                .collect();
+            let halves: Vec<f64> = (0..n).map(|_| (0.05 + 0.3 * rand()) * unit).collect();
+            // some scenes move slowly (the kept pairs serve), some fast (rebuilds)
+            let speed = if scene % 3 == 0 { 0.3 } else { 0.01 } * unit;
+            let mut kept = KeptAabbBroadPhase::new();
+            let mut out = Vec::new();
+            let calls = 60;
+            for call in 0..calls {
+                let mut boxes: Vec<Aabb> = centres
+                    .iter()
+                    .zip(&halves)
+                    .map(|(c, h)| (c.map(|x| x - h), c.map(|x| x + h)))
+                    .collect();
+                if scene % 5 == 1 {
+                    // a floor and a NaN box among them
+                    boxes.push((
+                        [-1e3 * unit, -1e3 * unit, -unit],
+                        [1e3 * unit, 1e3 * unit, 0.0],
+                    ));
+                    boxes.push(([f64::NAN; 3], [1.0; 3]));
+                }
+                kept.pairs(&boxes, &mut out);
+                assert_eq!(out, brute(&boxes), "scene {scene} call {call}");
+                for c in centres.iter_mut() {
+                    for x in c.iter_mut() {
+                        *x += speed * (rand() - 0.5);
+                    }
+                }
+            }
+            if speed < 0.1 * unit && scene % 5 != 1 {
+                assert!(
+                    kept.rebuilds() < calls / 3,
+                    "scene {scene}: {} rebuilds",
+                    kept.rebuilds()
+                );
+            }
+        }
     }
 }

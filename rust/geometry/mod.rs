@@ -52,7 +52,7 @@ pub mod shape2;
 pub mod shape3;
 mod validate;
 
-pub use broad::AabbBroadPhase;
+pub use broad::{AabbBroadPhase, KeptAabbBroadPhase};
 pub use contact::{
     contacts2, contacts3, ContactCache2, ContactCache3, ContactId, ContactPoint2, ContactPoint3,
     Reference,

@@ -32,7 +32,7 @@ use super::persistence::CandState;
 use super::{BodyKind, Pair, Scene, Stepper};
 use crate::geometry::broad::{lift2, Aabb};
 use crate::geometry::{
-    contacts2, contacts3, AabbBroadPhase, ContactCache2, ContactCache3, ContactId, ContactPoint2,
+    contacts2, contacts3, KeptAabbBroadPhase, ContactCache2, ContactCache3, ContactId, ContactPoint2,
     ContactPoint3, Reference, Shape2, Shape3,
 };
 use crate::step::solid::Pose;
@@ -98,7 +98,7 @@ pub(super) struct SolidPairs {
     /// the broad phase's pairs by key `a << 32 | b`, sorted, with their caches.
     auto_pairs: Vec<(u64, SolidPair, Cache)>,
     old_pairs: Vec<(u64, SolidPair, Cache)>,
-    grid: AabbBroadPhase,
+    grid: KeptAabbBroadPhase,
     boxes: Vec<Aabb>,
     found: Vec<(u32, u32)>,
     /// each solid's world pose and speed bound at the prepared state.
@@ -316,7 +316,7 @@ impl Stepper {
     }
 
     /// The pairs of [`Pair::Solids`]: every two solids whose boxes, each grown by
-    /// `gap_tolerance / 2 + 2 h R`, meet ([`AabbBroadPhase`]), but for two static solids, two
+    /// `gap_tolerance / 2 + 2 h R`, meet ([`KeptAabbBroadPhase`]), but for two static solids, two
     /// on one body and the declared pairs; each keeps its cache from the previous state.
     fn solid_broad_phase(&self, sp: &mut SolidPairs, half_tol: f64, h: f64) {
         let Some((mu, e)) = sp.auto else { return };
