@@ -370,7 +370,7 @@ pub(crate) fn solve_nsgs_measured(
         None => measure_into(problem, &r, &mut u),
     };
     let mut schedule = CheckSchedule::new(s.tol, measures.scaled_error);
-    let mut extrapolation = extrapolate::Extrapolation::new(n);
+    let mut extrapolation = extrapolate::Extrapolation::new();
     let mut stick = stick::StickSolve::default();
     // the last measured sweep and error, for the sticking-set solve's slowness test
     let mut last = (0usize, measures.scaled_error);

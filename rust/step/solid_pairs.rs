@@ -32,8 +32,8 @@ use super::persistence::CandState;
 use super::{BodyKind, Pair, Scene, Stepper};
 use crate::geometry::broad::{lift2, Aabb};
 use crate::geometry::{
-    contacts2, contacts3, KeptAabbBroadPhase, ContactCache2, ContactCache3, ContactId, ContactPoint2,
-    ContactPoint3, Reference, Shape2, Shape3,
+    contacts2, contacts3, ContactCache2, ContactCache3, ContactId, ContactPoint2, ContactPoint3,
+    KeptAabbBroadPhase, Reference, Shape2, Shape3,
 };
 use crate::step::solid::Pose;
 use crate::step::{Solid, SolidShape};

@@ -49,7 +49,8 @@ const DRIFT_MIN: f64 = 64.0;
 /// drift moves per solve at most.
 const MAX_DRIFTS: usize = 8;
 
-/// The last measured iterate and the buffers of a trial (allocated once per solve).
+/// The last measured iterate and the buffers of a trial (allocated once per solve, when first
+/// needed).
 pub(super) struct Extrapolation {
     last: Vec<f64>,
     last_sweep: usize,
@@ -63,15 +64,27 @@ pub(super) struct Extrapolation {
 }
 
 impl Extrapolation {
-    pub(super) fn new(n: usize) -> Self {
+    /// an empty record; its buffers are made at the first failed measure (a solve that
+    /// passes at its first measures, as most small ones do, makes none).
+    pub(super) fn new() -> Self {
         Self {
-            last: vec![0.0; n],
+            last: Vec::new(),
             last_sweep: 0,
             last_error: f64::NAN,
-            step: vec![f64::NAN; n],
+            step: Vec::new(),
             drifts: 0,
-            trial: vec![0.0; n],
-            u_trial: vec![0.0; n],
+            trial: Vec::new(),
+            u_trial: Vec::new(),
+        }
+    }
+
+    /// the buffers, sized to `n` with the values a fresh record starts from.
+    fn sized(&mut self, n: usize) {
+        if self.last.len() != n {
+            self.last = vec![0.0; n];
+            self.step = vec![f64::NAN; n];
+            self.trial = vec![0.0; n];
+            self.u_trial = vec![0.0; n];
         }
     }
 
@@ -86,6 +99,7 @@ impl Extrapolation {
         measures: &mut ContactMeasures,
         sweeps: usize,
     ) -> bool {
+        self.sized(r.len());
         let error = measures.scaled_error;
         let mut taken = false;
         let ratio = error / self.last_error;
