@@ -205,19 +205,34 @@ impl WAssembly {
         let (Some(csr), Some((_, slots))) = (self.csr.as_mut(), self.scratch.last_slots()) else {
             return false;
         };
+        let (firsts, empty) = self.scratch.last_firsts();
         let values = csr.values_mut();
-        values.fill(0.0);
-        let mut slots = slots.iter();
+        // a place's first tile is written as 0 + t, the bits zeroing it first and adding
+        // gave; only the places no tile reaches are zeroed
+        for &at in empty {
+            if let Some(place) = values.get_mut(at..at + D * D) {
+                place.fill(0.0);
+            }
+        }
+        if firsts.len() != slots.len() {
+            return false;
+        }
+        let mut slots = slots.iter().zip(firsts);
         // v * 0 is 0 exactly when v is finite
         let mut finite = 0.0;
         for list in &self.incidence[..self.blocks] {
             for (p, &(i, ki)) in list.iter().enumerate() {
                 for &(j, kj) in &list[p..] {
                     let blk = product((i, ki), (j, kj));
-                    let Some(tile) = slots.next().and_then(|&at| values.get_mut(at..at + D * D))
+                    let Some((tile, &first)) = slots
+                        .next()
+                        .and_then(|(&at, first)| Some((values.get_mut(at..at + D * D)?, first)))
                     else {
                         return false;
                     };
+                    if first {
+                        tile.fill(0.0);
+                    }
                     for al in 0..D {
                         for be in 0..D {
                             tile[al * D + be] += blk[al][be];
@@ -225,11 +240,14 @@ impl WAssembly {
                         }
                     }
                     if i != j {
-                        let Some(tile) =
-                            slots.next().and_then(|&at| values.get_mut(at..at + D * D))
-                        else {
+                        let Some((tile, &first)) = slots.next().and_then(|(&at, first)| {
+                            Some((values.get_mut(at..at + D * D)?, first))
+                        }) else {
                             return false;
                         };
+                        if first {
+                            tile.fill(0.0);
+                        }
                         for be in 0..D {
                             for al in 0..D {
                                 tile[be * D + al] += blk[al][be];

@@ -20,6 +20,11 @@ pub(crate) struct TileScratch {
     last: Option<(usize, usize)>,
     places: Vec<(usize, usize)>,
     slots: Vec<usize>,
+    /// whether each tile is the first (in the given order) at its place, and the places no
+    /// tile reaches (diagonal tiles stored as zero), by the offset of their values
+    firsts: Vec<bool>,
+    empty: Vec<usize>,
+    hit: Vec<bool>,
 }
 
 impl TileScratch {
@@ -27,6 +32,14 @@ impl TileScratch {
     /// value in the W's values (in the order the tiles were given).
     pub(crate) fn last_slots(&self) -> Option<((usize, usize), &[usize])> {
         self.last.map(|shape| (shape, self.slots.as_slice()))
+    }
+
+    /// for each tile of the last rebuild whether it was the first at its place, and the
+    /// places no tile reached: a caller summing tiles into the kept places writes `0 + t`
+    /// for a first tile (the bits a zeroed place plus t gives) and zeroes only the empty
+    /// places, instead of zeroing every value first.
+    pub(crate) fn last_firsts(&self) -> (&[bool], &[usize]) {
+        (&self.firsts, &self.empty)
     }
 
     /// whether `tiles` fall at the places of the last rebuild, of the same shape.
@@ -96,6 +109,9 @@ impl BlockCsr {
             mark,
             places,
             slots,
+            firsts,
+            empty,
+            hit,
             ..
         } = scratch;
         // 1. the tiles by block row, in their given order (a counting sort)
@@ -144,6 +160,10 @@ impl BlockCsr {
         self.values.resize(self.cols.len() * bs, 0.0);
         slots.clear();
         slots.resize(tiles.len(), 0);
+        firsts.clear();
+        firsts.resize(tiles.len(), false);
+        hit.clear();
+        hit.resize(self.cols.len(), false);
         for i in 0..nc {
             for t in self.row_ptr[i]..self.row_ptr[i + 1] {
                 mark[self.cols[t]] = t;
@@ -151,13 +171,19 @@ impl BlockCsr {
                     self.diag.push(t);
                 }
             }
+            // a row's tiles come in increasing k: the first at a place here is the first at
+            // it in the given order
             for &k in &order[start[i]..start[i + 1]] {
                 let (_, j, tile) = &tiles[k];
-                let at = mark[*j] * bs;
-                slots[k] = at;
-                add_tile(&mut self.values[at..at + bs], tile, dim);
+                let t = mark[*j];
+                slots[k] = t * bs;
+                firsts[k] = !hit[t];
+                hit[t] = true;
+                add_tile(&mut self.values[t * bs..(t + 1) * bs], tile, dim);
             }
         }
+        empty.clear();
+        empty.extend((0..hit.len()).filter(|&t| !hit[t]).map(|t| t * bs));
         places.clear();
         places.extend(tiles.iter().map(|t| (t.0, t.1)));
         scratch.last = Some((dim, nc));
