@@ -1,41 +1,49 @@
 //! Euclidean norms of the measures, accumulated without overflow or underflow, so that data
 //! of size 1e-200 or 1e300 measures neither 0 nor infinity.
 
-/// A Euclidean norm accumulated without overflow or underflow: `||x|| = scale sqrt(ssq)` with
-/// `scale` the largest magnitude seen (the scaled sum of squares of LAPACK's `dnrm2`). NaN
-/// and infinity propagate.
+/// entries below this are squared after scaling up by [`SMALL_UP`] (their squares could
+/// underflow); 2^-511.
+const SMALL: f64 = 1.4916681462400413e-154;
+/// entries above this are squared after scaling down by [`BIG_DOWN`] (their squares, or a sum
+/// of 2^50 of them, could overflow); 2^486.
+const BIG: f64 = 1.9979190722022350e146;
+/// 2^537: a small entry's scale, exact.
+const SMALL_UP: f64 = 4.4989137945431964e161;
+/// 2^-538: a big entry's scale, exact.
+const BIG_DOWN: f64 = 1.1113793747425387e-162;
+
+/// A Euclidean norm accumulated without overflow or underflow by Blue's three sums (Blue
+/// 1978; the scheme of LAPACK 3.10's `dnrm2`, Anderson 2017): entries between 2^-511 and
+/// 2^486 are squared as they are, the others after an exact scaling by a power of two, so an
+/// entry costs a comparison or two and a multiply-add, no division. In the middle range the
+/// norm is `sqrt(Σ x^2)` rounded as the plain sum is. NaN and infinity propagate.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct Norm2 {
-    scale: f64,
-    ssq: f64,
-    nan: bool,
-    inf: bool,
+    small: f64,
+    medium: f64,
+    big: f64,
 }
 
 impl Norm2 {
     /// adds `x^2`.
     #[inline]
     pub(crate) fn add(&mut self, x: f64) {
-        // the finite nonzero entries take two comparisons: infinity is above any finite scale,
-        // NaN fails both comparisons
         let a = x.abs();
-        if a > self.scale {
-            if a == f64::INFINITY {
-                self.inf = true;
-            } else {
-                let t = self.scale / a;
-                self.ssq = 1.0 + self.ssq * t * t;
-                self.scale = a;
-            }
-        } else if a > 0.0 {
-            let t = a / self.scale;
-            self.ssq += t * t;
-        } else if a.is_nan() {
-            self.nan = true;
+        if a > BIG {
+            // infinity lands here and stays infinite
+            let s = a * BIG_DOWN;
+            self.big += s * s;
+        } else if a < SMALL {
+            let s = a * SMALL_UP;
+            self.small += s * s;
+        } else {
+            // NaN fails both comparisons: the medium sum carries it
+            self.medium += a * a;
         }
     }
 
     /// adds every entry of `x`.
+    #[inline]
     pub(crate) fn add_all(&mut self, x: &[f64]) {
         for &v in x {
             self.add(v);
@@ -44,19 +52,93 @@ impl Norm2 {
 
     /// the norm.
     pub(crate) fn value(&self) -> f64 {
-        if self.nan {
-            f64::NAN
-        } else if self.inf {
-            f64::INFINITY
-        } else {
-            self.scale * self.ssq.sqrt()
+        if self.medium.is_nan() {
+            return f64::NAN;
         }
+        if self.big > 0.0 {
+            // the medium entries' squares, scaled down as the big ones were (their share is
+            // below the rounding of the big sum unless the medium sum is huge)
+            let big = self.big + (self.medium * BIG_DOWN) * BIG_DOWN;
+            return big.sqrt() / BIG_DOWN;
+        }
+        if self.small > 0.0 {
+            let ys = self.small.sqrt() / SMALL_UP;
+            if self.medium > 0.0 {
+                let ym = self.medium.sqrt();
+                let (lo, hi) = if ys > ym { (ym, ys) } else { (ys, ym) };
+                let t = lo / hi;
+                return hi * (1.0 + t * t).sqrt();
+            }
+            return ys;
+        }
+        self.medium.sqrt()
     }
 }
 
 /// `||x||_2` without overflow or underflow.
+#[inline]
 pub(crate) fn norm2(x: &[f64]) -> f64 {
     let mut n = Norm2::default();
     n.add_all(x);
     n.value()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testing::SplitMix64;
+
+    #[test]
+    fn the_scales_are_the_powers_of_two_they_name() {
+        assert_eq!(SMALL, 2f64.powi(-511));
+        assert_eq!(BIG, 2f64.powi(486));
+        assert_eq!(SMALL_UP, 2f64.powi(537));
+        assert_eq!(BIG_DOWN, 2f64.powi(-538));
+    }
+
+    /// against the norm in extended range (each entry split into a mantissa and a power of
+    /// two, the sum of squares taken at the largest one's scale), over vectors whose entries
+    /// span from 5e-324 to 1e308, one scale at a time and mixed.
+    #[test]
+    fn norms_match_the_scaled_sum_at_every_scale() {
+        let mut rng = SplitMix64::new(11);
+        for case in 0..20_000 {
+            let n = 1 + case % 7;
+            let centre = -320.0 + 626.0 * rng.uniform();
+            let spread = if case % 3 == 0 { 300.0 } else { 2.0 };
+            let x: Vec<f64> = (0..n)
+                .map(|_| {
+                    let e = (centre + spread * (2.0 * rng.uniform() - 1.0)).clamp(-323.0, 306.0);
+                    let s = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
+                    s * (1.0 + 9.0 * rng.uniform()) * 10f64.powf(e)
+                })
+                .collect();
+            let want = reference(&x);
+            let got = norm2(&x);
+            assert!(
+                (got - want).abs() <= 4.0 * (n as f64) * f64::EPSILON * want,
+                "{x:?}: {got} vs {want}"
+            );
+        }
+        assert_eq!(norm2(&[0.0, -0.0]), 0.0);
+        assert!(norm2(&[1.0, f64::NAN, 1e300]).is_nan());
+        assert!(norm2(&[f64::NAN, f64::INFINITY]).is_nan());
+        assert_eq!(norm2(&[1.0, f64::NEG_INFINITY]), f64::INFINITY);
+        let near = |a: f64, b: f64| (a - b).abs() <= 4.0 * f64::EPSILON * b;
+        assert!(near(norm2(&[1e308, 1e308]), 1e308 * 2f64.sqrt()));
+        assert!(near(norm2(&[3e-200, 4e-200]), 5e-200));
+        assert!(near(norm2(&[3e200, 4e200, 1.0, 1e-200]), 5e200));
+        assert!(near(norm2(&[3e-160, 4e-150]), 4e-150));
+        assert_eq!(norm2(&[3.0, 4.0]), 5.0);
+    }
+
+    /// the running-scale sum of squares (`dnrm2` before Blue's scheme), the reference.
+    fn reference(x: &[f64]) -> f64 {
+        let scale = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        if scale == 0.0 {
+            return 0.0;
+        }
+        let ssq: f64 = x.iter().map(|v| (v / scale) * (v / scale)).sum();
+        scale * ssq.sqrt()
+    }
 }
