@@ -72,7 +72,7 @@
 //! `literature_rho`), so it stops on the caller's verdict. Norms are accumulated with a running scale (LAPACK's `dnrm2` scheme), so data of
 //! size 1e-200 or 1e300 neither underflows to an error of 0 nor overflows to infinity.
 
-use super::projection::{project_cone, project_ellipse, tangent_norm};
+use super::projection::{project_cone, project_ellipse};
 use super::{ContactProblem, Delassus};
 use crate::error::{CoulombError, Result};
 use crate::readable::Readable;
@@ -297,7 +297,7 @@ fn scaled_residuals(
             } else if hypot_bound(x[0], x[1]) <= radius {
                 1.0
             } else {
-                let s = x[0].hypot(x[1]);
+                let s = hypot(x[0], x[1]);
                 if s > radius {
                     radius / s
                 } else {
@@ -518,7 +518,7 @@ pub(crate) fn anisotropic_residual(
     (e, (rh[1].hypot(rh[2]) - m * r[0]).max(flat))
 }
 
-/// An upper bound of `hypot(a, b)` as the platform's `hypot` returns it (within one unit in
+/// An upper bound of [`hypot`]`(a, b)` (and of the platform's `hypot`, within one unit in
 /// the last place, as glibc's and musl's are): `|a| + |b| >= sqrt(a^2 + b^2)`, widened by
 /// 8 eps for the rounding of the sum, of the product and of `hypot`. NaN for NaN entries (every
 /// comparison with it fails, and the caller then takes the norm itself).
@@ -529,7 +529,7 @@ fn hypot_bound(a: f64, b: f64) -> f64 {
 
 /// whether `||t|| > threshold` for t without NaN (the caller's dot is NaN otherwise), without
 /// the norm when the largest component already is
-/// (`||t|| >= max_k |t_k|`, which `hypot` keeps: the max is representable).
+/// (`||t|| >= max_k |t_k|`, which [`tangent_norm`] keeps).
 #[inline]
 fn slip_above(t: &[f64], threshold: f64) -> bool {
     t.iter().any(|v| v.abs() > threshold) || tangent_norm(t) > threshold
@@ -583,7 +583,7 @@ fn de_saxce_residual(r: &[f64], u: &[f64], mu: f64, slip_floor: f64) -> [f64; 3]
 mod norm;
 mod rows;
 
-pub(crate) use norm::{norm2, Norm2};
+pub(crate) use norm::{hypot, norm2, tangent_norm, Norm2};
 
 #[cfg(test)]
 mod reference;

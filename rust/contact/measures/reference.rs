@@ -1,11 +1,11 @@
 //! The measure as first written, one step after another as the module notes state it: the
 //! oracle that the optimized [`super::measure_into`] must match to the last bit.
 
-use super::super::projection::{project_ellipse, tangent_norm};
+use super::super::projection::project_ellipse;
 use super::super::ContactProblem;
 use super::{
-    anisotropic_residual, counted_slip, norm2, project_cone, rounding_floor, term_count,
-    ContactMeasures, ImpulseScale, Norm2, TINY,
+    anisotropic_residual, counted_slip, hypot, norm2, project_cone, rounding_floor, tangent_norm,
+    term_count, ContactMeasures, ImpulseScale, Norm2, TINY,
 };
 
 /// The two natural maps of one contact in impulse units (see the module notes): De Saxce's
@@ -38,7 +38,7 @@ fn scaled_residuals(
             for k in 1..dim {
                 x[k - 1] = r[k] - su[k];
             }
-            let s = x[0].hypot(x[1]);
+            let s = hypot(x[0], x[1]);
             let f = if s > radius { radius / s } else { 1.0 };
             for k in 1..dim {
                 a[k] = r[k] - f * x[k - 1];
