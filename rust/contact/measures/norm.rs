@@ -6,7 +6,7 @@
 const SMALL: f64 = 1.4916681462400413e-154;
 /// entries above this are squared after scaling down by [`BIG_DOWN`] (their squares, or a sum
 /// of 2^50 of them, could overflow); 2^486.
-const BIG: f64 = 1.9979190722022350e146;
+const BIG: f64 = 1.997_919_072_202_235e146;
 /// 2^537: a small entry's scale, exact.
 const SMALL_UP: f64 = 4.4989137945431964e161;
 /// 2^-538: a big entry's scale, exact.
