@@ -75,9 +75,15 @@ impl Norm2 {
     }
 }
 
-/// `||x||_2` without overflow or underflow.
+/// `||x||_2` without overflow or underflow: the plain sum of squares where it lies well inside
+/// the range (an entry whose square underflows is then below the sum's rounding), else
+/// [`Norm2`]'s three sums.
 #[inline]
 pub(crate) fn norm2(x: &[f64]) -> f64 {
+    let ss: f64 = x.iter().map(|v| v * v).sum();
+    if ss > 1e-290 && ss < 1e290 {
+        return ss.sqrt();
+    }
     let mut n = Norm2::default();
     n.add_all(x);
     n.value()
