@@ -213,30 +213,36 @@ impl Stepper {
         let h = self.settings.h;
         let cand = &self.candidates[c];
         // the exact and linearised displacements of a body-frame point over the step
-        let moved = |(body, p, _): (usize, [f64; 3], f64)| -> (Vector3<f64>, Vector3<f64>) {
-            let b = &self.bodies[body];
-            let vb = &v[b.off_v..b.off_v + b.nv];
-            let (xc, xp) = self.world_point(body, p);
-            let arm = Vector3::from(xp) - Vector3::from(xc);
-            let (lin, phi) = match b.kind {
-                BodyKind::Particle => (Vector3::from(pad(vb)), Vector3::zeros()),
-                BodyKind::Planar => (
-                    Vector3::new(vb[0], vb[1], 0.0),
-                    Vector3::new(0.0, 0.0, h * vb[2]),
-                ),
-                BodyKind::Spatial => (
-                    Vector3::new(vb[0], vb[1], vb[2]),
-                    Vector3::new(h * vb[3], h * vb[4], h * vb[5]),
-                ),
+        // (linearised, remainder, the point in the world)
+        let moved =
+            |(body, p, _): (usize, [f64; 3], f64)| -> (Vector3<f64>, Vector3<f64>, Vector3<f64>) {
+                let b = &self.bodies[body];
+                let vb = &v[b.off_v..b.off_v + b.nv];
+                let (xc, xp) = self.world_point(body, p);
+                let arm = Vector3::from(xp) - Vector3::from(xc);
+                let (lin, phi) = match b.kind {
+                    BodyKind::Particle => (Vector3::from(pad(vb)), Vector3::zeros()),
+                    BodyKind::Planar => (
+                        Vector3::new(vb[0], vb[1], 0.0),
+                        Vector3::new(0.0, 0.0, h * vb[2]),
+                    ),
+                    BodyKind::Spatial => (
+                        Vector3::new(vb[0], vb[1], vb[2]),
+                        Vector3::new(h * vb[3], h * vb[4], h * vb[5]),
+                    ),
+                };
+                (
+                    h * lin + phi.cross(&arm),
+                    rotation_remainder(&phi, &arm),
+                    Vector3::from(xp),
+                )
             };
-            (h * lin + phi.cross(&arm), rotation_remainder(&phi, &arm))
-        };
         let n = Vector3::from(geo.normal);
-        let (lin_a, rem_a) = moved(cand.a);
+        let (lin_a, rem_a, wa) = moved(cand.a);
         match cand.b {
             None => n.dot(&rem_a),
             Some(b) if cand.turn != Turn::Centres => {
-                let (lin_b, rem_b) = moved(b);
+                let (lin_b, rem_b, wb) = moved(b);
                 let carrier = match cand.turn {
                     Turn::WithA => cand.a.0,
                     _ => b.0,
@@ -244,18 +250,14 @@ impl Stepper {
                 // the normal turns with its body: n' = R(φ) n
                 let phi = self.rotation_vector(carrier, v);
                 let dn = phi.cross(&n) + rotation_remainder(&phi, &n);
-                let (_, wa) = self.world_point(cand.a.0, cand.a.1);
-                let (_, wb) = self.world_point(b.0, b.1);
-                let d = Vector3::from(wa) - Vector3::from(wb);
+                let d = wa - wb;
                 let delta = (lin_a + rem_a) - (lin_b + rem_b);
                 // g' - g - h J_n v with g = (x_a - x_b) . n, exactly for this model
                 (d + delta).dot(&dn) + n.dot(&(rem_a - rem_b))
             }
             Some(b) => {
-                let (lin_b, rem_b) = moved(b);
-                let (_, wa) = self.world_point(cand.a.0, cand.a.1);
-                let (_, wb) = self.world_point(b.0, b.1);
-                let d = Vector3::from(wa) - Vector3::from(wb);
+                let (lin_b, rem_b, wb) = moved(b);
+                let d = wa - wb;
                 let dist = d.norm();
                 let delta = (lin_a + rem_a) - (lin_b + rem_b);
                 let s = (d + delta).norm() + dist;
