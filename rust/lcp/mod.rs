@@ -352,8 +352,8 @@ impl<'a> LcpRef<'a> {
     }
 }
 
-/// `||x||_2`, without overflow or underflow: the plain sum of squares, redone with a running
-/// scale ([`crate::contact::measures`]'s scheme) when that sum is not finite or so small that
+/// `||x||_2`, without overflow or underflow: the plain sum of squares, redone by Blue's
+/// three sums ([`crate::contact::measures`]'s scheme) when that sum is not finite or so small that
 /// squares may have underflowed (data of size 1e300 or 1e-200).
 pub(crate) fn norm2(x: &[f64]) -> f64 {
     robust_sqrt_sum(x.iter().copied())

@@ -69,8 +69,9 @@
 //! heavy ones' impulses; `error_q` is the figure peers stop on (Siconos, FCLib), so an answer
 //! coulomb calls solved is solved by their measure too. A solver working in rescaled units
 //! ([`super::normalize`]) measures `error_q` in the caller's units (the problem's
-//! `literature_rho`), so it stops on the caller's verdict. Norms are accumulated with a running scale (LAPACK's `dnrm2` scheme), so data of
-//! size 1e-200 or 1e300 neither underflows to an error of 0 nor overflows to infinity.
+//! `literature_rho`), so it stops on the caller's verdict. Norms are accumulated by Blue's
+//! three sums (Blue 1978, the scheme of LAPACK 3.10's `dnrm2`), so data of size 1e-200 or
+//! 1e300 neither underflows to an error of 0 nor overflows to infinity.
 
 use super::projection::{project_cone, project_ellipse};
 use super::{ContactProblem, Delassus};
