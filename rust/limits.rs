@@ -34,8 +34,14 @@ pub fn set_memory_budget(bytes: usize) -> Result<usize> {
 }
 
 /// `count * item_bytes`, refused when it overflows or exceeds the budget. `what` names the
-/// allocation (with the input sizes that decide it) and `hint` says how to make it smaller.
-pub fn check_bytes(what: &str, count: usize, item_bytes: usize, hint: &str) -> Result<usize> {
+/// allocation (with the input sizes that decide it; formatted only for a refusal, so a hot
+/// caller passes `format_args!`) and `hint` says how to make it smaller.
+pub fn check_bytes(
+    what: impl std::fmt::Display,
+    count: usize,
+    item_bytes: usize,
+    hint: &str,
+) -> Result<usize> {
     let budget = memory_budget();
     match count.checked_mul(item_bytes) {
         Some(bytes) if bytes <= budget => Ok(bytes),

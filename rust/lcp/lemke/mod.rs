@@ -165,14 +165,12 @@ pub(crate) fn validate(lcp: &LcpRef<'_>, s: &LemkeSettings) -> Result<()> {
     }
     let entries = crate::limits::dense_lemke_entries(lcp.n).unwrap_or(usize::MAX);
     // the name is only formatted for a refusal: a batch validates every small problem
-    if (entries / 2).saturating_mul(8) > crate::limits::memory_budget() {
-        crate::limits::check_bytes(
-            &format!("Lemke's workspace for n = {}", lcp.n),
-            entries / 2,
-            8,
-            "",
-        )?;
-    }
+    crate::limits::check_bytes(
+        format_args!("Lemke's workspace for n = {}", lcp.n),
+        entries / 2,
+        8,
+        "",
+    )?;
     Ok(())
 }
 
