@@ -418,7 +418,7 @@ fn check_rollout_records(scenes: &[RolloutScene<'_>]) -> Result<()> {
         total = total.saturating_add(rows.saturating_mul(row_bytes));
     }
     crate::limits::check_bytes(
-        &format!(
+        format_args!(
             "recording the states of {} scene{}",
             scenes.len(),
             if scenes.len() == 1 { "" } else { "s" }

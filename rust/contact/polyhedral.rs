@@ -320,7 +320,7 @@ fn check_size(problem: &ContactProblem<'_>, facets: usize) -> Result<()> {
         .and_then(crate::limits::dense_lemke_entries)
         .unwrap_or(usize::MAX);
     crate::limits::check_bytes(
-        &format!(
+        format_args!(
             "the dense polyhedral LCP of {} contacts ({nf} with friction) with {facets} facets \
              ({} unknowns)",
             problem.nc,

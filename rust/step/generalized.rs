@@ -525,7 +525,7 @@ pub fn simulate_generalized<S: GeneralizedSystem>(
     let rows = steps.div_ceil(every) + 1;
     let row_bytes = 8 * (2 * nv + 6) + std::mem::size_of::<StepRecord>();
     crate::limits::check_bytes(
-        &format!("recording {rows} states of {nv} coordinates"),
+        format_args!("recording {rows} states of {nv} coordinates"),
         rows,
         row_bytes,
         "record fewer states with record_every",

@@ -156,7 +156,7 @@ fn run_scene(mut st: Stepper, settings: &StepSettings, record_every: usize) -> R
         .ceil()
         .max(1.0);
     crate::limits::check_bytes(
-        &format!("recording {rows} states of {} coordinates", st.nq),
+        format_args!("recording {rows} states of {} coordinates", st.nq),
         rows,
         row_bytes,
         &format!("record fewer states with record_every >= {needed:.0}"),
@@ -209,7 +209,7 @@ impl ChunkedRun {
         let row_bytes = 8 * (self.st.nq + self.st.nv + 5) + std::mem::size_of::<StepRecord>();
         let kept = steps.div_ceil(self.every) + 1;
         crate::limits::check_bytes(
-            &format!("a chunk of {kept} states of {} coordinates", self.st.nq),
+            format_args!("a chunk of {kept} states of {} coordinates", self.st.nq),
             kept,
             row_bytes,
             "stream smaller chunks",
@@ -434,7 +434,7 @@ fn check_contact_records(count: usize) -> Result<()> {
         .is_some_and(|b| b <= crate::limits::memory_budget());
     if !within {
         crate::limits::check_bytes(
-            &format!("recording {count} contact records"),
+            format_args!("recording {count} contact records"),
             count,
             item,
             "record fewer states with record_every",

@@ -331,7 +331,7 @@ pub enum FreeMotion<'a> {
 /// (`crate::limits`), checked before any work.
 fn check_dense_w(n: usize) -> Result<()> {
     crate::limits::check_bytes(
-        &format!("the dense W = G^T M^-1 G of {n} contact components"),
+        format_args!("the dense W = G^T M^-1 G of {n} contact components"),
         n.saturating_mul(n),
         8,
         "",
@@ -454,7 +454,7 @@ fn delassus_of_columns(
     }
     first.push(sides.len());
     crate::limits::check_bytes(
-        &format!(
+        format_args!(
             "M^-1 G over the blocks of M touched by {} columns of G",
             cols.len()
         ),
