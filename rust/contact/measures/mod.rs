@@ -258,7 +258,8 @@ pub fn measure(problem: &ContactProblem<'_>, r: &[f64]) -> Result<(Vec<f64>, Con
 
 /// The two natural maps of one contact in impulse units (see the module notes): De Saxce's
 /// `e` and Alart-Curnier's `a`, for the contact's impulse `r`, velocity `u`, scale `rho`.
-fn scaled_residuals(
+#[inline(always)]
+fn scaled_residuals<const D: usize>(
     problem: &ContactProblem<'_>,
     i: usize,
     rho: f64,
@@ -266,7 +267,7 @@ fn scaled_residuals(
     u: &[f64],
     slip_floor: f64,
 ) -> ([f64; 3], [f64; 3]) {
-    let dim = problem.dim;
+    let dim = D;
     let mu = problem.mu[i];
     let mut su = [0.0; 3];
     for k in 0..dim {
@@ -279,7 +280,7 @@ fn scaled_residuals(
     let rn = r[0].max(0.0);
     let e = match problem.anisotropy(i) {
         None => {
-            let e = de_saxce_residual(&r[..dim], &su[..dim], mu, floor);
+            let e = de_saxce_residual::<D>(&r[..D], &su[..D], mu, floor);
             // Coulomb with the normal impulse frozen: projection on the disk of radius mu r_n
             let radius = mu * rn;
             let mut x = [0.0; 2];
@@ -360,7 +361,21 @@ pub(crate) fn measure_into(
     r: &[f64],
     u: &mut [f64],
 ) -> ContactMeasures {
-    let dim = problem.dim;
+    // the dimension known at compile time: every per-contact loop unrolled (the same sums)
+    if problem.dim == 2 {
+        measure_of::<2>(problem, r, u)
+    } else {
+        measure_of::<3>(problem, r, u)
+    }
+}
+
+/// [`measure_into`] for contacts of D components (a problem's dim is 2 or 3).
+fn measure_of<const D: usize>(
+    problem: &ContactProblem<'_>,
+    r: &[f64],
+    u: &mut [f64],
+) -> ContactMeasures {
+    let dim = D;
     let rnorm = norm2(r);
     let qnorm = norm2(problem.q);
     let free = if rnorm > 0.0 && qnorm > 0.0 && (rnorm / qnorm).is_finite() {
@@ -386,7 +401,7 @@ pub(crate) fn measure_into(
         let ri = &r[o..o + dim];
         let qi = &problem.q[o..o + dim];
         // u_i and the magnitudes of its terms, (|W| |r| + |q|)_i
-        let (wr, mut terms) = rows::row_terms(problem, i, r);
+        let (wr, mut terms) = rows::row_terms::<D>(problem, i, r);
         for k in 0..dim {
             let v = wr[k] + qi[k];
             u[o + k] = v;
@@ -415,7 +430,7 @@ pub(crate) fn measure_into(
                 } else {
                     tangent_norm(&ri[1..]) - c
                 };
-                (de_saxce_residual(ri, &lu[..dim], mu, 0.0), viol)
+                (de_saxce_residual::<D>(ri, &lu[..D], mu, 0.0), viol)
             }
             Some(pair) => anisotropic_residual(pair, ri, &lu[..dim], 0.0),
         };
@@ -423,7 +438,7 @@ pub(crate) fn measure_into(
         // the unit-consistent maps, relative to the contact's own impulse scale
         let rho = scales.rho(problem, i);
         let floor = rounding_floor(problem.size(), &terms[1..dim]);
-        let (e, a) = scaled_residuals(problem, i, rho, ri, ui, floor);
+        let (e, a) = scaled_residuals::<D>(problem, i, rho, ri, ui, floor);
         let size = norm2(ri).max(rho * norm2(&terms[..dim]));
         let err = norm2(&e[..dim]).max(norm2(&a[..dim]));
         // size = 0 means r_i = 0 and every term of u_i is 0: both maps are exactly 0 there
@@ -560,8 +575,9 @@ fn project_cone_bounded(r: &mut [f64], mu: f64) {
 /// `e = r - P_K(r - (u + mu ||u_t|| n))` (De Saxcé and Feng 1991), zero-padded to 3, with the
 /// slip `||u_t||` counted by [`counted_slip`] above `slip_floor` (0 for the literature's map;
 /// the rounding of u_t for the verdict's, see [`rounding_floor`]).
-fn de_saxce_residual(r: &[f64], u: &[f64], mu: f64, slip_floor: f64) -> [f64; 3] {
-    let dim = r.len();
+#[inline(always)]
+fn de_saxce_residual<const D: usize>(r: &[f64], u: &[f64], mu: f64, slip_floor: f64) -> [f64; 3] {
+    let dim = D;
     let mut v = [0.0; 3];
     // below the floor by the bound the slip counts 0 without its norm
     let slip = if dim == 3 && hypot_bound(u[1], u[2]) <= slip_floor {

@@ -10,8 +10,12 @@ use super::super::{ContactProblem, Delassus};
 
 /// `((W r)_i, (|W| |r|)_i)`, zero-padded to 3.
 #[inline]
-pub(super) fn row_terms(problem: &ContactProblem<'_>, i: usize, r: &[f64]) -> ([f64; 3], [f64; 3]) {
-    match (problem.storage(), problem.dim) {
+pub(super) fn row_terms<const D: usize>(
+    problem: &ContactProblem<'_>,
+    i: usize,
+    r: &[f64],
+) -> ([f64; 3], [f64; 3]) {
+    match (problem.storage(), D) {
         (Delassus::Dense(w), 2) => dense2(w, problem.size(), i, r),
         (Delassus::Dense(w), 3) => dense3(w, problem.size(), i, r),
         (Delassus::BlockSparse(s), 2) => tiles::<2>(s.row_cols(i), s.row_values(i), r),
