@@ -149,13 +149,12 @@ impl WAssembly {
                             self.tiles.push((j, i, t));
                         }
                     } else {
-                        for al in 0..dim {
-                            for be in 0..dim {
-                                self.w[(i * dim + al) * n + j * dim + be] += blk[al][be];
-                                if mirror {
-                                    self.w[(j * dim + be) * n + i * dim + al] += blk[al][be];
-                                }
-                            }
+                        // the dimension known at compile time (the same sums, unrolled)
+                        match dim {
+                            3 => add_dense::<3>(&mut self.w, n, (i, j), &blk, mirror),
+                            2 => add_dense::<2>(&mut self.w, n, (i, j), &blk, mirror),
+                            // a block is at most 3 x 3: the one other dimension is 1
+                            _ => add_dense::<1>(&mut self.w, n, (i, j), &blk, mirror),
                         }
                     }
                 }
@@ -337,6 +336,26 @@ fn check_dense_w(n: usize) -> Result<()> {
         "",
     )?;
     Ok(())
+}
+
+/// adds block `blk` (D x D) of contacts (i, j) into the dense row-major `n x n` W at `(i, j)`,
+/// and its transpose at `(j, i)` when `mirror`, entry by entry in the order α, β.
+#[inline(always)]
+fn add_dense<const D: usize>(
+    w: &mut [f64],
+    n: usize,
+    (i, j): (usize, usize),
+    blk: &[[f64; 3]; 3],
+    mirror: bool,
+) {
+    for al in 0..D {
+        for be in 0..D {
+            w[(i * D + al) * n + j * D + be] += blk[al][be];
+            if mirror {
+                w[(j * D + be) * n + i * D + al] += blk[al][be];
+            }
+        }
+    }
 }
 
 /// `W = G^T M^{-1} G`, `q = G^T v_free + extra` (see the module notes); `extra` has
