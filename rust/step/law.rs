@@ -591,3 +591,31 @@ pub(super) fn poisson_phase(
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testing::SplitMix64;
+
+    /// the AVX2 copy of a tile's rows gives the baseline's bits (products and sums are never
+    /// contracted), over entries of every scale.
+    #[test]
+    fn avx2_tile_rows_equal_the_baseline_to_the_bit() {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            let mut rng = SplitMix64::new(3);
+            let mut x = || rng.normal() * 10f64.powi((rng.uniform() * 40.0) as i32 - 20);
+            for _ in 0..2000 {
+                let g: [[f64; 6]; 3] = std::array::from_fn(|_| std::array::from_fn(|_| x()));
+                let bt: [[f64; 4]; 6] = std::array::from_fn(|_| std::array::from_fn(|_| x()));
+                let base = side_rows::<3>(&g, &bt);
+                // SAFETY: AVX2 checked above.
+                let fast = unsafe { side_rows_avx2(&g, &bt) };
+                assert_eq!(
+                    base.map(|r| r.map(f64::to_bits)),
+                    fast.map(|r| r.map(f64::to_bits))
+                );
+            }
+        }
+    }
+}
