@@ -317,11 +317,24 @@ impl Stepper {
 
     /// `J_n v` of a geometry for a velocity vector.
     pub(super) fn normal_velocity(&self, g: &Geometry, v: &[f64]) -> f64 {
-        let mut s = 0.0;
+        let [s] = self.normal_velocities(g, [v]);
+        s
+    }
+
+    /// [`Stepper::normal_velocity`] in each of the velocities `vs`, each side's column formed
+    /// once (the same sums).
+    pub(super) fn normal_velocities<const K: usize>(
+        &self,
+        g: &Geometry,
+        vs: [&[f64]; K],
+    ) -> [f64; K] {
+        let mut s = [0.0; K];
         for &(body, sign, r) in &g.sides[..g.nsides] {
             let col = self.column(body, r, g.normal);
             let b = &self.bodies[body];
-            s += sign * (0..b.nv).map(|a| col[a] * v[b.off_v + a]).sum::<f64>();
+            for (sk, v) in s.iter_mut().zip(vs) {
+                *sk += sign * (0..b.nv).map(|a| col[a] * v[b.off_v + a]).sum::<f64>();
+            }
         }
         s
     }

@@ -443,14 +443,12 @@ impl Stepper {
         let far = geo.gap > tol_gap + 2.0 * h * reach && !pending && !kept;
         let (vn_k, vn_free) = if far {
             (0.0, 0.0)
+        } else if self.trial_search {
+            let [vf, vt, vk] = self.normal_velocities(geo, [&self.v_free, &self.v_trial, &self.v]);
+            (vk, vf.min(vt))
         } else {
-            let vn_free = self.normal_velocity(geo, &self.v_free);
-            let vn_trial = if self.trial_search {
-                self.normal_velocity(geo, &self.v_trial)
-            } else {
-                vn_free
-            };
-            (self.normal_velocity(geo, &self.v), vn_free.min(vn_trial))
+            let [vf, vk] = self.normal_velocities(geo, [&self.v_free, &self.v]);
+            (vk, vf)
         };
         let mut verdict = driver::search_verdict(&self.settings, geo.gap, vn_k, vn_free, pending);
         if kept && verdict.is_none() {
