@@ -16,6 +16,8 @@
 //! general path returns: the outside test without divisions decides only with a margin far
 //! above rounding, and an interior minimiser reuses that test's quotients.
 
+use crate::contact::measures::hypot;
+
 /// `S = Q diag(small, large) Q^T` with `Q = [(-sn, cs), (cs, sn)]` (columns: the eigenvectors
 /// of the smaller and larger eigenvalue).
 #[derive(Clone, Copy, Debug, Default)]
@@ -153,16 +155,10 @@ fn on_circle(d: [f64; 2], g: [f64; 2], radius: f64, lambda: f64) -> [f64; 2] {
     x
 }
 
-/// `||x||` of a 2-vector: the square root of the sum of squares where that neither overflows
-/// nor underflows to a loss of accuracy, `hypot` otherwise.
+/// `||x||` of a 2-vector (the measures' [`hypot`]: the plain square root inside the safe range).
 #[inline]
 fn norm2(x: [f64; 2]) -> f64 {
-    let ss = x[0] * x[0] + x[1] * x[1];
-    if ss > 1e-290 && ss < 1e290 {
-        ss.sqrt()
-    } else {
-        x[0].hypot(x[1])
-    }
+    hypot(x[0], x[1])
 }
 
 /// The root `λ > 0` of the secular equation `Σ_k g_k^2 / (d_k + λ)^2 = radius^2` when its
