@@ -38,6 +38,8 @@ mod settle;
 mod solid_pairs;
 #[path = "solve.rs"]
 mod solve;
+#[path = "tiles.rs"]
+mod tiles;
 
 use self::bodies::{bodies_of, norm3, BodyInfo, Frozen};
 pub use self::joints::{Joint, JointKind, JointSystemInfo};
