@@ -11,26 +11,17 @@
 //! contacts alone, pushing balls into their neighbours, and paid the lift against gravity
 //! with energy).
 
+mod common;
+
 use coulomb::step::{
-    simulate, Body, BodyKind, Drift, HalfSpace, Pair, Scene, Shape, StepSettings, Trajectory,
+    simulate, Body, BodyKind, Drift, Pair, Scene, Shape, StepSettings, Trajectory,
 };
 
 const R: f64 = 0.1;
 
 /// the stack, each ball `overlap` into the one below and the bottom one into the floor.
 fn stack(overlap: f64) -> Scene {
-    let mut scene = Scene {
-        dim: 3,
-        gravity: vec![0.0, 0.0, -9.81],
-        bodies: vec![],
-        shapes: vec![],
-        half_spaces: vec![HalfSpace {
-            point: vec![0.0; 3],
-            normal: vec![0.0, 0.0, 1.0],
-        }],
-        pairs: vec![Pair::Spheres { mu: 0.5, e: 0.0 }],
-        solids: Vec::new(),
-    };
+    let mut scene = common::floor_scene(Pair::Spheres { mu: 0.5, e: 0.0 });
     let i = 0.4 * R * R;
     for k in 0..5 {
         let kf = k as f64;

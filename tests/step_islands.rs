@@ -2,6 +2,8 @@
 //! links), the islands in parallel: the answer must not depend on the number of threads, and
 //! every step the islands' answer is judged on the whole problem.
 
+mod common;
+
 use coulomb::contact::ContactStatus;
 use coulomb::geometry::Shape3;
 use coulomb::step::{
@@ -16,18 +18,7 @@ const RADIUS: f64 = 0.05;
 /// islands merge and split as the run goes), dropped from 2 mm with 0.2 radii between its
 /// layers, or `stacked`: its columns touching the floor and each other from the start.
 fn piles(groups: usize, per_group: usize, stacked: bool) -> Scene {
-    let mut scene = Scene {
-        dim: 3,
-        gravity: vec![0.0, 0.0, -9.81],
-        bodies: vec![],
-        shapes: vec![],
-        half_spaces: vec![HalfSpace {
-            point: vec![0.0, 0.0, 0.0],
-            normal: vec![0.0, 0.0, 1.0],
-        }],
-        pairs: vec![Pair::Spheres { mu: 0.5, e: 0.0 }],
-        solids: Vec::new(),
-    };
+    let mut scene = common::floor_scene(Pair::Spheres { mu: 0.5, e: 0.0 });
     let side = (per_group as f64).cbrt().ceil() as usize;
     let spacing = 2.2 * RADIUS;
     let half = side as f64 * spacing / 2.0 + RADIUS;
@@ -156,18 +147,7 @@ fn assert_same(one: &Trajectory, other: &Trajectory, threads: &str) {
 /// face on the floor and the upper's on the lower are clipped polygons, each pair an island.
 fn cube_pairs(count: usize) -> Scene {
     let half = 0.05;
-    let mut scene = Scene {
-        dim: 3,
-        gravity: vec![0.0, 0.0, -9.81],
-        bodies: vec![],
-        shapes: vec![],
-        half_spaces: vec![HalfSpace {
-            point: vec![0.0; 3],
-            normal: vec![0.0, 0.0, 1.0],
-        }],
-        pairs: vec![Pair::Solids { mu: 0.5, e: 0.0 }],
-        solids: Vec::new(),
-    };
+    let mut scene = common::floor_scene(Pair::Solids { mu: 0.5, e: 0.0 });
     let inertia = 0.1 * (2.0 * half) * (2.0 * half) / 6.0;
     for k in 0..2 * count {
         let (column, level) = (k / 2, k % 2);

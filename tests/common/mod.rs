@@ -61,3 +61,20 @@ pub fn cube_g() -> Vec<f64> {
     }
     g
 }
+
+/// An empty 3D scene under gravity -9.81 along z with the floor z = 0 and one pair rule (the
+/// spheres' or the solids' broad phase): bodies, shapes and solids are added by the test.
+pub fn floor_scene(pair: coulomb::step::Pair) -> coulomb::step::Scene {
+    coulomb::step::Scene {
+        dim: 3,
+        gravity: vec![0.0, 0.0, -9.81],
+        bodies: vec![],
+        shapes: vec![],
+        half_spaces: vec![coulomb::step::HalfSpace {
+            point: vec![0.0; 3],
+            normal: vec![0.0, 0.0, 1.0],
+        }],
+        pairs: vec![pair],
+        solids: Vec::new(),
+    }
+}
