@@ -21,7 +21,9 @@
 //! passes the tolerance (the verdict's own test, so NSGS never stops on a measure the verdict
 //! would reject). That measure is recomputed from the original W and q into buffers allocated
 //! once, after the sweeps where it may pass ([`schedule`]) and always on the returned
-//! iterate. `b_i` is read from the stored tiles of W's block row i (a dense W with mostly
+//! iterate; a solve stopped at its sweep limit after a far drift move that left it worse
+//! returns its best measured iterate ([`best`]).
+//! `b_i` is read from the stored tiles of W's block row i (a dense W with mostly
 //! zero tiles is copied once into block CSR, [`rows`]), so a sweep costs O(nnz(W)) and
 //! allocates nothing (tests/nsgs_alloc.rs counts the allocations).
 //!
@@ -37,6 +39,7 @@
 //! contacts, by one sparse Cholesky factor ([`stick`]); on boxes resting face on face, whose
 //! four coplanar points make W singular, it ends the slow sweeps at once.
 
+mod best;
 mod closed;
 mod disk;
 mod extrapolate;
@@ -370,8 +373,9 @@ pub(crate) fn solve_nsgs_measured(
         None => measure_into(problem, &r, &mut u),
     };
     let mut schedule = CheckSchedule::new(s.tol, measures.scaled_error);
-    let mut extrapolation = extrapolate::Extrapolation::new();
+    let mut extrapolation = extrapolate::Extrapolation::new(s.max_iter);
     let mut stick = stick::StickSolve::default();
+    let mut best = best::Best::default();
     // the last measured sweep and error, for the sticking-set solve's slowness test
     let mut last = (0usize, measures.scaled_error);
     let mut sweeps = 0;
@@ -401,6 +405,7 @@ pub(crate) fn solve_nsgs_measured(
             last = (sweeps, measures.scaled_error);
             if !measures.passes(s.tol) {
                 schedule.measured(sweeps, measures.scaled_error, change);
+                best.offer(sweeps, extrapolation.far_moves(), &r, &u, &measures);
             }
         }
     }
@@ -408,6 +413,11 @@ pub(crate) fn solve_nsgs_measured(
         // interrupted between two measures: the verdict is the returned iterate's
         measures = measure_into(problem, &r, &mut u);
     }
+    let restored = if measures.passes(s.tol) {
+        None
+    } else {
+        best.restore(extrapolation.far_moves(), &mut r, &mut u, &mut measures)
+    };
 
     let (status, message) = if measures.passes(s.tol) {
         (
@@ -435,11 +445,19 @@ pub(crate) fn solve_nsgs_measured(
     } else {
         (
             ContactStatus::IterationLimit,
-            format!(
-                "stopped at max_iter = {} with {}",
-                s.max_iter,
-                measures.shortfall(s.tol)
-            ),
+            match restored {
+                None => format!(
+                    "stopped at max_iter = {} with {}",
+                    s.max_iter,
+                    measures.shortfall(s.tol)
+                ),
+                Some(at) => format!(
+                    "stopped at max_iter = {} with {} (the best measured iterate, after \
+                     sweep {at})",
+                    s.max_iter,
+                    measures.shortfall(s.tol)
+                ),
+            },
         )
     };
     Ok(ContactSolution {
