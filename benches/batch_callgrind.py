@@ -37,7 +37,10 @@ def totals(count: int, folder: str) -> dict[str, int]:
     subprocess.run(
         ["valgrind", "--tool=callgrind", "--separate-threads=yes",
          f"--callgrind-out-file={out}.%p", sys.executable, __file__, "--child", str(count)],
-        check=True, capture_output=True)
+        check=True, capture_output=True,
+        # numpy's BLAS threads spin while they wait, for as long as the run lasts: one
+        # BLAS thread keeps them out of the count
+        env={**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"})
     found = {}
     for path in sorted(glob.glob(f"{out}.*-*")):
         thread = path.rsplit("-", 1)[1]

@@ -307,11 +307,27 @@ pub fn solve_lcps(
 /// One problem of an LCP batch, as the single solve from Python runs it: small Lemke solves
 /// on the chunk's workspace `ws`, everything else through [`lcp::solve`].
 pub fn solve_lcp(ws: &mut LemkeWorkspace, p: &LcpRef<'_>, method: &Method) -> Result<LcpSolution> {
+    let mut out = LcpSolution::empty();
+    solve_lcp_into(ws, p, method, &mut out)?;
+    Ok(out)
+}
+
+/// [`solve_lcp`] into the chunk's kept answer `out`: a small Lemke solve then reuses its
+/// vectors and message, and allocates nothing.
+pub fn solve_lcp_into(
+    ws: &mut LemkeWorkspace,
+    p: &LcpRef<'_>,
+    method: &Method,
+    out: &mut LcpSolution,
+) -> Result<()> {
     match method {
         Method::Lemke(settings) if p.n <= REUSED_WORKSPACE_MAX_N => {
-            lcp::solve_lemke_with(ws, p, settings)
+            lcp::solve_lemke_into(ws, p, settings, out)
         }
-        other => lcp::solve(p, other),
+        other => {
+            *out = lcp::solve(p, other)?;
+            Ok(())
+        }
     }
 }
 

@@ -10,6 +10,104 @@ use std::fmt::{self, Write};
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Readable(pub f64);
 
+impl Readable {
+    /// appends the text to `out` (what `Display` prints), without the formatting machinery
+    /// for the common case: a solve's message prints at least one number.
+    pub(crate) fn push_to(self, out: &mut String) {
+        match fast_digits(self.0) {
+            Some((negative, digits, exponent)) => {
+                if negative {
+                    out.push('-');
+                }
+                out.push(char::from(b'0' + digits / 10));
+                if digits % 10 != 0 {
+                    out.push('.');
+                    out.push(char::from(b'0' + digits % 10));
+                }
+                out.push('e');
+                push_int(out, exponent);
+            }
+            None => {
+                // the exact path; a String's fmt::Write cannot fail
+                let _ = write!(out, "{self}");
+            }
+        }
+    }
+}
+
+/// `x`'s two significant digits `d` (10..=99) and exponent `e` with `|x|` = d.d x 10^e to
+/// two digits, when they are certain from f64 arithmetic: `None` for 0, non-finite values,
+/// magnitudes outside 1e-290..1e290 and values within 1e-9 (relative) of a rounding tie,
+/// which the exact formatter decides.
+fn fast_digits(x: f64) -> Option<(bool, u8, i32)> {
+    let a = x.abs();
+    if !(1e-290..=1e290).contains(&a) {
+        return None;
+    }
+    // log10's estimate of the exponent may be one off near a power of ten: corrected below
+    let mut e = a.log10().floor() as i32;
+    let mut m = a * 10f64.powi(1 - e);
+    if m < 10.0 {
+        e -= 1;
+        m *= 10.0;
+    } else if m >= 100.0 {
+        e += 1;
+        m /= 10.0;
+    }
+    let below = m.floor();
+    let frac = m - below;
+    // m carries a few ulps of error from the power and the product: a value this close to
+    // a tie (or to 10 or 100) is left to the exact formatter
+    if (frac - 0.5).abs() < 1e-9 || !(10.0 + 1e-9..100.0 - 1e-9).contains(&m) {
+        return None;
+    }
+    let mut digits = below as u32 + u32::from(frac > 0.5);
+    if digits == 100 {
+        digits = 10;
+        e += 1;
+    }
+    Some((x < 0.0, digits as u8, e))
+}
+
+/// appends the decimal digits of `v`.
+fn push_int(out: &mut String, v: i32) {
+    if v < 0 {
+        out.push('-');
+    }
+    let mut u = v.unsigned_abs();
+    let mut buf = [0u8; 10];
+    let mut at = buf.len();
+    loop {
+        at -= 1;
+        buf[at] = b'0' + (u % 10) as u8;
+        u /= 10;
+        if u == 0 {
+            break;
+        }
+    }
+    for &b in &buf[at..] {
+        out.push(char::from(b));
+    }
+}
+
+/// appends the decimal digits of `v` (a count in a message).
+pub(crate) fn push_count(out: &mut String, v: usize) {
+    let mut u = v;
+    let mut buf = [0u8; 20];
+    let mut at = buf.len();
+    loop {
+        at -= 1;
+        buf[at] = b'0' + (u % 10) as u8;
+        u /= 10;
+        if u == 0 {
+            break;
+        }
+    }
+    for &b in &buf[at..] {
+        out.push(char::from(b));
+    }
+}
+
 impl fmt::Display for Readable {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let x = self.0;
@@ -104,5 +202,50 @@ mod tests {
             x *= 7.3;
         }
         assert_eq!(Readable(-f64::MAX).to_string(), heap(-f64::MAX));
+    }
+
+    #[test]
+    fn the_fast_path_prints_what_the_exact_formatter_prints() {
+        let pushed = |x: f64| {
+            let mut s = String::new();
+            Readable(x).push_to(&mut s);
+            s
+        };
+        // every decade, values at and around the ties d.d5 and the powers of ten, and a
+        // dense sweep of mantissas (xorshift: deterministic)
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut checked = 0;
+        for e in -320..=308 {
+            let p = 10f64.powi(e);
+            let mut values = vec![p, p * 0.999_999_999_999, p * 1.000_000_000_001];
+            for d in 10..100 {
+                let tie = (d as f64 + 0.5) / 10.0 * p;
+                values.extend([tie, tie.next_up(), tie.next_down(), d as f64 / 10.0 * p]);
+            }
+            for _ in 0..200 {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                values.push((1.0 + (state >> 11) as f64 / (1u64 << 53) as f64 * 9.0) * p);
+            }
+            for v in values.into_iter().filter(|v| v.is_finite() && *v != 0.0) {
+                for v in [v, -v] {
+                    assert_eq!(pushed(v), Readable(v).to_string(), "{v:e}");
+                    checked += 1;
+                }
+            }
+        }
+        for v in [
+            0.0,
+            -0.0,
+            f64::INFINITY,
+            f64::NAN,
+            f64::MIN_POSITIVE,
+            5e-324,
+            f64::MAX,
+        ] {
+            assert_eq!(pushed(v), Readable(v).to_string(), "{v:e}");
+        }
+        assert!(checked > 400_000, "{checked}");
     }
 }

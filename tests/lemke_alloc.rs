@@ -4,7 +4,9 @@
 
 use std::alloc::{GlobalAlloc, Layout, System};
 
-use coulomb::lcp::{solve_lemke_with, LcpRef, LemkeSettings, LemkeWorkspace};
+use coulomb::lcp::{
+    solve_lemke_into, solve_lemke_with, LcpRef, LcpSolution, LemkeSettings, LemkeWorkspace,
+};
 use coulomb::testing::planted_psd;
 
 struct Counting;
@@ -104,4 +106,36 @@ fn a_kept_workspace_allocates_only_the_answer() {
     println!("allocations per solve: {counts:?}");
     // z, w, the basis (none when it is empty) and the message: 20 before the scratch was kept
     assert!(counts.iter().all(|&c| c <= 4), "{counts:?}");
+}
+
+/// With the answer kept too (`solve_lemke_into`, as a batch's worker solves), a solve after
+/// the first two of its size (the first sizes the workspace, the second fills the kept
+/// spare vectors) allocates nothing, and gives what a fresh solve gives.
+#[test]
+fn a_kept_workspace_and_answer_allocate_nothing() {
+    let mut ws = LemkeWorkspace::new(0);
+    let mut out = LcpSolution::empty();
+    let mut counts = Vec::new();
+    for seed in 0..20 {
+        let n = 3 + (seed as usize % 5);
+        let (m, q, _, _) = planted_psd(n, n / 2 + 1, seed);
+        let lcp = LcpRef::new(n, &m.data, &q).expect("well-formed");
+        let settings = LemkeSettings::default();
+        for _ in 0..2 {
+            solve_lemke_into(&mut ws, &lcp, &settings, &mut out).expect("valid");
+        }
+        let before = mine();
+        solve_lemke_into(&mut ws, &lcp, &settings, &mut out).expect("valid");
+        counts.push(mine() - before);
+        let fresh = solve_lemke_with(&mut LemkeWorkspace::new(n), &lcp, &settings).expect("valid");
+        assert!(out.success(), "{}", out.message);
+        assert_eq!(out.z, fresh.z);
+        assert_eq!(out.w, fresh.w);
+        assert_eq!(out.basis, fresh.basis);
+        assert_eq!(out.message, fresh.message);
+        assert_eq!(out.measures, fresh.measures);
+        assert_eq!((out.pivots, out.polished), (fresh.pivots, fresh.polished));
+    }
+    println!("allocations per solve: {counts:?}");
+    assert!(counts.iter().all(|&c| c == 0), "{counts:?}");
 }

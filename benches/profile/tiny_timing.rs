@@ -3,7 +3,9 @@
 //! `cargo run --release --example tiny_timing` (`REPS=k` solves each, 200,000 by default;
 //! `ONLY=kept` or `ONLY=contact` times one of them, for callgrind).
 use coulomb::contact::{self, ContactProblem, NsgsSettings};
-use coulomb::lcp::{solve_lemke, solve_lemke_with, LcpRef, LemkeSettings, LemkeWorkspace};
+use coulomb::lcp::{
+    solve_lemke, solve_lemke_into, LcpRef, LcpSolution, LemkeSettings, LemkeWorkspace,
+};
 
 fn timed(what: &str, reps: usize, mut f: impl FnMut() -> Result<f64, coulomb::CoulombError>) {
     let t = std::time::Instant::now();
@@ -37,10 +39,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         timed("solve", reps, || Ok(solve_lemke(&lcp, &s)?.z[0]));
     }
     if only.is_empty() || only == "kept" {
-        // as a batch's worker solves: one workspace for every problem
+        // as a batch's worker solves: one workspace and one answer for every problem
         let mut ws = LemkeWorkspace::new(3);
+        let mut out = LcpSolution::empty();
         timed("solve on a kept workspace", reps, || {
-            Ok(solve_lemke_with(&mut ws, &lcp, &s)?.z[0])
+            solve_lemke_into(&mut ws, &lcp, &s, &mut out)?;
+            Ok(out.z[0])
         });
     }
     if only.is_empty() || only == "contact" {

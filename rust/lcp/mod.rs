@@ -32,7 +32,9 @@ use crate::error::{check_finite, CoulombError, Result};
 use crate::matrix::DenseMatrix;
 
 pub use enumerate::{solve_enumerate, EnumerateSettings};
-pub use lemke::{solve_lemke, solve_lemke_with, LemkeEngine, LemkeSettings, LemkeWorkspace};
+pub use lemke::{
+    solve_lemke, solve_lemke_into, solve_lemke_with, LemkeEngine, LemkeSettings, LemkeWorkspace,
+};
 pub use pgs::{solve_pgs, PgsSettings};
 
 /// the vector instruction set Lemke's pivot kernel uses on this CPU.
@@ -102,7 +104,7 @@ impl WarmStart {
 }
 
 /// The error measures of an answer z, always computed from the original M and q.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct LcpMeasures {
     /// `||min(z, w)||_2 / max(1, ||q||_2)` with `w = M z + q` (as Siconos reports it).
     pub error: f64,
@@ -160,6 +162,26 @@ pub struct LcpSolution {
 }
 
 impl LcpSolution {
+    /// a solution with nothing in it yet (status `Solved`, empty vectors and message), for
+    /// the solvers that fill one in place.
+    pub fn empty() -> Self {
+        Self {
+            z: Vec::new(),
+            w: Vec::new(),
+            status: LcpStatus::Solved,
+            message: String::new(),
+            measures: LcpMeasures::default(),
+            pivots: 0,
+            iterations: 0,
+            basis: Vec::new(),
+            warm_start: WarmStart::None,
+            pivots_saved: 0,
+            polished: false,
+            restarts: 0,
+            solutions: Vec::new(),
+        }
+    }
+
     /// whether the answer passes the tolerance on the original data.
     pub fn success(&self) -> bool {
         self.status == LcpStatus::Solved
@@ -276,10 +298,22 @@ impl<'a> LcpRef<'a> {
         terms: &mut Vec<f64>,
     ) -> (Vec<f64>, LcpMeasures) {
         let mut w = vec![0.0; self.n];
-        terms.resize(self.n, 0.0);
-        self.evaluate_parts(z, scaling, &mut w, terms);
-        let m = self.measures_with_terms(|i| z[i], &w, |i| terms[i], scaling);
+        let m = self.evaluate_into(z, scaling, &mut w, terms);
         (w, m)
+    }
+
+    /// [`LcpRef::evaluate_with`] into the caller's `w` (length n), so a kept workspace's
+    /// solves reuse it.
+    pub(crate) fn evaluate_into(
+        &self,
+        z: &[f64],
+        scaling: &scaling::Equilibration,
+        w: &mut [f64],
+        terms: &mut Vec<f64>,
+    ) -> LcpMeasures {
+        terms.resize(self.n, 0.0);
+        self.evaluate_parts(z, scaling, w, terms);
+        self.measures_with_terms(|i| z[i], w, |i| terms[i], scaling)
     }
 
     /// the measures of z = 0 without a pass over M (w = q, and the terms of w_i are |q_i|).

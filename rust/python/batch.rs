@@ -25,7 +25,7 @@ use crate::contact;
 use crate::contact::prox::ProxSettings;
 use crate::error::CoulombError;
 use crate::lcp::{
-    EnumerateSettings, LemkeEngine, LemkeSettings, LemkeWorkspace, Method, PgsSettings,
+    EnumerateSettings, LcpSolution, LemkeEngine, LemkeSettings, LemkeWorkspace, Method, PgsSettings,
 };
 
 /// Runs a batch with the GIL released, the calling thread checking for Ctrl-C (the signal
@@ -294,11 +294,12 @@ fn lcp_solve_batch<'py>(
             watch,
             |range| {
                 let cols = LcpColumns::new(range.len(), n);
-                (LemkeWorkspace::new(0), Instant::now(), cols)
+                let kept = (LemkeWorkspace::new(0), LcpSolution::empty());
+                (kept, Instant::now(), cols)
             },
-            |(ws, last, cols), i| {
-                let s = batch::solve_lcp(ws, &problems[i], batch::pick(&methods, i)?)?;
-                cols.push(&s, batch::lap(last));
+            |((ws, s), last, cols), i| {
+                batch::solve_lcp_into(ws, &problems[i], batch::pick(&methods, i)?, s)?;
+                cols.push(s, batch::lap(last));
                 Ok(())
             },
         )

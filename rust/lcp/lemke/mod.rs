@@ -43,7 +43,7 @@ use super::revised::{PathEnd, RevisedLemke};
 use super::scaling::Equilibration;
 use super::{check_tol, passes, LcpRef, LcpSolution, LcpStatus, WarmStart};
 use crate::error::{check_finite, CoulombError, Result};
-use answer::{better, candidate, principal, with_fallback_note, Candidate};
+use answer::{add_fallback_note, better, candidate, principal, Candidate, Spare};
 pub use tableau::LemkeWorkspace;
 use verdict::verdict;
 
@@ -293,6 +293,7 @@ fn best_answer(
     path: &Path,
     z: &[f64],
     basis: &[usize],
+    spare: &mut Spare,
     terms: &mut Vec<f64>,
 ) -> (Candidate, bool) {
     let (n, tol) = (lcp.n, settings.tol);
@@ -305,18 +306,27 @@ fn best_answer(
         let refined = if path.on_product_form {
             let pf = &mut ws.product_form;
             pf.refine(lcp, eq);
-            let mut zr = vec![0.0; n];
+            let mut zr = spare.zeros(n);
             let mut br = Vec::with_capacity(basis.len());
             pf.extract(eq, &mut zr, &mut br);
-            Some(candidate(lcp, eq, zr, terms))
+            Some(candidate(lcp, eq, zr, spare, terms))
         } else {
-            let mut zr = z.to_vec();
-            ws.refine(lcp, eq, &mut zr)
-                .then(|| candidate(lcp, eq, zr, terms))
+            let mut zr = spare.copy_of(z);
+            if ws.refine(lcp, eq, &mut zr) {
+                Some(candidate(lcp, eq, zr, spare, terms))
+            } else {
+                spare.give(zr);
+                None
+            }
         };
         match refined {
             Some(c) if passes(&c.measures, tol) => Some(c),
-            _ => principal(lcp, eq, basis, terms),
+            other => {
+                if let Some(c) = other {
+                    spare.give_candidate(c);
+                }
+                principal(lcp, eq, basis, spare, terms)
+            }
         }
     } else {
         None
@@ -324,10 +334,12 @@ fn best_answer(
     match polished_answer {
         Some(p) if passes(&p.measures, tol) => (p, true),
         Some(p) => {
-            let t = candidate(lcp, eq, z.to_vec(), terms);
+            let t = candidate(lcp, eq, spare.copy_of(z), spare, terms);
             if better(&p.measures, &t.measures) {
+                spare.give_candidate(t);
                 (p, true)
             } else {
+                spare.give_candidate(p);
                 (t, false)
             }
         }
@@ -335,13 +347,21 @@ fn best_answer(
         // z0 = 0 to rounding may still pick another leaving row; its answer, and the
         // principal solution of its basic z's, are judged like any other
         None if ending != Ending::NonFinite && settings.polish => {
-            let t = candidate(lcp, eq, z.to_vec(), terms);
-            match principal(lcp, eq, basis, terms) {
-                Some(p) if better(&p.measures, &t.measures) => (p, true),
-                _ => (t, false),
+            let t = candidate(lcp, eq, spare.copy_of(z), spare, terms);
+            match principal(lcp, eq, basis, spare, terms) {
+                Some(p) if better(&p.measures, &t.measures) => {
+                    spare.give_candidate(t);
+                    (p, true)
+                }
+                other => {
+                    if let Some(p) = other {
+                        spare.give_candidate(p);
+                    }
+                    (t, false)
+                }
             }
         }
-        None => (candidate(lcp, eq, z.to_vec(), terms), false),
+        None => (candidate(lcp, eq, spare.copy_of(z), spare, terms), false),
     }
 }
 
@@ -354,6 +374,7 @@ pub(super) struct Scratch {
     z: Vec<f64>,
     basis: Vec<usize>,
     terms: Vec<f64>,
+    spare: Spare,
 }
 
 /// Solves the LCP by Lemke's method, reusing `ws` (resized if needed).
@@ -365,48 +386,60 @@ pub fn solve_lemke_with(
     lcp: &LcpRef<'_>,
     settings: &LemkeSettings,
 ) -> Result<LcpSolution> {
+    let mut out = LcpSolution::empty();
+    solve_lemke_into(ws, lcp, settings, &mut out)?;
+    Ok(out)
+}
+
+/// [`solve_lemke_with`] into `out`, whose vectors and message are reused: a loop that keeps
+/// one solution and one workspace (a batch's worker) allocates nothing per small solve.
+/// Every field of `out` is overwritten.
+pub fn solve_lemke_into(
+    ws: &mut LemkeWorkspace,
+    lcp: &LcpRef<'_>,
+    settings: &LemkeSettings,
+    out: &mut LcpSolution,
+) -> Result<()> {
     validate(lcp, settings)?;
     if ws.size() != lcp.n {
         *ws = LemkeWorkspace::new(lcp.n);
     }
     let mut scratch = std::mem::take(&mut ws.scratch);
-    let out = solve_on(ws, &mut scratch, lcp, settings);
+    solve_on(ws, &mut scratch, lcp, settings, out);
     ws.scratch = scratch;
-    Ok(out)
+    Ok(())
 }
 
-/// [`solve_lemke_with`] on validated input, with the scratch vectors taken out of `ws`.
+/// [`solve_lemke_into`] on validated input, with the scratch vectors taken out of `ws`.
 fn solve_on(
     ws: &mut LemkeWorkspace,
     sc: &mut Scratch,
     lcp: &LcpRef<'_>,
     settings: &LemkeSettings,
-) -> LcpSolution {
+    out: &mut LcpSolution,
+) {
     let n = lcp.n;
     sc.eq.compute_into(n, lcp.m, lcp.q);
     let eq = &sc.eq;
     let tol = settings.tol;
     // z and w are filled where the answer is decided: every return below sets them
-    let mut out = LcpSolution {
-        z: Vec::new(),
-        w: Vec::new(),
-        status: LcpStatus::Solved,
-        message: String::new(),
-        measures: lcp.measures_at_zero(eq),
-        pivots: 0,
-        iterations: 0,
-        basis: Vec::new(),
-        warm_start: WarmStart::None,
-        pivots_saved: 0,
-        polished: false,
-        restarts: 0,
-        solutions: Vec::new(),
-    };
+    sc.spare.give(std::mem::take(&mut out.z));
+    sc.spare.give(std::mem::take(&mut out.w));
+    out.status = LcpStatus::Solved;
+    out.message.clear();
+    // room for a solved path's message, which is pushed piece by piece
+    out.message.reserve(64);
+    out.measures = lcp.measures_at_zero(eq);
+    (out.pivots, out.iterations, out.pivots_saved, out.restarts) = (0, 0, 0, 0);
+    out.basis.clear();
+    out.warm_start = WarmStart::None;
+    out.polished = false;
+    out.solutions.clear();
 
     if let Some(guess) = &settings.warm_start {
         let mut a = guess.clone();
         a.sort_unstable();
-        if let Some(c) = principal(lcp, eq, &a, &mut sc.terms) {
+        if let Some(c) = principal(lcp, eq, &a, &mut sc.spare, &mut sc.terms) {
             if passes(&c.measures, tol) {
                 out.warm_start = WarmStart::Accepted;
                 out.pivots_saved = a.len() + 1;
@@ -414,18 +447,20 @@ fn solve_on(
                 out.z = c.z;
                 out.w = c.w;
                 out.measures = c.measures;
-                out.message = "solved by the warm-start basis without pivoting".into();
-                return out;
+                out.message
+                    .push_str("solved by the warm-start basis without pivoting");
+                return;
             }
+            sc.spare.give_candidate(c);
         }
         out.warm_start = WarmStart::Rejected;
     }
 
     if passes(&out.measures, tol) {
-        out.z = vec![0.0; n];
-        out.w = lcp.q.to_vec();
-        out.message = "z = 0 solves the problem (q >= 0)".into();
-        return out;
+        out.z = sc.spare.zeros(n);
+        out.w = sc.spare.copy_of(lcp.q);
+        out.message.push_str("z = 0 solves the problem (q >= 0)");
+        return;
     }
 
     let max_pivots = settings.max_pivots.unwrap_or_else(|| (50 * n).max(1000));
@@ -452,14 +487,26 @@ fn solve_on(
         abandoned += path.abandoned;
         out.pivots += pivots;
         out.restarts = attempt;
-        let (best, polished) = best_answer(ws, lcp, eq, settings, &path, z, basis, &mut sc.terms);
-        out.z = best.z;
-        out.w = best.w;
+        let (best, polished) = best_answer(
+            ws,
+            lcp,
+            eq,
+            settings,
+            &path,
+            z,
+            basis,
+            &mut sc.spare,
+            &mut sc.terms,
+        );
+        sc.spare.give(std::mem::replace(&mut out.z, best.z));
+        sc.spare.give(std::mem::replace(&mut out.w, best.w));
         out.measures = best.measures;
-        out.basis = basis.clone();
+        out.basis.clear();
+        out.basis.extend_from_slice(basis);
         out.polished = polished;
-        if verdict(&mut out, ending, polished, tol, max_pivots, attempt) {
-            return with_fallback_note(out, abandoned);
+        if verdict(out, ending, polished, tol, max_pivots, attempt) {
+            add_fallback_note(out, abandoned);
+            return;
         }
         let keep = matches!(ending, Ending::Terminal | Ending::Cycle)
             && failed_terminal
@@ -471,9 +518,9 @@ fn solve_on(
     }
     if let Some(mut f) = failed_terminal {
         (f.pivots, f.restarts) = (out.pivots, out.restarts);
-        out = f;
+        *out = f;
     }
-    with_fallback_note(out, abandoned)
+    add_fallback_note(out, abandoned);
 }
 
 #[cfg(test)]

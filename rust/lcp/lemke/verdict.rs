@@ -1,11 +1,14 @@
 //! The status and message of one Lemke path's answer.
 
+use std::fmt::Write;
+
 use super::super::{passes, LcpSolution, LcpStatus};
 use super::Ending;
-use crate::readable::Readable;
+use crate::readable::{push_count, Readable};
 
 /// The status and message of a path's answer (already in `out`); `true` when it is final,
 /// `false` after a ray, which a restart with another covering vector may still overcome.
+/// The message is written into `out.message`'s own buffer (a kept solution reuses it).
 pub(super) fn verdict(
     out: &mut LcpSolution,
     ending: Ending,
@@ -18,7 +21,9 @@ pub(super) fn verdict(
     match ending {
         Ending::Ray | Ending::Limit | Ending::Cycle if passes(&m, tol) => {
             out.status = LcpStatus::Solved;
-            out.message = format!(
+            out.message.clear();
+            let _ = write!(
+                out.message,
                 "solved in {} pivots (error {}{}; the path ended on {}, but the answer \
                  there passes tol)",
                 out.pivots,
@@ -34,19 +39,24 @@ pub(super) fn verdict(
         }
         Ending::Terminal if passes(&m, tol) => {
             out.status = LcpStatus::Solved;
-            out.message = format!(
-                "solved in {} pivots (error {}{})",
-                out.pivots,
-                Readable(m.error),
-                if polished { ", polished" } else { "" }
-            );
+            // "solved in {pivots} pivots (error {error}[, polished])", pushed piece by piece:
+            // every solve of a batch or a simulation writes it
+            let text = &mut out.message;
+            text.clear();
+            text.push_str("solved in ");
+            push_count(text, out.pivots);
+            text.push_str(" pivots (error ");
+            Readable(m.error).push_to(text);
+            text.push_str(if polished { ", polished)" } else { ")" });
             return true;
         }
         // a rounding casualty of degenerate pivots (a wrong leaving row on a singular W,
         // for example): another covering vector takes another path, so not final
         Ending::Terminal => {
             out.status = LcpStatus::NumericalFailure;
-            out.message = format!(
+            out.message.clear();
+            let _ = write!(
+                out.message,
                 "z0 left the basis but the answer fails tol {}: error {}, \
                  scaled error {} (ill-conditioned basis; {} covering vector(s) tried)",
                 Readable(tol),
@@ -57,7 +67,9 @@ pub(super) fn verdict(
         }
         Ending::Cycle => {
             out.status = LcpStatus::NumericalFailure;
-            out.message = format!(
+            out.message.clear();
+            let _ = write!(
+                out.message,
                 "the path cycled (rounding at degenerate ties) after {} pivots, with {} \
                  covering vector(s) tried: error {}",
                 out.pivots,
@@ -67,7 +79,9 @@ pub(super) fn verdict(
         }
         Ending::Ray => {
             out.status = LcpStatus::RayTermination;
-            out.message = format!(
+            out.message.clear();
+            let _ = write!(
+                out.message,
                 "ray termination after {} pivots with {} covering vector(s): no solution \
                  found on Lemke's path (for copositive-plus M, e.g. positive semidefinite, \
                  this proves there is none)",
@@ -77,7 +91,9 @@ pub(super) fn verdict(
         }
         Ending::Limit => {
             out.status = LcpStatus::PivotLimit;
-            out.message = format!(
+            out.message.clear();
+            let _ = write!(
+                out.message,
                 "stopped at the pivot limit ({max_pivots}) with error {}",
                 Readable(m.error)
             );
@@ -85,7 +101,12 @@ pub(super) fn verdict(
         }
         Ending::NonFinite => {
             out.status = LcpStatus::NumericalFailure;
-            out.message = format!("the tableau became non-finite after {} pivots", out.pivots);
+            out.message.clear();
+            let _ = write!(
+                out.message,
+                "the tableau became non-finite after {} pivots",
+                out.pivots
+            );
             return true;
         }
     }
