@@ -46,7 +46,9 @@ impl Spare {
     /// takes `v` back for a later solve.
     pub(super) fn give(&mut self, v: Vec<f64>) {
         if v.capacity() > 0 && self.0.len() < SPARE_KEPT {
-            self.0.reserve_exact(SPARE_KEPT);
+            if self.0.capacity() == 0 {
+                self.0.reserve_exact(SPARE_KEPT);
+            }
             self.0.push(v);
         }
     }

@@ -41,7 +41,7 @@ mod verdict;
 
 use super::revised::{PathEnd, RevisedLemke};
 use super::scaling::Equilibration;
-use super::{check_tol, passes, LcpRef, LcpSolution, LcpStatus, WarmStart};
+use super::{check_tol, passes, LcpMeasures, LcpRef, LcpSolution, LcpStatus, WarmStart};
 use crate::error::{check_finite, CoulombError, Result};
 use answer::{add_fallback_note, better, candidate, principal, Candidate, Spare};
 pub use tableau::LemkeWorkspace;
@@ -429,7 +429,8 @@ fn solve_on(
     out.message.clear();
     // room for a solved path's message, which is pushed piece by piece
     out.message.reserve(64);
-    out.measures = lcp.measures_at_zero(eq);
+    // every path below overwrites them (a path is always followed)
+    out.measures = LcpMeasures::default();
     (out.pivots, out.iterations, out.pivots_saved, out.restarts) = (0, 0, 0, 0);
     out.basis.clear();
     out.warm_start = WarmStart::None;
@@ -456,11 +457,18 @@ fn solve_on(
         out.warm_start = WarmStart::Rejected;
     }
 
-    if passes(&out.measures, tol) {
-        out.z = sc.spare.zeros(n);
-        out.w = sc.spare.copy_of(lcp.q);
-        out.message.push_str("z = 0 solves the problem (q >= 0)");
-        return;
+    // z = 0 is measured only when it may pass: a q_i < 0 makes its scaled error exactly 1
+    // (w_i over its own size |q_i|), which passes no tol below 1
+    let zero_may_pass = tol >= 1.0 || lcp.q.iter().all(|v| *v >= 0.0);
+    if zero_may_pass {
+        let at_zero = lcp.measures_at_zero(eq);
+        if passes(&at_zero, tol) {
+            out.measures = at_zero;
+            out.z = sc.spare.zeros(n);
+            out.w = sc.spare.copy_of(lcp.q);
+            out.message.push_str("z = 0 solves the problem (q >= 0)");
+            return;
+        }
     }
 
     let max_pivots = settings.max_pivots.unwrap_or_else(|| (50 * n).max(1000));
@@ -530,6 +538,23 @@ mod tests {
     fn lemke(n: usize, m: &[f64], q: &[f64]) -> LcpSolution {
         let lcp = LcpRef::new(n, m, q).unwrap();
         solve_lemke(&lcp, &LemkeSettings::default()).unwrap()
+    }
+
+    /// the solve skips measuring z = 0 when some q_i < 0: its scaled error is then exactly 1,
+    /// at every scale of q, so it passes no tol below 1.
+    #[test]
+    fn z_zero_with_a_negative_q_has_scaled_error_one() {
+        let m = [2.0, 1.0, 0.0, 1.0, 3.0, 1.0, 0.0, 1.0, 4.0];
+        for scale in [1e-300, 1e-20, 1e-8, 1.0, 1e8, 1e300] {
+            for q in [[-1.0, 2.0, 3.0], [5.0, -1e-12, 0.0], [-3.0, -4.0, -1e-9]] {
+                let q = q.map(|v| v * scale);
+                let lcp = LcpRef::new(3, &m, &q).unwrap();
+                let eq = Equilibration::compute(3, &m, &q);
+                assert_eq!(lcp.measures_at_zero(&eq).scaled_error, 1.0, "{q:?}");
+                let s = solve_lemke(&lcp, &LemkeSettings::default()).unwrap();
+                assert!(s.success() && s.pivots > 0, "{q:?}: {}", s.message);
+            }
+        }
     }
 
     #[test]
