@@ -34,6 +34,10 @@ from collections.abc import Callable
 from functools import partial
 from pathlib import Path
 
+# numpy's BLAS threads spin for a while after each product that makes the test data, on the
+# cores the batches are timed on: one BLAS thread keeps them out of the measurement
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
 import coulomb
 import numpy as np
 

@@ -33,7 +33,7 @@ use rayon::ThreadPool;
 use crate::contact::{self, ContactProblem, ContactSolution};
 use crate::error::{check_finite, CoulombError, Result};
 use crate::interrupt;
-use crate::lcp::kernel::all_finite;
+use crate::lcp::kernel::first_non_finite;
 use crate::lcp::{self, LcpRef, LcpSolution, LemkeWorkspace, Method};
 use crate::step::{simulate_joints, Joint, Scene, StepRecord, StepSettings, Trajectory};
 
@@ -218,8 +218,8 @@ where
 }
 
 /// Checks the LCPs `(Ms[i], qs[i])` of a batch (`sizes[i]` = n_i, M_i row-major) before any
-/// work, naming the first failing problem: `Shape` for lengths that do not fit, `NonFinite`
-/// for a NaN or an infinity.
+/// work, naming the first failing problem: `Shape` for lengths that do not fit, then
+/// `NonFinite` for a NaN or an infinity (all problems' entries in one pass).
 pub fn lcp_problems<'a>(
     sizes: &[usize],
     ms: &[&'a [f64]],
@@ -247,12 +247,12 @@ pub fn lcp_problems<'a>(
                 q.len()
             )));
         }
-        // the name is only formatted for a refusal
-        if !(all_finite(m) && all_finite(q)) {
-            check_finite(&format!("Ms[{i}]"), m)?;
-            check_finite(&format!("qs[{i}]"), q)?;
-        }
         out.push(LcpRef { n, m, q });
+    }
+    // one pass for every problem; the name is only formatted for a refusal
+    if let Some(i) = first_non_finite(ms, qs) {
+        check_finite(&format!("Ms[{i}]"), ms[i])?;
+        check_finite(&format!("qs[{i}]"), qs[i])?;
     }
     Ok(out)
 }

@@ -386,14 +386,24 @@ pub fn ruiz_sweep(
 /// compiler vectorizes, where a search for the first non-finite entry runs one entry per
 /// step.
 pub fn all_finite(values: &[f64]) -> bool {
-    #[inline(always)]
-    fn body(values: &[f64]) -> bool {
-        let top = values
-            .iter()
-            .fold(0u64, |m, v| m.max(v.to_bits() & 0x7fff_ffff_ffff_ffff));
-        top < 0x7ff0_0000_0000_0000
-    }
-    dispatch!(detect(), bool, || body(values))
+    dispatch!(detect(), bool, || finite_body(values))
+}
+
+#[inline(always)]
+fn finite_body(values: &[f64]) -> bool {
+    let top = values
+        .iter()
+        .fold(0u64, |m, v| m.max(v.to_bits() & 0x7fff_ffff_ffff_ffff));
+    top < 0x7ff0_0000_0000_0000
+}
+
+/// The first i whose `a[i]` or `b[i]` has a non-finite entry ([`all_finite`] over each pair,
+/// the CPU's form chosen once for all of them: a batch checks many small problems).
+pub fn first_non_finite(a: &[&[f64]], b: &[&[f64]]) -> Option<usize> {
+    dispatch!(detect(), Option<usize>, || a
+        .iter()
+        .zip(b)
+        .position(|(x, y)| !(finite_body(x) && finite_body(y))))
 }
 
 /// the largest magnitude as a bit-pattern maximum (see [`all_finite`]): not finite exactly

@@ -142,14 +142,15 @@ fn vec_slices<'a>(name: &str, v: &'a Vecs<'_>) -> Result<Vec<&'a [f64]>, Coulomb
 }
 
 /// per-problem optional vectors (`None` for all, or one entry per problem, each maybe `None`),
-/// copied.
+/// copied; empty when none was given (a batch's common case costs nothing per problem).
 fn per_problem(
     name: &str,
     v: &Option<Vec<Option<PyReadonlyArray1<'_, f64>>>>,
     count: usize,
 ) -> Result<Vec<Option<Vec<f64>>>, CoulombError> {
     match v {
-        None => Ok(vec![None; count]),
+        // none given: empty (see `or_nones`), not a vector of `count` Nones to walk
+        None => Ok(Vec::new()),
         Some(list) if list.len() != count => Err(CoulombError::Shape(format!(
             "{name} must hold one entry per problem ({count}), got {}",
             list.len()
@@ -197,7 +198,7 @@ fn lcp_methods(
     engine: LemkeEngine,
 ) -> Result<Vec<Method>, CoulombError> {
     let warm = match warm {
-        None => vec![None; count],
+        None => Vec::new(),
         Some(w) if w.len() != count => {
             return Err(CoulombError::Shape(format!(
                 "warm_start must hold one basis per problem ({count}), got {}",
@@ -235,12 +236,22 @@ fn lcp_methods(
     if uniform {
         return Ok(vec![one(None, None, None)?]);
     }
-    covers
+    or_nones(covers, count)
         .into_iter()
-        .zip(warm)
-        .zip(initials)
+        .zip(or_nones(warm, count))
+        .zip(or_nones(initials, count))
         .map(|((c, w), i)| one(c, w, i))
         .collect()
+}
+
+/// a per-problem list given as empty for "none given" ([`per_problem`]), as one `None` per
+/// problem.
+fn or_nones<T: Clone>(v: Vec<Option<T>>, count: usize) -> Vec<Option<T>> {
+    if v.is_empty() {
+        vec![None; count]
+    } else {
+        v
+    }
 }
 
 /// Solves a batch of LCPs `0 <= z_i ⊥ M_i z_i + q_i >= 0` across `threads` threads (all the
