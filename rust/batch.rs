@@ -158,20 +158,49 @@ where
     F: Fn(&mut S, usize) -> Result<()> + Sync,
 {
     let threads = thread_count(threads)?;
+    let seeds = vec![(); chunk_ranges(count, threads).len()];
+    map_chunks_seeded(count, threads, watch, seeds, |range, ()| init(range), f)
+}
+
+/// The chunks [`map_chunks`] splits `0..count` into on `threads` threads (a count that
+/// [`thread_count`] accepted): consecutive, in order, about eight per thread.
+pub fn chunk_ranges(count: usize, threads: usize) -> Vec<Range<usize>> {
+    let chunk = count.div_ceil(threads.max(1) * CHUNKS_PER_THREAD).max(1);
+    (0..count.div_ceil(chunk))
+        .map(|c| c * chunk..((c + 1) * chunk).min(count))
+        .collect()
+}
+
+/// [`map_chunks`] on `threads` threads (a count that [`thread_count`] accepted) with one seed
+/// per chunk of [`chunk_ranges`], moved into that chunk's `init`: a batch hands each chunk its
+/// own rows of columns allocated once for the whole batch, which the chunk then fills in
+/// place. Seeds of chunks beyond `seeds` are not made: give one per chunk.
+pub fn map_chunks_seeded<T, S, I, F>(
+    count: usize,
+    threads: usize,
+    watch: &mut dyn FnMut() -> bool,
+    seeds: Vec<T>,
+    init: I,
+    f: F,
+) -> Result<Vec<S>>
+where
+    T: Send,
+    S: Send,
+    I: Fn(Range<usize>, T) -> S + Sync,
+    F: Fn(&mut S, usize) -> Result<()> + Sync,
+{
     if count == 0 {
         return Ok(Vec::new());
     }
     let pool = pool(threads)?;
-    let chunk = count.div_ceil(threads * CHUNKS_PER_THREAD).max(1);
-    let chunks = count.div_ceil(chunk);
+    let ranges = chunk_ranges(count, threads);
     let stop = Arc::new(AtomicBool::new(false));
-    let run_chunk = |c: usize| -> Result<S> {
+    let run_chunk = |(range, seed): (Range<usize>, T)| -> Result<S> {
         let flag = stop.clone();
         interrupt::run(
             move || flag.load(Ordering::Relaxed),
             || {
-                let range = c * chunk..((c + 1) * chunk).min(count);
-                let mut state = init(range.clone());
+                let mut state = init(range.clone(), seed);
                 for i in range {
                     if stop.load(Ordering::Relaxed) || interrupt::stopped() {
                         return Err(CoulombError::Interrupted);
@@ -182,14 +211,12 @@ where
             },
         )
     };
+    let work: Vec<(Range<usize>, T)> = ranges.into_iter().zip(seeds).collect();
     let (tx, rx) = mpsc::channel();
     let outcome = pool.in_place_scope(|scope| {
         scope.spawn(|_| {
             let all = catch_unwind(AssertUnwindSafe(|| {
-                (0..chunks)
-                    .into_par_iter()
-                    .map(run_chunk)
-                    .collect::<Vec<_>>()
+                work.into_par_iter().map(run_chunk).collect::<Vec<_>>()
             }));
             // the receiver waits until this arrives: sending cannot fail
             let _ = tx.send(all);
@@ -488,6 +515,23 @@ mod tests {
         for t in [0, MAX_THREADS + 1] {
             let out = map(3, Some(t), &mut never, || (), |_, i| Ok(i));
             assert!(matches!(out, Err(CoulombError::InvalidParameter(_))));
+        }
+    }
+
+    #[test]
+    fn the_chunks_cover_the_problems_in_order() {
+        for count in [0, 1, 7, 16, 17, 1000, 10_001] {
+            for threads in [1, 2, 3, 8] {
+                let ranges = chunk_ranges(count, threads);
+                let mut next = 0;
+                for r in &ranges {
+                    assert_eq!(r.start, next, "{count} {threads}");
+                    assert!(!r.is_empty());
+                    next = r.end;
+                }
+                assert_eq!(next, count);
+                assert!(ranges.len() <= threads * CHUNKS_PER_THREAD);
+            }
         }
     }
 

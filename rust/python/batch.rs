@@ -16,7 +16,7 @@ use pyo3::types::PyDict;
 
 #[path = "batch_columns.rs"]
 mod columns;
-use columns::{ContactColumns, LcpColumns};
+use columns::{ContactColumns, LcpColumns, LcpFixed};
 
 use super::errors::internal_error;
 use super::{settings, signal_hook, to_py};
@@ -297,25 +297,33 @@ fn lcp_solve_batch<'py>(
     })();
     let (problems, methods) = prepared.map_err(|e| to_py(py, e))?;
     let n = problems.first().map_or(0, |p| p.n);
-    let parts = batch_guarded(py, |watch| {
+    let sizes: Vec<usize> = problems.iter().map(|p| p.n).collect();
+    let mut fixed = LcpFixed::new(&sizes);
+    let ragged = batch_guarded(py, |watch| {
         batch::check_methods(&methods, problems.len())?;
-        batch::map_chunks(
+        let threads = batch::thread_count(threads)?;
+        let ranges = batch::chunk_ranges(problems.len(), threads);
+        let rows = fixed.rows(&ranges);
+        let parts = batch::map_chunks_seeded(
             problems.len(),
             threads,
             watch,
-            |range| {
+            rows,
+            |range, rows| {
                 let cols = LcpColumns::new(range.len(), n);
                 let kept = (LemkeWorkspace::new(0), LcpSolution::empty());
-                (kept, Instant::now(), cols)
+                (kept, Instant::now(), cols, rows)
             },
-            |((ws, s), last, cols), i| {
+            |((ws, s), last, cols, rows), i| {
                 batch::solve_lcp_into(ws, &problems[i], batch::pick(&methods, i)?, s)?;
-                cols.push(s, batch::lap(last));
+                rows.put(i, s, batch::lap(last));
+                cols.push(s);
                 Ok(())
             },
-        )
+        )?;
+        Ok(parts.into_iter().map(|(_, _, c, _)| c).collect::<Vec<_>>())
     })?;
-    LcpColumns::into_dict(py, parts.into_iter().map(|(_, _, c)| c).collect())
+    LcpColumns::into_dict(py, fixed, ragged)
 }
 
 /// the options of a contact batch, the same for every problem.

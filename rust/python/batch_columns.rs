@@ -3,6 +3,8 @@
 //! and joined once on the calling thread: one flat array per field, the per-problem vectors cut
 //! by offsets, the messages one string cut by char offsets.
 
+use std::ops::Range;
+
 use numpy::PyArray1;
 use pyo3::intern;
 use pyo3::prelude::*;
@@ -108,11 +110,14 @@ fn column<'py, C, T: numpy::Element + Copy>(
     PyArray1::from_vec(py, out)
 }
 
-/// The answers of a chunk of LCPs: `z`, `w` (same offsets), the measures and counts,
-/// `status` and `warm_start` as codes (in the order of [`LcpStatus`] and [`WarmStart`]),
-/// `basis` and `solutions` with their own offsets, the messages and the solve times.
-pub(super) struct LcpColumns {
-    z: Ragged<f64>,
+/// The fixed-size answers of an LCP batch, allocated once for all problems: `z` and `w`
+/// (cut by `offsets`, known from the sizes before any solve), `status` and `warm_start` as
+/// codes (in the order of [`LcpStatus`] and [`WarmStart`]), the measures, the counts,
+/// `polished` and the solve times. Each chunk writes its own rows ([`LcpFixed::rows`]), so
+/// nothing is joined afterwards.
+pub(super) struct LcpFixed {
+    offsets: Vec<i64>,
+    z: Vec<f64>,
     w: Vec<f64>,
     status: Vec<u8>,
     warm: Vec<u8>,
@@ -120,6 +125,165 @@ pub(super) struct LcpColumns {
     counts: [Vec<i64>; 4],
     polished: Vec<bool>,
     time: Vec<f64>,
+}
+
+/// One chunk's rows of [`LcpFixed`]: problems `start..`, their vectors from `base` on.
+pub(super) struct LcpRows<'a> {
+    start: usize,
+    base: i64,
+    offsets: &'a [i64],
+    z: &'a mut [f64],
+    w: &'a mut [f64],
+    status: &'a mut [u8],
+    warm: &'a mut [u8],
+    measures: [&'a mut [f64]; 5],
+    counts: [&'a mut [i64]; 4],
+    polished: &'a mut [bool],
+    time: &'a mut [f64],
+}
+
+/// `v` cut into consecutive pieces of the given lengths (shorter pieces once `v` runs out).
+fn cut<T>(v: &mut [T], lens: impl Iterator<Item = usize>) -> std::vec::IntoIter<&mut [T]> {
+    let mut rest = v;
+    let mut out = Vec::new();
+    for len in lens {
+        let k = len.min(rest.len());
+        let (piece, tail) = std::mem::take(&mut rest).split_at_mut(k);
+        out.push(piece);
+        rest = tail;
+    }
+    out.into_iter()
+}
+
+impl LcpFixed {
+    /// zeroed columns for problems of sizes `sizes` (the pages are touched by the chunks that
+    /// fill them, in parallel).
+    pub(super) fn new(sizes: &[usize]) -> Self {
+        let count = sizes.len();
+        let mut offsets = Vec::with_capacity(count + 1);
+        offsets.push(0i64);
+        let mut total = 0i64;
+        for &n in sizes {
+            total += n as i64;
+            offsets.push(total);
+        }
+        let total = total as usize;
+        Self {
+            offsets,
+            z: vec![0.0; total],
+            w: vec![0.0; total],
+            status: vec![0; count],
+            warm: vec![0; count],
+            measures: std::array::from_fn(|_| vec![0.0; count]),
+            counts: std::array::from_fn(|_| vec![0; count]),
+            polished: vec![false; count],
+            time: vec![0.0; count],
+        }
+    }
+
+    /// the rows of each chunk of `ranges` (consecutive, from problem 0).
+    pub(super) fn rows(&mut self, ranges: &[Range<usize>]) -> Vec<LcpRows<'_>> {
+        let lens = || ranges.iter().map(|r| r.len());
+        let offsets = &self.offsets;
+        let at = |i: usize| offsets.get(i).copied().unwrap_or(0);
+        let vec_lens = || ranges.iter().map(|r| (at(r.end) - at(r.start)) as usize);
+        let mut z = cut(&mut self.z, vec_lens());
+        let mut w = cut(&mut self.w, vec_lens());
+        let mut status = cut(&mut self.status, lens());
+        let mut warm = cut(&mut self.warm, lens());
+        let mut measures = self.measures.each_mut().map(|m| cut(m, lens()));
+        let mut counts = self.counts.each_mut().map(|c| cut(c, lens()));
+        let mut polished = cut(&mut self.polished, lens());
+        let mut time = cut(&mut self.time, lens());
+        ranges
+            .iter()
+            .map(|r| LcpRows {
+                start: r.start,
+                base: at(r.start),
+                offsets,
+                z: z.next().unwrap_or_default(),
+                w: w.next().unwrap_or_default(),
+                status: status.next().unwrap_or_default(),
+                warm: warm.next().unwrap_or_default(),
+                measures: measures.each_mut().map(|m| m.next().unwrap_or_default()),
+                counts: counts.each_mut().map(|c| c.next().unwrap_or_default()),
+                polished: polished.next().unwrap_or_default(),
+                time: time.next().unwrap_or_default(),
+            })
+            .collect()
+    }
+
+    /// sets the columns in `d` (the keys `coulomb.lcp.LcpBatchResult` reads).
+    fn into_dict(self, py: Python<'_>, d: &Bound<'_, PyDict>) -> PyResult<()> {
+        d.set_item(intern!(py, "z"), PyArray1::from_vec(py, self.z))?;
+        d.set_item(intern!(py, "w"), PyArray1::from_vec(py, self.w))?;
+        d.set_item(intern!(py, "offsets"), PyArray1::from_vec(py, self.offsets))?;
+        d.set_item(intern!(py, "status"), PyArray1::from_vec(py, self.status))?;
+        d.set_item(intern!(py, "warm_start"), PyArray1::from_vec(py, self.warm))?;
+        for (name, col) in LCP_MEASURES.iter().zip(self.measures) {
+            d.set_item(*name, PyArray1::from_vec(py, col))?;
+        }
+        for (name, col) in LCP_COUNTS.iter().zip(self.counts) {
+            d.set_item(*name, PyArray1::from_vec(py, col))?;
+        }
+        d.set_item(
+            intern!(py, "polished"),
+            PyArray1::from_vec(py, self.polished),
+        )?;
+        d.set_item(intern!(py, "solve_time"), PyArray1::from_vec(py, self.time))?;
+        Ok(())
+    }
+}
+
+impl LcpRows<'_> {
+    /// writes problem i's answer (i in this chunk) and the seconds it took.
+    pub(super) fn put(&mut self, i: usize, s: &LcpSolution, seconds: f64) {
+        let k = i - self.start;
+        let at = |j: usize| (self.offsets.get(j).copied().unwrap_or(0) - self.base) as usize;
+        let (a, b) = (at(i), at(i + 1));
+        // a solver's z and w have the problem's n entries
+        for (o, v) in self.z[a..b].iter_mut().zip(&s.z) {
+            *o = *v;
+        }
+        for (o, v) in self.w[a..b].iter_mut().zip(&s.w) {
+            *o = *v;
+        }
+        self.status[k] = match s.status {
+            LcpStatus::Solved => 0,
+            LcpStatus::RayTermination => 1,
+            LcpStatus::PivotLimit => 2,
+            LcpStatus::IterationLimit => 3,
+            LcpStatus::NumericalFailure => 4,
+            LcpStatus::NoSolution => 5,
+        };
+        self.warm[k] = match s.warm_start {
+            WarmStart::None => 0,
+            WarmStart::Accepted => 1,
+            WarmStart::Rejected => 2,
+        };
+        let m = &s.measures;
+        let values = [
+            m.error,
+            m.scaled_error,
+            m.min_z,
+            m.min_w,
+            m.max_complementarity,
+        ];
+        for (col, v) in self.measures.iter_mut().zip(values) {
+            col[k] = v;
+        }
+        let counts = [s.pivots, s.iterations, s.pivots_saved, s.restarts];
+        for (col, v) in self.counts.iter_mut().zip(counts) {
+            col[k] = v as i64;
+        }
+        self.polished[k] = s.polished;
+        self.time[k] = seconds;
+    }
+}
+
+/// The per-problem answers of a chunk of LCPs whose sizes vary: `basis` and `solutions` with
+/// their own offsets, and the messages.
+pub(super) struct LcpColumns {
     basis: Ragged<i64>,
     solutions: Ragged<f64>,
     messages: Text,
@@ -138,77 +302,29 @@ impl LcpColumns {
     /// room for `problems` answers of about `n` unknowns.
     pub(super) fn new(problems: usize, n: usize) -> Self {
         Self {
-            z: Ragged::new(problems, n),
-            w: Vec::with_capacity(problems * n),
-            status: Vec::with_capacity(problems),
-            warm: Vec::with_capacity(problems),
-            measures: std::array::from_fn(|_| Vec::with_capacity(problems)),
-            counts: std::array::from_fn(|_| Vec::with_capacity(problems)),
-            polished: Vec::with_capacity(problems),
-            time: Vec::with_capacity(problems),
             basis: Ragged::new(problems, n),
             solutions: Ragged::new(problems, 0),
             messages: Text::new(problems),
         }
     }
 
-    /// appends one answer and the seconds it took.
-    pub(super) fn push(&mut self, s: &LcpSolution, seconds: f64) {
-        self.z.push(s.z.iter().copied());
-        self.w.extend_from_slice(&s.w);
-        self.status.push(match s.status {
-            LcpStatus::Solved => 0,
-            LcpStatus::RayTermination => 1,
-            LcpStatus::PivotLimit => 2,
-            LcpStatus::IterationLimit => 3,
-            LcpStatus::NumericalFailure => 4,
-            LcpStatus::NoSolution => 5,
-        });
-        self.warm.push(match s.warm_start {
-            WarmStart::None => 0,
-            WarmStart::Accepted => 1,
-            WarmStart::Rejected => 2,
-        });
-        let m = &s.measures;
-        let values = [
-            m.error,
-            m.scaled_error,
-            m.min_z,
-            m.min_w,
-            m.max_complementarity,
-        ];
-        for (col, v) in self.measures.iter_mut().zip(values) {
-            col.push(v);
-        }
-        let counts = [s.pivots, s.iterations, s.pivots_saved, s.restarts];
-        for (col, v) in self.counts.iter_mut().zip(counts) {
-            col.push(v as i64);
-        }
-        self.polished.push(s.polished);
-        self.time.push(seconds);
+    /// appends one answer's basis, solutions and message.
+    pub(super) fn push(&mut self, s: &LcpSolution) {
         self.basis.push(s.basis.iter().map(|&k| k as i64));
         self.solutions
             .push(s.solutions.iter().flat_map(|x| x.iter().copied()));
         self.messages.push(&s.message);
     }
 
-    /// the chunks' columns joined into one dict (the keys `coulomb.lcp.LcpBatchResult` reads).
-    pub(super) fn into_dict(py: Python<'_>, parts: Vec<Self>) -> PyResult<Bound<'_, PyDict>> {
+    /// the fixed columns and the chunks' joined into one dict (the keys
+    /// `coulomb.lcp.LcpBatchResult` reads).
+    pub(super) fn into_dict(
+        py: Python<'_>,
+        fixed: LcpFixed,
+        parts: Vec<Self>,
+    ) -> PyResult<Bound<'_, PyDict>> {
         let d = PyDict::new(py);
-        let (z, offsets) = Ragged::join(parts.iter().map(|p| &p.z));
-        d.set_item(intern!(py, "z"), PyArray1::from_vec(py, z))?;
-        d.set_item(intern!(py, "w"), column(py, &parts, |p| &p.w))?;
-        d.set_item(intern!(py, "offsets"), PyArray1::from_vec(py, offsets))?;
-        d.set_item(intern!(py, "status"), column(py, &parts, |p| &p.status))?;
-        d.set_item(intern!(py, "warm_start"), column(py, &parts, |p| &p.warm))?;
-        for (k, name) in LCP_MEASURES.iter().enumerate() {
-            d.set_item(*name, column(py, &parts, |p| &p.measures[k]))?;
-        }
-        for (k, name) in LCP_COUNTS.iter().enumerate() {
-            d.set_item(*name, column(py, &parts, |p| &p.counts[k]))?;
-        }
-        d.set_item(intern!(py, "polished"), column(py, &parts, |p| &p.polished))?;
-        d.set_item(intern!(py, "solve_time"), column(py, &parts, |p| &p.time))?;
+        fixed.into_dict(py, &d)?;
         let (b, b_off) = Ragged::join(parts.iter().map(|p| &p.basis));
         d.set_item(intern!(py, "basis"), PyArray1::from_vec(py, b))?;
         d.set_item(intern!(py, "basis_offsets"), PyArray1::from_vec(py, b_off))?;
