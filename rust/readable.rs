@@ -69,25 +69,12 @@ fn fast_digits(x: f64) -> Option<(bool, u8, i32)> {
     Some((x < 0.0, digits as u8, e))
 }
 
-/// appends the decimal digits of `v`.
+/// appends the decimal digits of `v`, with its sign.
 fn push_int(out: &mut String, v: i32) {
     if v < 0 {
         out.push('-');
     }
-    let mut u = v.unsigned_abs();
-    let mut buf = [0u8; 10];
-    let mut at = buf.len();
-    loop {
-        at -= 1;
-        buf[at] = b'0' + (u % 10) as u8;
-        u /= 10;
-        if u == 0 {
-            break;
-        }
-    }
-    for &b in &buf[at..] {
-        out.push(char::from(b));
-    }
+    push_count(out, v.unsigned_abs() as usize);
 }
 
 /// appends the decimal digits of `v` (a count in a message).
