@@ -1,7 +1,9 @@
-//! The answers of a batch column by column, gathered per chunk on the worker thread that
-//! solved them (so the per-problem vectors are freed where they were allocated, in parallel)
-//! and joined once on the calling thread: one flat array per field, the per-problem vectors cut
-//! by offsets, the messages one string cut by char offsets.
+//! The answers of a batch column by column: one flat array per field, the per-problem vectors
+//! cut by offsets, the messages one string cut by char offsets. An LCP batch's fixed-size
+//! fields are allocated once and filled in place, each chunk its own rows ([`LcpFixed`]);
+//! the fields whose sizes are known only after the solves (and a contact batch's) are
+//! gathered per chunk on the worker thread that solved them and joined once on the calling
+//! thread.
 
 use std::ops::Range;
 
