@@ -19,7 +19,8 @@
 //! chain against MuJoCo's joint chain).
 //!
 //! NSGS's sweep order, relaxation and sweep limit can be changed for experiments through the
-//! environment: `ORDER=symmetric|backward|forward`, `RELAX=1.3`, `MAXIT=100`; `STICK=1` turns on
+//! environment: `SOLVER=lemke` solves the steps by Lemke on the polyhedral cone (default
+//! settings) instead of NSGS; `ORDER=symmetric|backward|forward`, `RELAX=1.3`, `MAXIT=100`; `STICK=1` turns on
 //! NSGS's sticking-set solve. `QUIET=1` lists no steps, `CONTACTS=K` prints the contacts of the
 //! first K steps; `UNIT=1e-4` builds the dominoes with lengths in that unit (gravity, inertia
 //! and the gap tolerance with them); `THREADS=k` solves each step's islands on k threads (all
@@ -436,6 +437,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let mut settings = StepSettings::new(1e-3, steps);
     settings.gap_tolerance *= unit;
+    if std::env::var("SOLVER").is_ok_and(|v| v == "lemke") {
+        settings.solver = coulomb::step::StepSolver::Lemke(
+            coulomb::contact::PolyhedralSettings::for_dim(scene.dim),
+        );
+    }
     if let (Ok(order), coulomb::step::StepSolver::Nsgs(s)) =
         (std::env::var("ORDER"), &mut settings.solver)
     {

@@ -161,6 +161,12 @@ pub struct LcpSolution {
     pub solutions: Vec<Vec<f64>>,
 }
 
+impl Default for LcpSolution {
+    fn default() -> Self {
+        Self::empty()
+    }
+}
+
 impl LcpSolution {
     /// a solution with nothing in it yet (status `Solved`, empty vectors and message), for
     /// the solvers that fill one in place.

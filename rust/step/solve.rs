@@ -13,7 +13,9 @@ use crate::contact::{
 };
 use crate::error::Result;
 use crate::lcp::lemke::spread;
-use crate::lcp::{solve_lemke_with, LcpRef, LcpStatus, LemkeWorkspace};
+use crate::lcp::{
+    solve_lemke_into, solve_lemke_with, LcpRef, LcpSolution, LcpStatus, LemkeWorkspace,
+};
 
 /// from this many active contacts on, a step's W is assembled in block CSR (its NSGS sweep then
 /// costs O(nnz) instead of O(nc^2)).
@@ -84,6 +86,8 @@ pub(super) struct SolveBuffers {
     pub(super) basis: Vec<u64>,
     /// Lemke's tableau, reused while the LCP keeps its size.
     pub(super) lemke: Option<LemkeWorkspace>,
+    /// Lemke's answer, its vectors and message reused from step to step.
+    lemke_answer: LcpSolution,
     /// on entry to [`solve_step_problem`], whether the warm start holds impulses that a solve
     /// changed (the contacts' [`CandState::corrected`](super::persistence::CandState)); on
     /// exit, whether this solve changed its warm start (NSGS sweeps or Lemke pivots). Such
@@ -139,7 +143,8 @@ pub(super) fn solve_polyhedral_warm(
         settings.warm_start = Some(guess.to_vec());
     }
     let lw = ws.lemke.get_or_insert_with(|| LemkeWorkspace::new(lcp.n));
-    let mut ls = solve_lemke_with(lw, &lref, &settings)?;
+    let ls = &mut ws.lemke_answer;
+    solve_lemke_into(lw, &lref, &settings, ls)?;
     ws.impulse = lcp.impulses(&ls.z);
     ws.velocity.resize(problem.size(), 0.0);
     let mut measures = measure_into(problem, &ws.impulse, &mut ws.velocity);
@@ -160,7 +165,7 @@ pub(super) fn solve_polyhedral_warm(
             let mut u = vec![0.0; problem.size()];
             let m = measure_into(problem, &r, &mut u);
             if other.status == LcpStatus::Solved && m.scaled_error < measures.scaled_error {
-                (ls, measures, ws.impulse, ws.velocity) = (other, m, r, u);
+                (*ls, measures, ws.impulse, ws.velocity) = (other, m, r, u);
             }
         }
     }
