@@ -18,8 +18,8 @@
 //! [`crate::interrupt::poll`]s and the chunks stop between problems, and the batch ends with
 //! [`CoulombError::Interrupted`].
 //!
-//! Input is checked before any work: [`lcp_problems`] and [`contact_problems`] check every
-//! problem's shapes and values and name the failing problem by its index.
+//! Input is checked before any work: [`lcp_problems`], [`lcp_stack`] and [`contact_problems`]
+//! check every problem's shapes and values and name the failing problem by its index.
 
 use std::ops::Range;
 use std::panic::{catch_unwind, resume_unwind, AssertUnwindSafe};
@@ -31,11 +31,14 @@ use rayon::prelude::*;
 use rayon::ThreadPool;
 
 use crate::contact::{self, ContactProblem, ContactSolution};
-use crate::error::{check_finite, CoulombError, Result};
+use crate::error::{CoulombError, Result};
 use crate::interrupt;
-use crate::lcp::kernel::first_non_finite;
 use crate::lcp::{self, LcpRef, LcpSolution, LemkeWorkspace, Method};
 use crate::step::{simulate_joints, Joint, Scene, StepRecord, StepSettings, Trajectory};
+
+mod problems;
+
+pub use problems::{contact_problems, lcp_problems, lcp_stack, LcpSet};
 
 /// the most threads a batch may ask for.
 pub const MAX_THREADS: usize = 1024;
@@ -244,46 +247,6 @@ where
     all.into_iter().collect()
 }
 
-/// Checks the LCPs `(Ms[i], qs[i])` of a batch (`sizes[i]` = n_i, M_i row-major) before any
-/// work, naming the first failing problem: `Shape` for lengths that do not fit, then
-/// `NonFinite` for a NaN or an infinity (all problems' entries in one pass).
-pub fn lcp_problems<'a>(
-    sizes: &[usize],
-    ms: &[&'a [f64]],
-    qs: &[&'a [f64]],
-) -> Result<Vec<LcpRef<'a>>> {
-    if ms.len() != sizes.len() || qs.len() != sizes.len() {
-        return Err(CoulombError::Shape(format!(
-            "Ms and qs must hold the same number of problems, got {} and {}",
-            ms.len(),
-            qs.len()
-        )));
-    }
-    let mut out = Vec::with_capacity(sizes.len());
-    for (i, ((&n, &m), &q)) in sizes.iter().zip(ms).zip(qs).enumerate() {
-        if m.len() != n * n {
-            return Err(CoulombError::Shape(format!(
-                "Ms[{i}] must be {n} x {n} ({} entries), got {} entries",
-                n * n,
-                m.len()
-            )));
-        }
-        if q.len() != n {
-            return Err(CoulombError::Shape(format!(
-                "qs[{i}] has length {} but Ms[{i}] is {n} x {n}",
-                q.len()
-            )));
-        }
-        out.push(LcpRef { n, m, q });
-    }
-    // one pass for every problem; the name is only formatted for a refusal
-    if let Some(i) = first_non_finite(ms, qs) {
-        check_finite(&format!("Ms[{i}]"), ms[i])?;
-        check_finite(&format!("qs[{i}]"), qs[i])?;
-    }
-    Ok(out)
-}
-
 /// The method of problem `i`: `methods` holds one for all problems or one per problem.
 pub fn pick<M>(methods: &[M], i: usize) -> Result<&M> {
     match methods {
@@ -365,39 +328,6 @@ pub fn lap(last: &mut Instant) -> f64 {
     let t = now.duration_since(*last).as_secs_f64();
     *last = now;
     t
-}
-
-/// Checks the friction-contact problems `(Ws[i], qs[i], mus[i])` of a batch (W_i dense,
-/// row-major; `pairs[i]` the anisotropic `(mu_1, mu_2)` pairs or `None`) before any work, as
-/// [`ContactProblem::new`] does, naming the first failing problem.
-pub fn contact_problems<'a>(
-    dim: usize,
-    ws: &[&'a [f64]],
-    qs: &[&'a [f64]],
-    mus: &[&'a [f64]],
-    pairs: &[Option<&'a [f64]>],
-) -> Result<Vec<ContactProblem<'a>>> {
-    let count = ws.len();
-    if qs.len() != count || mus.len() != count || pairs.len() != count {
-        return Err(CoulombError::Shape(format!(
-            "Ws, qs and mus must hold the same number of problems, got {}, {} and {}",
-            count,
-            qs.len(),
-            mus.len()
-        )));
-    }
-    let mut out = Vec::with_capacity(count);
-    for i in 0..count {
-        let p = ContactProblem::new(dim, ws[i], qs[i], mus[i]).map_err(|e| at_problem(i, e))?;
-        let p = match pairs[i] {
-            Some(pp) => p
-                .with_anisotropic_friction(pp)
-                .map_err(|e| at_problem(i, e))?,
-            None => p,
-        };
-        out.push(p);
-    }
-    Ok(out)
 }
 
 /// Solves every friction-contact problem of `problems` with `methods` (one for all, or one

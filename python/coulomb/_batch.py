@@ -71,6 +71,10 @@ def per_problem(value: Any, name: str, count: int) -> list[Any]:
     return list(value)
 
 
+#: the message length the core records for a message kept whole in the overflow.
+_OVERFLOWED = 0xFFFF
+
+
 class BatchResult(Sequence[R], Generic[R]):
     """The answers of a batch: a sequence with one result per problem, in order (``len``,
     indexing, slicing and iteration; each item is the result object the one-at-a-time solve
@@ -107,23 +111,37 @@ class BatchResult(Sequence[R], Generic[R]):
         offsets = np.asarray(columns["offsets"])
         self._offsets = offsets
         self._count = len(offsets) - 1
-        codes = np.asarray(columns["status"])
-        kinds = np.array([Status(s) for s in self._STATUS] or [Status.SOLVED], dtype=object)
-        self.status = kinds[codes] if self._count else np.empty(0, dtype=object)
-        self.success = codes == 0
-        self._messages: str = columns["messages"]
-        self._message_offsets = np.asarray(columns["message_offsets"])
+        self._codes = np.asarray(columns["status"])
+        self.success = self._codes == 0
+        # each message in a slot of bytes filled in place by the core (a longer one whole in
+        # the overflow): no text is joined or decoded until it is read
+        self._message_slot = int(columns["message_slot"])
+        self._message_bytes = np.asarray(columns["message_bytes"])
+        self._message_lengths = np.asarray(columns["message_lengths"])
+        self._message_overflow: Mapping[int, str] = columns["message_overflow"]
         self.wall_time = float(wall_time)
+
+    @property
+    def status(self) -> NDArray[np.object_]:
+        """Per problem, how its solve ended (a :class:`Status`; made when first read)."""
+        made = self.__dict__.get("_status")
+        if made is None:
+            kinds = np.array([Status(s) for s in self._STATUS] or [Status.SOLVED], dtype=object)
+            made = kinds[self._codes] if self._count else np.empty(0, dtype=object)
+            self._status = made
+        return made
 
     @property
     def message(self) -> list[str]:
         """Per problem, one line for a person."""
-        text, off = self._messages, self._message_offsets.tolist()
-        return [text[off[i]:off[i + 1]] for i in range(self._count)]
+        return [self._message(i) for i in range(self._count)]
 
     def _message(self, i: int) -> str:
-        off = self._message_offsets
-        return self._messages[int(off[i]):int(off[i + 1])]
+        n = int(self._message_lengths[i])
+        if n == _OVERFLOWED:
+            return self._message_overflow[i]
+        a = i * self._message_slot
+        return self._message_bytes[a:a + n].tobytes().decode()
 
     def __len__(self) -> int:
         return self._count

@@ -95,8 +95,9 @@ class _ContactSolveDict(TypedDict):
 class _LcpBatchDict(TypedDict):
     """``lcp_solve_batch``: the answers column by column; ``z``, ``w`` flat, problem i at
     ``offsets[i]:offsets[i + 1]``; ``status`` and ``warm_start`` as codes (in the order of
-    ``_LcpStatusName`` and none / accepted / rejected); ``basis`` and ``solutions`` flat with
-    their own offsets; the messages as one string cut by ``message_offsets`` (in chars)."""
+    ``_LcpStatusName`` and none / accepted / rejected); ``basis`` in the layout of ``z``, its
+    first ``basis_count[i]`` entries problem i's; ``solutions`` flat, ``solution_count[i]``
+    vectors of problem i's size each; the messages as in ``_ContactBatchDict``."""
 
     z: _F64
     w: _F64
@@ -115,16 +116,20 @@ class _LcpBatchDict(TypedDict):
     polished: NDArray[np.bool_]
     solve_time: _F64
     basis: _I64
-    basis_offsets: _I64
+    basis_count: _I64
     solutions: _F64
-    solutions_offsets: _I64
-    messages: str
-    message_offsets: _I64
+    solution_count: _I64
+    message_slot: int
+    message_bytes: NDArray[np.uint8]
+    message_lengths: NDArray[np.uint16]
+    message_overflow: dict[int, str]
 
 class _ContactBatchDict(TypedDict):
     """``contact_solve_batch``: the answers column by column; ``impulse``, ``velocity`` flat,
     problem i at ``offsets[i]:offsets[i + 1]``; ``status`` as codes (in the order of
-    ``_ContactStatusName``); the messages as one string cut by ``message_offsets``."""
+    ``_ContactStatusName``); problem i's message is the first ``message_lengths[i]`` UTF-8
+    bytes of its slot ``message_bytes[i * message_slot:(i + 1) * message_slot]``, or
+    ``message_overflow[i]`` when that length is 65535 (a message longer than a slot)."""
 
     impulse: _F64
     velocity: _F64
@@ -140,8 +145,10 @@ class _ContactBatchDict(TypedDict):
     cone_violation: _F64
     dissipation_violation: _F64
     solve_time: _F64
-    messages: str
-    message_offsets: _I64
+    message_slot: int
+    message_bytes: NDArray[np.uint8]
+    message_lengths: NDArray[np.uint16]
+    message_overflow: dict[int, str]
 
 class _SiconosLocalFcDict(TypedDict):
     """``read_siconos_fc`` of a local (``FC2D``/``FC3D``) problem."""

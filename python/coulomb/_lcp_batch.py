@@ -47,8 +47,7 @@ class LcpBatchResult(BatchResult[LcpResult]):
     def _item(self, i: int) -> LcpResult:
         c = self._cols
         n = int(self._offsets[i + 1] - self._offsets[i])
-        ba, bb = int(c["basis_offsets"][i]), int(c["basis_offsets"][i + 1])
-        sa, sb = int(c["solutions_offsets"][i]), int(c["solutions_offsets"][i + 1])
+        sa, sb = self._solution_span(i)
         sols = np.array(c["solutions"][sa:sb])
         out = {
             "success": bool(self.success[i]),
@@ -63,7 +62,7 @@ class LcpBatchResult(BatchResult[LcpResult]):
             "max_complementarity": float(c["max_complementarity"][i]),
             "pivots": int(c["pivots"][i]),
             "iterations": int(c["iterations"][i]),
-            "basis": np.array(c["basis"][ba:bb]),
+            "basis": self._basis(i),
             "warm_start": self._WARM[int(c["warm_start"][i])],
             "pivots_saved": int(c["pivots_saved"][i]),
             "polished": bool(c["polished"][i]),
@@ -77,9 +76,23 @@ class LcpBatchResult(BatchResult[LcpResult]):
     def basis(self) -> list[NDArray[np.int64]]:
         """Per problem, the indices with z_i basic at the end (pass the whole result as the
         next batch's ``warm_start``)."""
-        c = self._cols
-        off = c["basis_offsets"]
-        return [np.array(c["basis"][off[i]:off[i + 1]]) for i in range(len(self))]
+        return [self._basis(i) for i in range(len(self))]
+
+    def _basis(self, i: int) -> NDArray[np.int64]:
+        # in the layout of z: problem i's indices start where its z does
+        a = int(self._offsets[i])
+        return np.array(self._cols["basis"][a:a + int(self._cols["basis_count"][i])])
+
+    def _solution_span(self, i: int) -> tuple[int, int]:
+        """Where problem i's solutions are in the flat ``solutions`` (only enumeration has
+        any; the offsets are summed once, when first needed)."""
+        ends = self.__dict__.get("_solution_ends")
+        if ends is None:
+            c = self._cols
+            sizes = np.diff(self._offsets) * np.asarray(c["solution_count"])
+            ends = np.concatenate(([0], np.cumsum(sizes)))
+            self._solution_ends = ends
+        return int(ends[i]), int(ends[i + 1])
 
 
 def _per_problem_vectors(value: Any, name: str, sizes: list[int]

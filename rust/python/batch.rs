@@ -16,7 +16,7 @@ use pyo3::types::PyDict;
 
 #[path = "batch_columns.rs"]
 mod columns;
-use columns::{ContactColumns, LcpColumns, LcpFixed};
+use columns::{ContactFixed, LcpFixed};
 
 use super::errors::internal_error;
 use super::{settings, signal_hook, to_py};
@@ -283,23 +283,19 @@ fn lcp_solve_batch<'py>(
     let prepared = (|| {
         batch::thread_count(threads)?;
         let engine = lemke_engine(engine)?;
-        let (sizes, m_parts) = mat_slices("Ms", &ms)?;
-        let q_parts = vec_slices("qs", &qs)?;
-        let count = sizes.len();
+        let problems = lcp_set(&ms, &qs)?;
+        let count = problems.len();
         let covers = per_problem("covering_vector", &covering_vector, count)?;
         let initials = per_problem("initial", &initial, count)?;
         let methods = lcp_methods(
             count, method, tol, max_pivots, covers, warm_start, polish, restarts, max_iter,
             relaxation, initials, engine,
         )?;
-        let problems = batch::lcp_problems(&sizes, &m_parts, &q_parts)?;
         Ok((problems, methods))
     })();
     let (problems, methods) = prepared.map_err(|e| to_py(py, e))?;
-    let n = problems.first().map_or(0, |p| p.n);
-    let sizes: Vec<usize> = problems.iter().map(|p| p.n).collect();
-    let mut fixed = LcpFixed::new(&sizes);
-    let ragged = batch_guarded(py, |watch| {
+    let mut fixed = LcpFixed::new(problems.sizes());
+    let tails = batch_guarded(py, |watch| {
         batch::check_methods(&methods, problems.len())?;
         let threads = batch::thread_count(threads)?;
         let ranges = batch::chunk_ranges(problems.len(), threads);
@@ -309,21 +305,39 @@ fn lcp_solve_batch<'py>(
             threads,
             watch,
             rows,
-            |range, rows| {
-                let cols = LcpColumns::new(range.len(), n);
+            |_, rows| {
                 let kept = (LemkeWorkspace::new(0), LcpSolution::empty());
-                (kept, Instant::now(), cols, rows)
+                (kept, Instant::now(), rows)
             },
-            |((ws, s), last, cols, rows), i| {
-                batch::solve_lcp_into(ws, &problems[i], batch::pick(&methods, i)?, s)?;
+            |((ws, s), last, rows), i| {
+                let p = problems.get(i);
+                batch::solve_lcp_into(ws, &p, batch::pick(&methods, i)?, s)?;
                 rows.put(i, s, batch::lap(last));
-                cols.push(s);
                 Ok(())
             },
         )?;
-        Ok(parts.into_iter().map(|(_, _, c, _)| c).collect::<Vec<_>>())
+        Ok(parts
+            .into_iter()
+            .map(|(_, _, rows)| rows.finish())
+            .collect::<Vec<_>>())
     })?;
-    LcpColumns::into_dict(py, fixed, ragged)
+    fixed.into_dict(py, tails)
+}
+
+/// The LCPs of `ms` and `qs`, checked: a stack of equal sizes is read in place, without a
+/// slice per problem.
+fn lcp_set<'a>(ms: &'a Mats<'_>, qs: &'a Vecs<'_>) -> Result<batch::LcpSet<'a>, CoulombError> {
+    if let (Mats::Stack(m), Vecs::Stack(q)) = (ms, qs) {
+        let (sm, sq) = (m.shape(), q.shape());
+        if sm[1] == sm[2] && sq[0] == sm[0] && sq[1] == sm[1] {
+            let m = m.as_slice().map_err(|_| contiguous("Ms"))?;
+            let q = q.as_slice().map_err(|_| contiguous("qs"))?;
+            return batch::lcp_stack(sm[1], sm[0], m, q);
+        }
+    }
+    let (sizes, m_parts) = mat_slices("Ms", ms)?;
+    let q_parts = vec_slices("qs", qs)?;
+    batch::lcp_problems(&sizes, &m_parts, &q_parts).map(batch::LcpSet::List)
 }
 
 /// the options of a contact batch, the same for every problem.
@@ -461,22 +475,30 @@ fn contact_solve_batch<'py>(
         Ok((problems, methods))
     })();
     let (problems, methods) = prepared.map_err(|e| to_py(py, e))?;
-    let n = problems.first().map_or(0, |p| p.dim * p.nc);
-    let parts = batch_guarded(py, |watch| {
+    let mut fixed = ContactFixed::new(problems.iter().map(|p| p.dim * p.nc));
+    let overflow = batch_guarded(py, |watch| {
         batch::check_methods(&methods, problems.len())?;
-        batch::map_chunks(
+        let threads = batch::thread_count(threads)?;
+        let ranges = batch::chunk_ranges(problems.len(), threads);
+        let rows = fixed.rows(&ranges);
+        let parts = batch::map_chunks_seeded(
             problems.len(),
             threads,
             watch,
-            |range| (Instant::now(), ContactColumns::new(range.len(), n)),
-            |(last, cols), i| {
+            rows,
+            |_, rows| (Instant::now(), rows),
+            |(last, rows), i| {
                 let s = contact::solve(&problems[i], batch::pick(&methods, i)?)?;
-                cols.push(&s, batch::lap(last));
+                rows.put(i, &s, batch::lap(last));
                 Ok(())
             },
-        )
+        )?;
+        Ok(parts
+            .into_iter()
+            .map(|(_, rows)| rows.finish())
+            .collect::<Vec<_>>())
     })?;
-    ContactColumns::into_dict(py, parts.into_iter().map(|(_, c)| c).collect())
+    fixed.into_dict(py, overflow)
 }
 
 /// adds this file's functions to `coulomb._core`.

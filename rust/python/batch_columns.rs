@@ -1,9 +1,12 @@
-//! The answers of a batch column by column: one flat array per field, the per-problem vectors
-//! cut by offsets, the messages one string cut by char offsets. An LCP batch's fixed-size
-//! fields are allocated once and filled in place, each chunk its own rows ([`LcpFixed`]);
-//! the fields whose sizes are known only after the solves (and a contact batch's) are
-//! gathered per chunk on the worker thread that solved them and joined once on the calling
-//! thread.
+//! The answers of a batch column by column, allocated once for the whole batch and filled in
+//! place: each chunk of problems is handed its own rows ([`LcpFixed::rows`],
+//! [`ContactFixed::rows`]) and writes them on the worker thread that solved it, so the calling
+//! thread joins nothing and the pages are first touched by the workers, in parallel.
+//!
+//! Every size is known before the solves: a problem's vectors (z and w, or the impulse and
+//! the velocity) from its size, Lemke's basis from it too (at most n indices), and its message
+//! is kept in a slot of [`MESSAGE_SLOT`] bytes. The rare longer message (a failure's
+//! explanation) and an enumeration's solutions are kept by the chunk and gathered at the end.
 
 use std::ops::Range;
 
@@ -15,134 +18,12 @@ use pyo3::types::PyDict;
 use crate::contact::{ContactSolution, ContactStatus};
 use crate::lcp::{LcpSolution, LcpStatus, WarmStart};
 
-/// per-problem vectors, flat, with where each ends.
-struct Ragged<T> {
-    data: Vec<T>,
-    ends: Vec<i64>,
-}
+/// bytes of a problem's message slot: the messages of solves that end normally ("solved in 3
+/// pivots (error 1.8e-16, polished)") fit; a longer one goes to its chunk's overflow.
+const MESSAGE_SLOT: usize = 56;
 
-impl<T: Copy> Ragged<T> {
-    fn new(problems: usize, per_problem: usize) -> Self {
-        Self {
-            data: Vec::with_capacity(problems * per_problem),
-            ends: Vec::with_capacity(problems),
-        }
-    }
-
-    fn push(&mut self, items: impl IntoIterator<Item = T>) {
-        self.data.extend(items);
-        self.ends.push(self.data.len() as i64);
-    }
-
-    /// the chunks' vectors joined, and the offsets (`B + 1`, from 0) of every problem's.
-    fn join<'a>(parts: impl Iterator<Item = &'a Self>) -> (Vec<T>, Vec<i64>)
-    where
-        T: 'a,
-    {
-        let mut data = Vec::new();
-        let mut offsets = vec![0i64];
-        for p in parts {
-            let base = data.len() as i64;
-            data.extend_from_slice(&p.data);
-            offsets.extend(p.ends.iter().map(|e| e + base));
-        }
-        (data, offsets)
-    }
-}
-
-/// per-problem messages, one string, with where each ends (in chars, as Python slices).
-struct Text {
-    all: String,
-    chars: i64,
-    ends: Vec<i64>,
-}
-
-impl Text {
-    fn new(problems: usize) -> Self {
-        Self {
-            all: String::new(),
-            chars: 0,
-            ends: Vec::with_capacity(problems),
-        }
-    }
-
-    fn push(&mut self, t: &str) {
-        self.all.push_str(t);
-        self.chars += if t.is_ascii() {
-            t.len()
-        } else {
-            t.chars().count()
-        } as i64;
-        self.ends.push(self.chars);
-    }
-
-    /// sets `messages` and `message_offsets` in `d` from the chunks' texts.
-    fn join_into<'a>(
-        py: Python<'_>,
-        d: &Bound<'_, PyDict>,
-        parts: impl Iterator<Item = &'a Self>,
-    ) -> PyResult<()> {
-        let mut all = String::new();
-        let mut offsets = vec![0i64];
-        let mut base = 0i64;
-        for p in parts {
-            all.push_str(&p.all);
-            offsets.extend(p.ends.iter().map(|e| e + base));
-            base += p.chars;
-        }
-        d.set_item(intern!(py, "messages"), all)?;
-        d.set_item(
-            intern!(py, "message_offsets"),
-            PyArray1::from_vec(py, offsets),
-        )?;
-        Ok(())
-    }
-}
-
-/// one column over the chunks, joined, as a numpy array.
-fn column<'py, C, T: numpy::Element + Copy>(
-    py: Python<'py>,
-    parts: &[C],
-    f: impl Fn(&C) -> &Vec<T>,
-) -> Bound<'py, PyArray1<T>> {
-    let mut out = Vec::with_capacity(parts.iter().map(|p| f(p).len()).sum());
-    for p in parts {
-        out.extend_from_slice(f(p));
-    }
-    PyArray1::from_vec(py, out)
-}
-
-/// The fixed-size answers of an LCP batch, allocated once for all problems: `z` and `w`
-/// (cut by `offsets`, known from the sizes before any solve), `status` and `warm_start` as
-/// codes (in the order of [`LcpStatus`] and [`WarmStart`]), the measures, the counts,
-/// `polished` and the solve times. Each chunk writes its own rows ([`LcpFixed::rows`]), so
-/// nothing is joined afterwards.
-pub(super) struct LcpFixed {
-    offsets: Vec<i64>,
-    z: Vec<f64>,
-    w: Vec<f64>,
-    status: Vec<u8>,
-    warm: Vec<u8>,
-    measures: [Vec<f64>; 5],
-    counts: [Vec<i64>; 4],
-    polished: Vec<bool>,
-    time: Vec<f64>,
-}
-
-/// One chunk's rows of [`LcpFixed`]: problems `start..`, their vectors from `base` on.
-pub(super) struct LcpRows<'a> {
-    start: usize,
-    base: i64,
-    offsets: &'a [i64],
-    z: &'a mut [f64],
-    w: &'a mut [f64],
-    status: &'a mut [u8],
-    warm: &'a mut [u8],
-    measures: [&'a mut [f64]; 5],
-    counts: [&'a mut [i64]; 4],
-    polished: &'a mut [bool],
-    time: &'a mut [f64],
-}
+/// the length recorded for a message kept in the overflow instead of its slot.
+const OVERFLOWED: u16 = u16::MAX;
 
 /// `v` cut into consecutive pieces of the given lengths (shorter pieces once `v` runs out).
 fn cut<T>(v: &mut [T], lens: impl Iterator<Item = usize>) -> std::vec::IntoIter<&mut [T]> {
@@ -157,70 +38,267 @@ fn cut<T>(v: &mut [T], lens: impl Iterator<Item = usize>) -> std::vec::IntoIter<
     out.into_iter()
 }
 
-impl LcpFixed {
-    /// zeroed columns for problems of sizes `sizes` (the pages are touched by the chunks that
-    /// fill them, in parallel).
-    pub(super) fn new(sizes: &[usize]) -> Self {
+/// What every batch keeps per problem: where its vectors start (`offsets`, `B + 1` from 0),
+/// its status code, its solve time and its message (a slot of [`MESSAGE_SLOT`] UTF-8 bytes and
+/// its length, [`OVERFLOWED`] for a message kept whole in the overflow).
+struct Shared {
+    offsets: Vec<i64>,
+    status: Vec<u8>,
+    time: Vec<f64>,
+    text: Vec<u8>,
+    text_len: Vec<u16>,
+}
+
+/// One chunk's rows of [`Shared`]: problems `start..`, their vectors from `base` on.
+struct SharedRows<'a> {
+    start: usize,
+    base: i64,
+    offsets: &'a [i64],
+    status: &'a mut [u8],
+    time: &'a mut [f64],
+    text: &'a mut [u8],
+    text_len: &'a mut [u16],
+    overflow: Vec<(usize, String)>,
+}
+
+impl Shared {
+    /// zeroed columns for problems whose vectors have the given sizes (zeroed memory is not
+    /// touched before the chunks write it).
+    fn new(sizes: impl ExactSizeIterator<Item = usize>) -> Self {
         let count = sizes.len();
         let mut offsets = Vec::with_capacity(count + 1);
         offsets.push(0i64);
         let mut total = 0i64;
-        for &n in sizes {
+        for n in sizes {
             total += n as i64;
             offsets.push(total);
         }
-        let total = total as usize;
         Self {
             offsets,
+            status: vec![0; count],
+            time: vec![0.0; count],
+            text: vec![0; count * MESSAGE_SLOT],
+            text_len: vec![0; count],
+        }
+    }
+
+    /// the first vector entry of problem i.
+    fn at(&self, i: usize) -> usize {
+        self.offsets.get(i).copied().unwrap_or(0) as usize
+    }
+
+    /// the vector entries of each chunk of `ranges`.
+    fn vec_lens<'r>(&'r self, ranges: &'r [Range<usize>]) -> impl Iterator<Item = usize> + 'r {
+        ranges.iter().map(|r| self.at(r.end) - self.at(r.start))
+    }
+
+    /// the rows of each chunk of `ranges` (consecutive, from problem 0).
+    fn rows(&mut self, ranges: &[Range<usize>]) -> Vec<SharedRows<'_>> {
+        let lens = || ranges.iter().map(|r| r.len());
+        let mut status = cut(&mut self.status, lens());
+        let mut time = cut(&mut self.time, lens());
+        let mut text = cut(&mut self.text, lens().map(|n| n * MESSAGE_SLOT));
+        let mut text_len = cut(&mut self.text_len, lens());
+        let offsets = &self.offsets;
+        ranges
+            .iter()
+            .map(|r| SharedRows {
+                start: r.start,
+                base: offsets.get(r.start).copied().unwrap_or(0),
+                offsets,
+                status: status.next().unwrap_or_default(),
+                time: time.next().unwrap_or_default(),
+                text: text.next().unwrap_or_default(),
+                text_len: text_len.next().unwrap_or_default(),
+                overflow: Vec::new(),
+            })
+            .collect()
+    }
+
+    /// sets the columns in `d`, with the chunks' overflowed messages.
+    fn into_dict<'a>(
+        self,
+        py: Python<'_>,
+        d: &Bound<'_, PyDict>,
+        overflow: impl Iterator<Item = &'a [(usize, String)]>,
+    ) -> PyResult<()> {
+        d.set_item(intern!(py, "offsets"), PyArray1::from_vec(py, self.offsets))?;
+        d.set_item(intern!(py, "status"), PyArray1::from_vec(py, self.status))?;
+        d.set_item(intern!(py, "solve_time"), PyArray1::from_vec(py, self.time))?;
+        d.set_item(intern!(py, "message_slot"), MESSAGE_SLOT)?;
+        d.set_item(
+            intern!(py, "message_bytes"),
+            PyArray1::from_vec(py, self.text),
+        )?;
+        d.set_item(
+            intern!(py, "message_lengths"),
+            PyArray1::from_vec(py, self.text_len),
+        )?;
+        let long = PyDict::new(py);
+        for (i, m) in overflow.flatten() {
+            long.set_item(*i, m.as_str())?;
+        }
+        d.set_item(intern!(py, "message_overflow"), long)?;
+        Ok(())
+    }
+}
+
+impl SharedRows<'_> {
+    /// the range of problem i's vector entries within this chunk's vector rows.
+    fn span(&self, i: usize) -> Range<usize> {
+        let at = |j: usize| (self.offsets.get(j).copied().unwrap_or(0) - self.base) as usize;
+        at(i)..at(i + 1)
+    }
+
+    /// writes problem i's status code, seconds and message.
+    fn put(&mut self, i: usize, status: u8, seconds: f64, message: &str) {
+        let k = i - self.start;
+        self.status[k] = status;
+        self.time[k] = seconds;
+        let bytes = message.as_bytes();
+        if bytes.len() <= MESSAGE_SLOT {
+            self.text[k * MESSAGE_SLOT..k * MESSAGE_SLOT + bytes.len()].copy_from_slice(bytes);
+            self.text_len[k] = bytes.len() as u16;
+        } else {
+            self.text_len[k] = OVERFLOWED;
+            self.overflow.push((i, message.to_owned()));
+        }
+    }
+}
+
+/// `dst[..src.len()] = src` (a solver's vectors have the problem's n entries).
+fn put_vec<T: Copy>(dst: &mut [T], src: impl IntoIterator<Item = T>) {
+    for (o, v) in dst.iter_mut().zip(src) {
+        *o = v;
+    }
+}
+
+const LCP_MEASURES: [&str; 5] = [
+    "error",
+    "scaled_error",
+    "min_z",
+    "min_w",
+    "max_complementarity",
+];
+const LCP_COUNTS: [&str; 4] = ["pivots", "iterations", "pivots_saved", "restarts"];
+
+/// The answers of an LCP batch: `z`, `w` and the basis (at most n indices, in the layout of
+/// z, with their count) cut by `offsets`; `warm_start` as a code (in the order of
+/// [`WarmStart`]), the measures, the counts, `polished`, and the number of solutions an
+/// enumeration found (their entries gathered from the chunks at the end).
+pub(super) struct LcpFixed {
+    shared: Shared,
+    z: Vec<f64>,
+    w: Vec<f64>,
+    basis: Vec<i64>,
+    basis_count: Vec<i64>,
+    solution_count: Vec<i64>,
+    warm: Vec<u8>,
+    measures: [Vec<f64>; 5],
+    counts: [Vec<i64>; 4],
+    polished: Vec<bool>,
+}
+
+/// One chunk's rows of [`LcpFixed`], and the solutions its enumerations found.
+pub(super) struct LcpRows<'a> {
+    shared: SharedRows<'a>,
+    z: &'a mut [f64],
+    w: &'a mut [f64],
+    basis: &'a mut [i64],
+    basis_count: &'a mut [i64],
+    solution_count: &'a mut [i64],
+    warm: &'a mut [u8],
+    measures: [&'a mut [f64]; 5],
+    counts: [&'a mut [i64]; 4],
+    polished: &'a mut [bool],
+    solutions: Vec<f64>,
+}
+
+/// What a chunk of LCPs keeps beyond its rows: its enumerations' solutions and its messages
+/// longer than a slot.
+pub(super) struct LcpTail {
+    solutions: Vec<f64>,
+    overflow: Vec<(usize, String)>,
+}
+
+impl LcpFixed {
+    /// zeroed columns for problems of sizes `sizes`.
+    pub(super) fn new(sizes: impl ExactSizeIterator<Item = usize>) -> Self {
+        let count = sizes.len();
+        let shared = Shared::new(sizes);
+        let total = shared.at(count);
+        Self {
+            shared,
             z: vec![0.0; total],
             w: vec![0.0; total],
-            status: vec![0; count],
+            basis: vec![0; total],
+            basis_count: vec![0; count],
+            solution_count: vec![0; count],
             warm: vec![0; count],
             measures: std::array::from_fn(|_| vec![0.0; count]),
             counts: std::array::from_fn(|_| vec![0; count]),
             polished: vec![false; count],
-            time: vec![0.0; count],
         }
     }
 
     /// the rows of each chunk of `ranges` (consecutive, from problem 0).
     pub(super) fn rows(&mut self, ranges: &[Range<usize>]) -> Vec<LcpRows<'_>> {
         let lens = || ranges.iter().map(|r| r.len());
-        let offsets = &self.offsets;
-        let at = |i: usize| offsets.get(i).copied().unwrap_or(0);
-        let vec_lens = || ranges.iter().map(|r| (at(r.end) - at(r.start)) as usize);
-        let mut z = cut(&mut self.z, vec_lens());
-        let mut w = cut(&mut self.w, vec_lens());
-        let mut status = cut(&mut self.status, lens());
+        let vec_lens: Vec<usize> = self.shared.vec_lens(ranges).collect();
+        let mut z = cut(&mut self.z, vec_lens.iter().copied());
+        let mut w = cut(&mut self.w, vec_lens.iter().copied());
+        let mut basis = cut(&mut self.basis, vec_lens.iter().copied());
+        let mut basis_count = cut(&mut self.basis_count, lens());
+        let mut solution_count = cut(&mut self.solution_count, lens());
         let mut warm = cut(&mut self.warm, lens());
         let mut measures = self.measures.each_mut().map(|m| cut(m, lens()));
         let mut counts = self.counts.each_mut().map(|c| cut(c, lens()));
         let mut polished = cut(&mut self.polished, lens());
-        let mut time = cut(&mut self.time, lens());
-        ranges
-            .iter()
-            .map(|r| LcpRows {
-                start: r.start,
-                base: at(r.start),
-                offsets,
+        self.shared
+            .rows(ranges)
+            .into_iter()
+            .map(|shared| LcpRows {
+                shared,
                 z: z.next().unwrap_or_default(),
                 w: w.next().unwrap_or_default(),
-                status: status.next().unwrap_or_default(),
+                basis: basis.next().unwrap_or_default(),
+                basis_count: basis_count.next().unwrap_or_default(),
+                solution_count: solution_count.next().unwrap_or_default(),
                 warm: warm.next().unwrap_or_default(),
                 measures: measures.each_mut().map(|m| m.next().unwrap_or_default()),
                 counts: counts.each_mut().map(|c| c.next().unwrap_or_default()),
                 polished: polished.next().unwrap_or_default(),
-                time: time.next().unwrap_or_default(),
+                solutions: Vec::new(),
             })
             .collect()
     }
 
-    /// sets the columns in `d` (the keys `coulomb.lcp.LcpBatchResult` reads).
-    fn into_dict(self, py: Python<'_>, d: &Bound<'_, PyDict>) -> PyResult<()> {
+    /// the columns and the chunks' tails as one dict (the keys `coulomb.lcp.LcpBatchResult`
+    /// reads).
+    pub(super) fn into_dict(
+        self,
+        py: Python<'_>,
+        tails: Vec<LcpTail>,
+    ) -> PyResult<Bound<'_, PyDict>> {
+        let d = PyDict::new(py);
+        self.shared
+            .into_dict(py, &d, tails.iter().map(|t| t.overflow.as_slice()))?;
         d.set_item(intern!(py, "z"), PyArray1::from_vec(py, self.z))?;
         d.set_item(intern!(py, "w"), PyArray1::from_vec(py, self.w))?;
-        d.set_item(intern!(py, "offsets"), PyArray1::from_vec(py, self.offsets))?;
-        d.set_item(intern!(py, "status"), PyArray1::from_vec(py, self.status))?;
+        d.set_item(intern!(py, "basis"), PyArray1::from_vec(py, self.basis))?;
+        d.set_item(
+            intern!(py, "basis_count"),
+            PyArray1::from_vec(py, self.basis_count),
+        )?;
+        d.set_item(
+            intern!(py, "solution_count"),
+            PyArray1::from_vec(py, self.solution_count),
+        )?;
+        let solutions: Vec<f64> = tails
+            .iter()
+            .flat_map(|t| t.solutions.iter().copied())
+            .collect();
+        d.set_item(intern!(py, "solutions"), PyArray1::from_vec(py, solutions))?;
         d.set_item(intern!(py, "warm_start"), PyArray1::from_vec(py, self.warm))?;
         for (name, col) in LCP_MEASURES.iter().zip(self.measures) {
             d.set_item(*name, PyArray1::from_vec(py, col))?;
@@ -232,32 +310,26 @@ impl LcpFixed {
             intern!(py, "polished"),
             PyArray1::from_vec(py, self.polished),
         )?;
-        d.set_item(intern!(py, "solve_time"), PyArray1::from_vec(py, self.time))?;
-        Ok(())
+        Ok(d)
     }
 }
 
 impl LcpRows<'_> {
     /// writes problem i's answer (i in this chunk) and the seconds it took.
     pub(super) fn put(&mut self, i: usize, s: &LcpSolution, seconds: f64) {
-        let k = i - self.start;
-        let at = |j: usize| (self.offsets.get(j).copied().unwrap_or(0) - self.base) as usize;
-        let (a, b) = (at(i), at(i + 1));
-        // a solver's z and w have the problem's n entries
-        for (o, v) in self.z[a..b].iter_mut().zip(&s.z) {
-            *o = *v;
+        let k = i - self.shared.start;
+        let span = self.shared.span(i);
+        put_vec(&mut self.z[span.clone()], s.z.iter().copied());
+        put_vec(&mut self.w[span.clone()], s.w.iter().copied());
+        // the basis holds distinct indices below n: it fits the problem's n entries
+        let basis = &mut self.basis[span];
+        let kept = s.basis.len().min(basis.len());
+        put_vec(basis, s.basis[..kept].iter().map(|&b| b as i64));
+        self.basis_count[k] = kept as i64;
+        self.solution_count[k] = s.solutions.len() as i64;
+        for x in &s.solutions {
+            self.solutions.extend_from_slice(x);
         }
-        for (o, v) in self.w[a..b].iter_mut().zip(&s.w) {
-            *o = *v;
-        }
-        self.status[k] = match s.status {
-            LcpStatus::Solved => 0,
-            LcpStatus::RayTermination => 1,
-            LcpStatus::PivotLimit => 2,
-            LcpStatus::IterationLimit => 3,
-            LcpStatus::NumericalFailure => 4,
-            LcpStatus::NoSolution => 5,
-        };
         self.warm[k] = match s.warm_start {
             WarmStart::None => 0,
             WarmStart::Accepted => 1,
@@ -279,79 +351,24 @@ impl LcpRows<'_> {
             col[k] = v as i64;
         }
         self.polished[k] = s.polished;
-        self.time[k] = seconds;
+        let status = match s.status {
+            LcpStatus::Solved => 0,
+            LcpStatus::RayTermination => 1,
+            LcpStatus::PivotLimit => 2,
+            LcpStatus::IterationLimit => 3,
+            LcpStatus::NumericalFailure => 4,
+            LcpStatus::NoSolution => 5,
+        };
+        self.shared.put(i, status, seconds, &s.message);
     }
-}
 
-/// The per-problem answers of a chunk of LCPs whose sizes vary: `basis` and `solutions` with
-/// their own offsets, and the messages.
-pub(super) struct LcpColumns {
-    basis: Ragged<i64>,
-    solutions: Ragged<f64>,
-    messages: Text,
-}
-
-const LCP_MEASURES: [&str; 5] = [
-    "error",
-    "scaled_error",
-    "min_z",
-    "min_w",
-    "max_complementarity",
-];
-const LCP_COUNTS: [&str; 4] = ["pivots", "iterations", "pivots_saved", "restarts"];
-
-impl LcpColumns {
-    /// room for `problems` answers of about `n` unknowns.
-    pub(super) fn new(problems: usize, n: usize) -> Self {
-        Self {
-            basis: Ragged::new(problems, n),
-            solutions: Ragged::new(problems, 0),
-            messages: Text::new(problems),
+    /// what the chunk keeps once its rows are written.
+    pub(super) fn finish(self) -> LcpTail {
+        LcpTail {
+            solutions: self.solutions,
+            overflow: self.shared.overflow,
         }
     }
-
-    /// appends one answer's basis, solutions and message.
-    pub(super) fn push(&mut self, s: &LcpSolution) {
-        self.basis.push(s.basis.iter().map(|&k| k as i64));
-        self.solutions
-            .push(s.solutions.iter().flat_map(|x| x.iter().copied()));
-        self.messages.push(&s.message);
-    }
-
-    /// the fixed columns and the chunks' joined into one dict (the keys
-    /// `coulomb.lcp.LcpBatchResult` reads).
-    pub(super) fn into_dict(
-        py: Python<'_>,
-        fixed: LcpFixed,
-        parts: Vec<Self>,
-    ) -> PyResult<Bound<'_, PyDict>> {
-        let d = PyDict::new(py);
-        fixed.into_dict(py, &d)?;
-        let (b, b_off) = Ragged::join(parts.iter().map(|p| &p.basis));
-        d.set_item(intern!(py, "basis"), PyArray1::from_vec(py, b))?;
-        d.set_item(intern!(py, "basis_offsets"), PyArray1::from_vec(py, b_off))?;
-        let (s, s_off) = Ragged::join(parts.iter().map(|p| &p.solutions));
-        d.set_item(intern!(py, "solutions"), PyArray1::from_vec(py, s))?;
-        d.set_item(
-            intern!(py, "solutions_offsets"),
-            PyArray1::from_vec(py, s_off),
-        )?;
-        Text::join_into(py, &d, parts.iter().map(|p| &p.messages))?;
-        Ok(d)
-    }
-}
-
-/// The answers of a chunk of friction-contact problems: `impulse`, `velocity` (same offsets),
-/// `status` as a code (in the order of [`ContactStatus`]), the sweeps, the measures, the
-/// messages and the solve times.
-pub(super) struct ContactColumns {
-    impulse: Ragged<f64>,
-    velocity: Vec<f64>,
-    status: Vec<u8>,
-    iterations: Vec<i64>,
-    measures: [Vec<f64>; 8],
-    time: Vec<f64>,
-    messages: Text,
 }
 
 const CONTACT_MEASURES: [&str; 8] = [
@@ -365,30 +382,95 @@ const CONTACT_MEASURES: [&str; 8] = [
     "dissipation_violation",
 ];
 
-impl ContactColumns {
-    /// room for `problems` answers of about `n` unknowns.
-    pub(super) fn new(problems: usize, n: usize) -> Self {
+/// The answers of a friction-contact batch: `impulse` and `velocity` cut by `offsets`, the
+/// sweeps and the measures.
+pub(super) struct ContactFixed {
+    shared: Shared,
+    impulse: Vec<f64>,
+    velocity: Vec<f64>,
+    iterations: Vec<i64>,
+    measures: [Vec<f64>; 8],
+}
+
+/// One chunk's rows of [`ContactFixed`].
+pub(super) struct ContactRows<'a> {
+    shared: SharedRows<'a>,
+    impulse: &'a mut [f64],
+    velocity: &'a mut [f64],
+    iterations: &'a mut [i64],
+    measures: [&'a mut [f64]; 8],
+}
+
+impl ContactFixed {
+    /// zeroed columns for problems of `sizes` unknowns.
+    pub(super) fn new(sizes: impl ExactSizeIterator<Item = usize>) -> Self {
+        let count = sizes.len();
+        let shared = Shared::new(sizes);
+        let total = shared.at(count);
         Self {
-            impulse: Ragged::new(problems, n),
-            velocity: Vec::with_capacity(problems * n),
-            status: Vec::with_capacity(problems),
-            iterations: Vec::with_capacity(problems),
-            measures: std::array::from_fn(|_| Vec::with_capacity(problems)),
-            time: Vec::with_capacity(problems),
-            messages: Text::new(problems),
+            shared,
+            impulse: vec![0.0; total],
+            velocity: vec![0.0; total],
+            iterations: vec![0; count],
+            measures: std::array::from_fn(|_| vec![0.0; count]),
         }
     }
 
-    /// appends one answer and the seconds it took.
-    pub(super) fn push(&mut self, s: &ContactSolution, seconds: f64) {
-        self.impulse.push(s.impulse.iter().copied());
-        self.velocity.extend_from_slice(&s.velocity);
-        self.status.push(match s.status {
-            ContactStatus::Solved => 0,
-            ContactStatus::IterationLimit => 1,
-            ContactStatus::NumericalFailure => 2,
-        });
-        self.iterations.push(s.iterations as i64);
+    /// the rows of each chunk of `ranges` (consecutive, from problem 0).
+    pub(super) fn rows(&mut self, ranges: &[Range<usize>]) -> Vec<ContactRows<'_>> {
+        let lens = || ranges.iter().map(|r| r.len());
+        let vec_lens: Vec<usize> = self.shared.vec_lens(ranges).collect();
+        let mut impulse = cut(&mut self.impulse, vec_lens.iter().copied());
+        let mut velocity = cut(&mut self.velocity, vec_lens.iter().copied());
+        let mut iterations = cut(&mut self.iterations, lens());
+        let mut measures = self.measures.each_mut().map(|m| cut(m, lens()));
+        self.shared
+            .rows(ranges)
+            .into_iter()
+            .map(|shared| ContactRows {
+                shared,
+                impulse: impulse.next().unwrap_or_default(),
+                velocity: velocity.next().unwrap_or_default(),
+                iterations: iterations.next().unwrap_or_default(),
+                measures: measures.each_mut().map(|m| m.next().unwrap_or_default()),
+            })
+            .collect()
+    }
+
+    /// the columns and the chunks' overflowed messages as one dict (the keys
+    /// `coulomb.contact.ContactBatchResult` reads).
+    pub(super) fn into_dict(
+        self,
+        py: Python<'_>,
+        overflow: Vec<Vec<(usize, String)>>,
+    ) -> PyResult<Bound<'_, PyDict>> {
+        let d = PyDict::new(py);
+        self.shared
+            .into_dict(py, &d, overflow.iter().map(|o| o.as_slice()))?;
+        d.set_item(intern!(py, "impulse"), PyArray1::from_vec(py, self.impulse))?;
+        d.set_item(
+            intern!(py, "velocity"),
+            PyArray1::from_vec(py, self.velocity),
+        )?;
+        d.set_item(
+            intern!(py, "iterations"),
+            PyArray1::from_vec(py, self.iterations),
+        )?;
+        for (name, col) in CONTACT_MEASURES.iter().zip(self.measures) {
+            d.set_item(*name, PyArray1::from_vec(py, col))?;
+        }
+        Ok(d)
+    }
+}
+
+impl ContactRows<'_> {
+    /// writes problem i's answer (i in this chunk) and the seconds it took.
+    pub(super) fn put(&mut self, i: usize, s: &ContactSolution, seconds: f64) {
+        let k = i - self.shared.start;
+        let span = self.shared.span(i);
+        put_vec(&mut self.impulse[span.clone()], s.impulse.iter().copied());
+        put_vec(&mut self.velocity[span], s.velocity.iter().copied());
+        self.iterations[k] = s.iterations as i64;
         let m = &s.measures;
         let values = [
             m.error,
@@ -401,30 +483,18 @@ impl ContactColumns {
             m.dissipation_violation,
         ];
         for (col, v) in self.measures.iter_mut().zip(values) {
-            col.push(v);
+            col[k] = v;
         }
-        self.time.push(seconds);
-        self.messages.push(&s.message);
+        let status = match s.status {
+            ContactStatus::Solved => 0,
+            ContactStatus::IterationLimit => 1,
+            ContactStatus::NumericalFailure => 2,
+        };
+        self.shared.put(i, status, seconds, &s.message);
     }
 
-    /// the chunks' columns joined into one dict (the keys `coulomb.contact.ContactBatchResult`
-    /// reads).
-    pub(super) fn into_dict(py: Python<'_>, parts: Vec<Self>) -> PyResult<Bound<'_, PyDict>> {
-        let d = PyDict::new(py);
-        let (r, offsets) = Ragged::join(parts.iter().map(|p| &p.impulse));
-        d.set_item(intern!(py, "impulse"), PyArray1::from_vec(py, r))?;
-        d.set_item(intern!(py, "velocity"), column(py, &parts, |p| &p.velocity))?;
-        d.set_item(intern!(py, "offsets"), PyArray1::from_vec(py, offsets))?;
-        d.set_item(intern!(py, "status"), column(py, &parts, |p| &p.status))?;
-        d.set_item(
-            intern!(py, "iterations"),
-            column(py, &parts, |p| &p.iterations),
-        )?;
-        for (k, name) in CONTACT_MEASURES.iter().enumerate() {
-            d.set_item(*name, column(py, &parts, |p| &p.measures[k]))?;
-        }
-        d.set_item(intern!(py, "solve_time"), column(py, &parts, |p| &p.time))?;
-        Text::join_into(py, &d, parts.iter().map(|p| &p.messages))?;
-        Ok(d)
+    /// the chunk's messages longer than a slot.
+    pub(super) fn finish(self) -> Vec<(usize, String)> {
+        self.shared.overflow
     }
 }

@@ -122,6 +122,38 @@ def test_enumeration_and_warm_starts_per_problem():
         assert r.z.tobytes() == c.z.tobytes() or np.allclose(r.z, c.z, rtol=1e-12, atol=1e-15)
 
 
+def test_failures_and_long_messages_are_those_of_the_single_solves():
+    # the core keeps a message in a fixed slot of bytes, a longer one whole beside it: both
+    # kinds, in every chunk, read back as the single solve's text
+    rng = np.random.default_rng(12)
+    pairs = []
+    for k in range(64):
+        if k % 3 == 0:  # no solution: Lemke ends on a ray
+            pairs.append((-(1.0 + k) * np.eye(3), -1.0 - np.abs(rng.standard_normal(3))))
+        else:
+            pairs.append(spd(3, rng))
+    spd_only = [p for k, p in enumerate(pairs) if k % 3]
+    for method, opts, some in (("lemke", {}, pairs), ("pgs", {"max_iter": 3}, spd_only)):
+        Ms, qs = np.stack([p[0] for p in some]), np.stack([p[1] for p in some])
+        single = [lcp.solve(M, q, method, **opts) for M, q in some]
+        lengths = {len(s.message.encode()) for s in single}
+        assert min(lengths) <= 56 and (method == "pgs" or max(lengths) > 56), lengths
+        for threads in (1, 2):
+            out = lcp.solve_batch(Ms, qs, method, threads=threads, **opts)
+            assert out.message == [s.message for s in single]
+            assert not out.success.all()
+            for r, s in zip(out, single, strict=True):
+                same(r, s)
+    probs = [contact_problem(3, 3, rng) for _ in range(8)]
+    for opts in ({"max_iter": 1}, {}):
+        single = [contact.solve(W, q, mu, 3, "nsgs", **opts) for W, q, mu in probs]
+        out = contact.solve_batch([p[0] for p in probs], [p[1] for p in probs],
+                                  [p[2] for p in probs], 3, "nsgs", threads=2, **opts)
+        assert out.message == [s.message for s in single]
+        for r, s in zip(out, single, strict=True):
+            same(r, s)
+
+
 def test_options_are_those_of_the_single_solve():
     rng = np.random.default_rng(4)
     pairs = [spd(5, rng) for _ in range(4)]
