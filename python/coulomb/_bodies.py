@@ -125,15 +125,15 @@ class RigidBody3D(Body):
             raise InvalidParameterError("inertia must be symmetric")
         if np.linalg.eigvalsh(j).min() <= 0.0:
             raise InvalidParameterError("inertia must be positive definite")
-        quat = np.asarray(_vector("orientation", self.orientation, 4))
-        norm = float(np.linalg.norm(quat))
+        given = np.asarray(_vector("orientation", self.orientation, 4))
+        norm = float(np.linalg.norm(given))
         if norm == 0.0:
             raise InvalidParameterError("orientation quaternion must be nonzero")
         return {
             "kind": "spatial",
             "mass": _positive("mass", self.mass),
             "inertia": j.reshape(-1).tolist(),
-            "q0": _vector("position", self.position, 3) + (quat / norm).tolist(),
+            "q0": _vector("position", self.position, 3) + (given / norm).tolist(),
             "v0": _vector("velocity", self.velocity, 3)
             + _vector("angular_velocity", self.angular_velocity, 3),
         }

@@ -42,7 +42,7 @@ def energy_gain(tr: Trajectory) -> np.ndarray:
     e, w = tr.total_energy, 0.5 * tr.h * tr.load_power
     gain = np.diff(e) - np.abs(np.diff(w))
     start = 0  # the state before the landing step of the current run of rebounds
-    for k in np.flatnonzero(tr.resumed):
+    for k in map(int, np.flatnonzero(tr.resumed)):
         if k < 1:
             continue
         if not tr.resumed[k - 1]:
