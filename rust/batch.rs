@@ -247,6 +247,41 @@ where
     all.into_iter().collect()
 }
 
+/// [`map_chunks_seeded`]'s work as one chunk on the calling thread, inside
+/// [`interrupt::run`] with `hook` (a batch too small to pay for waking the pool's threads, or
+/// one asked to run on one thread): the same answers, `hook` asked as a single solve asks it
+/// (from the solver loops, and between problems every few thousand).
+pub fn map_inline<T, S, I, F>(
+    count: usize,
+    hook: fn() -> bool,
+    seed: T,
+    init: I,
+    f: F,
+) -> Result<Vec<S>>
+where
+    I: FnOnce(Range<usize>, T) -> S,
+    F: Fn(&mut S, usize) -> Result<()>,
+{
+    if count == 0 {
+        return Ok(Vec::new());
+    }
+    interrupt::run(hook, || {
+        let mut state = init(0..count, seed);
+        for i in 0..count {
+            // a stop asked for ends the run here: `run` then returns `Interrupted`
+            if interrupt::poll(BETWEEN_PROBLEMS) {
+                break;
+            }
+            f(&mut state, i).map_err(|e| at_problem(i, e))?;
+        }
+        Ok(vec![state])
+    })
+}
+
+/// the work [`map_inline`] counts between two problems (units of [`interrupt::poll`]): the
+/// hook is asked at least every `WORK_PER_CLOCK / BETWEEN_PROBLEMS` = 4,096 problems.
+const BETWEEN_PROBLEMS: usize = 64;
+
 /// The method of problem `i`: `methods` holds one for all problems or one per problem.
 pub fn pick<M>(methods: &[M], i: usize) -> Result<&M> {
     match methods {

@@ -151,7 +151,9 @@ def solve_batch(
         One guessed basis (or None) per problem, as :func:`solve` takes it; a previous
         batch's result gives each problem its basis.
     threads : int, optional
-        Threads to solve on, in [1, 1024] (default: all the cores).
+        Threads to solve on, in [1, 1024] (default: all the cores). With one thread, or for a
+        light batch (one problem, or a few hundred small ones), the calling thread solves it
+        with the GIL released: waking a pool's threads would cost more than the solves.
 
     Returns
     -------

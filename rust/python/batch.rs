@@ -4,7 +4,9 @@
 //! lists of arrays of different sizes; the answers go back column by column (one flat array per
 //! field, with offsets for the per-problem vectors), from which `coulomb.batch` makes each
 //! problem's result object on demand. The GIL is released for the whole batch; the calling
-//! thread checks for Ctrl-C while the pool works.
+//! thread checks for Ctrl-C while the pool works. A batch asked to run on one thread, or too
+//! light to pay for waking the pool ([`INLINE_WORK`]), is solved on the calling thread under
+//! the single solve's signal hook ([`batch::map_inline`]).
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
@@ -52,6 +54,35 @@ pub(super) fn batch_guarded<T: Send>(
                 .unwrap_or_else(|| "unknown panic".into());
             Err(internal_error(py, &what))
         }
+    }
+}
+
+/// a batch whose problems weigh this little (the sum of `(n_i + 1)^3`, about a Lemke solve's
+/// flops) is solved on the calling thread: waking the pool's sleeping threads costs 70 to 100
+/// microseconds on this project's 2-core virtual machines, about what 250 Lemke solves at
+/// n = 3 cost (a microsecond each).
+const INLINE_WORK: usize = 16_384;
+
+/// whether a batch of problems of `sizes` unknowns runs on the calling thread
+/// ([`batch::map_inline`]): when one thread is asked for, the batch holds one problem, or it
+/// is light.
+fn inline(threads: Option<usize>, sizes: impl ExactSizeIterator<Item = usize>) -> bool {
+    threads == Some(1)
+        || sizes.len() <= 1
+        || sizes
+            .map(|n| (n + 1).saturating_pow(3))
+            .try_fold(0usize, |w, x| {
+                w.checked_add(x).filter(|&t| t <= INLINE_WORK)
+            })
+            .is_some()
+}
+
+/// the chunks of a batch of `count` problems: one when it runs inline.
+fn chunks(count: usize, threads: usize, inline: bool) -> Vec<std::ops::Range<usize>> {
+    if inline && count > 0 {
+        std::iter::once(0..count).collect()
+    } else {
+        batch::chunk_ranges(count, threads)
     }
 }
 
@@ -295,27 +326,35 @@ fn lcp_solve_batch<'py>(
     })();
     let (problems, methods) = prepared.map_err(|e| to_py(py, e))?;
     let mut fixed = LcpFixed::new(problems.sizes());
+    let inline = inline(threads, problems.sizes());
     let tails = batch_guarded(py, |watch| {
         batch::check_methods(&methods, problems.len())?;
         let threads = batch::thread_count(threads)?;
-        let ranges = batch::chunk_ranges(problems.len(), threads);
-        let rows = fixed.rows(&ranges);
-        let parts = batch::map_chunks_seeded(
-            problems.len(),
-            threads,
-            watch,
-            rows,
-            |_, rows| {
-                let kept = (LemkeWorkspace::new(0), LcpSolution::empty());
-                (kept, Instant::now(), rows)
+        let ranges = chunks(problems.len(), threads, inline);
+        let mut rows = fixed.rows(&ranges);
+        let init = |_, rows| {
+            let kept = (LemkeWorkspace::new(0), LcpSolution::empty());
+            (kept, Instant::now(), rows)
+        };
+        let solve = |((ws, s), last, rows): &mut (
+            (LemkeWorkspace, LcpSolution),
+            Instant,
+            columns::LcpRows<'_>,
+        ),
+                     i| {
+            let p = problems.get(i);
+            batch::solve_lcp_into(ws, &p, batch::pick(&methods, i)?, s)?;
+            rows.put(i, s, batch::lap(last));
+            Ok(())
+        };
+        let count = problems.len();
+        let parts = match (inline, rows.len()) {
+            (true, 1) => match rows.pop() {
+                Some(one) => batch::map_inline(count, signal_hook, one, init, solve)?,
+                None => Vec::new(),
             },
-            |((ws, s), last, rows), i| {
-                let p = problems.get(i);
-                batch::solve_lcp_into(ws, &p, batch::pick(&methods, i)?, s)?;
-                rows.put(i, s, batch::lap(last));
-                Ok(())
-            },
-        )?;
+            _ => batch::map_chunks_seeded(count, threads, watch, rows, init, solve)?,
+        };
         Ok(parts
             .into_iter()
             .map(|(_, _, rows)| rows.finish())
@@ -476,23 +515,26 @@ fn contact_solve_batch<'py>(
     })();
     let (problems, methods) = prepared.map_err(|e| to_py(py, e))?;
     let mut fixed = ContactFixed::new(problems.iter().map(|p| p.dim * p.nc));
+    let inline = inline(threads, problems.iter().map(|p| p.dim * p.nc));
     let overflow = batch_guarded(py, |watch| {
         batch::check_methods(&methods, problems.len())?;
         let threads = batch::thread_count(threads)?;
-        let ranges = batch::chunk_ranges(problems.len(), threads);
-        let rows = fixed.rows(&ranges);
-        let parts = batch::map_chunks_seeded(
-            problems.len(),
-            threads,
-            watch,
-            rows,
-            |_, rows| (Instant::now(), rows),
-            |(last, rows), i| {
-                let s = contact::solve(&problems[i], batch::pick(&methods, i)?)?;
-                rows.put(i, &s, batch::lap(last));
-                Ok(())
+        let ranges = chunks(problems.len(), threads, inline);
+        let mut rows = fixed.rows(&ranges);
+        let init = |_, rows| (Instant::now(), rows);
+        let solve = |(last, rows): &mut (Instant, columns::ContactRows<'_>), i| {
+            let s = contact::solve(&problems[i], batch::pick(&methods, i)?)?;
+            rows.put(i, &s, batch::lap(last));
+            Ok(())
+        };
+        let count = problems.len();
+        let parts = match (inline, rows.len()) {
+            (true, 1) => match rows.pop() {
+                Some(one) => batch::map_inline(count, signal_hook, one, init, solve)?,
+                None => Vec::new(),
             },
-        )?;
+            _ => batch::map_chunks_seeded(count, threads, watch, rows, init, solve)?,
+        };
         Ok(parts
             .into_iter()
             .map(|(_, rows)| rows.finish())

@@ -347,11 +347,43 @@ def test_a_batch_releases_the_gil():
     "W, q = redundant(100); coulomb.contact.solve_batch([W, W], [q, q], 0.5, 3, tol=1e-300, "
     "max_iter=10**9)",
     "coulomb.rollout([pile(10), pile(10)], 10000.0, 1e-3, record_every=100)",
+    # solved on the calling thread: one problem, or one thread asked for
+    "M, q = murty(40); coulomb.lcp.solve_batch([M], [q], covering_vector=np.ones(40), "
+    "max_pivots=10**9)",
+    "W, q = redundant(100); coulomb.contact.solve_batch([W, W], [q, q], 0.5, 3, tol=1e-300, "
+    "max_iter=10**9, threads=1)",
 ])
 def test_ctrl_c_stops_a_batch(call):
     got = interrupt(call)
     assert got["outcome"] == "KeyboardInterrupt", got
     assert got["latency"] < BOUND, got
+
+
+def test_a_light_batch_runs_on_the_calling_thread_and_a_heavy_one_on_the_pool():
+    # thread names in a fresh process: the pool's threads are "coulomb-batch-<i>"
+    code = (
+        "import os, numpy as np, coulomb\n"
+        "def names():\n"
+        "    t = f'/proc/{os.getpid()}/task'\n"
+        "    return sorted(open(f'{t}/{k}/comm').read().strip() for k in os.listdir(t))\n"
+        "M = np.stack([np.eye(3) * 2] * 200); q = -np.ones((200, 3))\n"
+        "coulomb.lcp.solve_batch(M, q, threads=2)\n"
+        "coulomb.lcp.solve_batch(M[:1], q[:1], threads=2)\n"
+        "coulomb.lcp.solve_batch(np.stack([np.eye(3)] * 20000), -np.ones((20000, 3)), "
+        "threads=1)\n"
+        "light = names()\n"
+        "coulomb.lcp.solve_batch(np.stack([np.eye(3)] * 20000), -np.ones((20000, 3)), "
+        "threads=2)\n"
+        "pool = lambda ns: sum('coulomb-batch' in n for n in ns)\n"
+        "print(pool(light), pool(names()))\n"
+    )
+    if not os.path.isdir("/proc/self/task"):
+        pytest.skip("needs /proc to name the threads")
+    import subprocess
+    import sys
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True, env={**os.environ, "OPENBLAS_NUM_THREADS": "1"})
+    assert out.stdout.split() == ["0", "2"], out
 
 
 @pytest.mark.skipif(not hasattr(os, "fork"), reason="needs fork")
