@@ -86,6 +86,31 @@ fn chunks(count: usize, threads: usize, inline: bool) -> Vec<std::ops::Range<usi
     }
 }
 
+/// A batch's chunks, each given its rows: as one chunk on the calling thread when `inline`
+/// ([`batch::map_inline`]), else on the pool ([`batch::map_chunks_seeded`]).
+fn run_chunks<T, S, I, F>(
+    count: usize,
+    threads: usize,
+    inline: bool,
+    watch: &mut dyn FnMut() -> bool,
+    mut rows: Vec<T>,
+    init: I,
+    f: F,
+) -> Result<Vec<S>, CoulombError>
+where
+    T: Send,
+    S: Send,
+    I: Fn(std::ops::Range<usize>, T) -> S + Sync,
+    F: Fn(&mut S, usize) -> Result<(), CoulombError> + Sync,
+{
+    if inline && rows.len() == 1 {
+        if let Some(one) = rows.pop() {
+            return batch::map_inline(count, signal_hook, one, init, f);
+        }
+    }
+    batch::map_chunks_seeded(count, threads, watch, rows, init, f)
+}
+
 /// Square matrices: stacked `(B, n, n)` or a list of `(n_i, n_i)` arrays.
 #[derive(FromPyObject)]
 enum Mats<'py> {
@@ -331,7 +356,7 @@ fn lcp_solve_batch<'py>(
         batch::check_methods(&methods, problems.len())?;
         let threads = batch::thread_count(threads)?;
         let ranges = chunks(problems.len(), threads, inline);
-        let mut rows = fixed.rows(&ranges);
+        let rows = fixed.rows(&ranges);
         let init = |_, rows| {
             let kept = (LemkeWorkspace::new(0), LcpSolution::empty());
             (kept, Instant::now(), rows)
@@ -348,13 +373,7 @@ fn lcp_solve_batch<'py>(
             Ok(())
         };
         let count = problems.len();
-        let parts = match (inline, rows.len()) {
-            (true, 1) => match rows.pop() {
-                Some(one) => batch::map_inline(count, signal_hook, one, init, solve)?,
-                None => Vec::new(),
-            },
-            _ => batch::map_chunks_seeded(count, threads, watch, rows, init, solve)?,
-        };
+        let parts = run_chunks(count, threads, inline, watch, rows, init, solve)?;
         Ok(parts
             .into_iter()
             .map(|(_, _, rows)| rows.finish())
@@ -520,7 +539,7 @@ fn contact_solve_batch<'py>(
         batch::check_methods(&methods, problems.len())?;
         let threads = batch::thread_count(threads)?;
         let ranges = chunks(problems.len(), threads, inline);
-        let mut rows = fixed.rows(&ranges);
+        let rows = fixed.rows(&ranges);
         let init = |_, rows| (Instant::now(), rows);
         let solve = |(last, rows): &mut (Instant, columns::ContactRows<'_>), i| {
             let s = contact::solve(&problems[i], batch::pick(&methods, i)?)?;
@@ -528,13 +547,7 @@ fn contact_solve_batch<'py>(
             Ok(())
         };
         let count = problems.len();
-        let parts = match (inline, rows.len()) {
-            (true, 1) => match rows.pop() {
-                Some(one) => batch::map_inline(count, signal_hook, one, init, solve)?,
-                None => Vec::new(),
-            },
-            _ => batch::map_chunks_seeded(count, threads, watch, rows, init, solve)?,
-        };
+        let parts = run_chunks(count, threads, inline, watch, rows, init, solve)?;
         Ok(parts
             .into_iter()
             .map(|(_, rows)| rows.finish())
