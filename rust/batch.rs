@@ -501,6 +501,64 @@ mod tests {
     }
 
     #[test]
+    fn an_inline_batch_is_one_chunk_in_order_and_names_its_failing_problem() {
+        let out = map_inline(
+            100,
+            never,
+            7usize,
+            |r, seed| (r, seed, Vec::new()),
+            |(_, seed, v), i| {
+                v.push(i * *seed);
+                Ok(())
+            },
+        )
+        .unwrap();
+        assert_eq!(out.len(), 1);
+        assert_eq!(out[0].0, 0..100);
+        assert_eq!(out[0].2, (0..100).map(|i| 7 * i).collect::<Vec<_>>());
+        let failed = map_inline(
+            10,
+            never,
+            (),
+            |_, ()| (),
+            |(), i| {
+                if i == 4 {
+                    Err(CoulombError::InvalidParameter("bad".into()))
+                } else {
+                    Ok(())
+                }
+            },
+        );
+        match failed {
+            Err(CoulombError::InvalidParameter(m)) => assert!(m.starts_with("problem 4:"), "{m}"),
+            other => panic!("expected an error, got {other:?}"),
+        }
+        assert!(map_inline(0, never, (), |_, ()| (), |(), _| Ok(()))
+            .unwrap()
+            .is_empty());
+    }
+
+    #[test]
+    fn an_inline_batch_stops_when_its_hook_asks() {
+        fn stop() -> bool {
+            true
+        }
+        // every problem counts work, so the hook is asked within a few thousand problems
+        let out = map_inline(
+            usize::MAX,
+            stop,
+            (),
+            |_, ()| 0usize,
+            |done, _| {
+                *done += 1;
+                crate::interrupt::poll(1 << 12);
+                Ok(())
+            },
+        );
+        assert!(matches!(out, Err(CoulombError::Interrupted)), "{out:?}");
+    }
+
+    #[test]
     fn an_empty_batch_returns_nothing() {
         let out = map(0, None, &mut never, || (), |_, i| Ok(i)).unwrap();
         assert!(out.is_empty());
