@@ -63,12 +63,10 @@ impl<'a> LcpSet<'a> {
 
     /// every problem's size, in order.
     pub fn sizes(&self) -> impl ExactSizeIterator<Item = usize> + '_ {
-        let (stack, list) = match self {
-            LcpSet::Stack { n, count, .. } => (Some((*n, *count)), &[][..]),
-            LcpSet::List(v) => (None, v.as_slice()),
-        };
-        let count = stack.map_or(list.len(), |(_, c)| c);
-        (0..count).map(move |i| stack.map_or_else(|| list[i].n, |(n, _)| n))
+        (0..self.len()).map(move |i| match self {
+            LcpSet::Stack { n, .. } => *n,
+            LcpSet::List(v) => v.get(i).map_or(0, |p| p.n),
+        })
     }
 }
 
