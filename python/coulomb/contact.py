@@ -59,7 +59,11 @@ Methods:
     the problem is exactly an LCP, the first such stall is met instead by Lemke's method on the
     contacts that push (grown by those that close), kept only if it passes on the whole problem
     (``message`` then says "2D LCP finish"; Rust ``contact::lcp_finish``): it solves the
-    FCLib granular flow whose rounded W is slightly indefinite and singular. For the
+    FCLib granular flow whose rounded W is slightly indefinite and singular. In 3D the first two
+    stalls solve the polyhedral LCP (8, then 32 directions) on those contacts, up to 500 LCP
+    unknowns: its answer is exact when no contact slides and is then kept ("3D polyhedral
+    LCP finish"), and otherwise Newton restarts from it ("restarted k time(s) from the
+    polyhedral LCP's answer"). For the
     problems where NSGS stalls at tight tolerances (redundant contacts, FCLib BoxesStack and
     OneObject). ``success`` follows the rule below;
     ``iterations`` counts Newton steps (each one sparse LU factorization); ``max_iter`` defaults

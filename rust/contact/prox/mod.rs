@@ -52,8 +52,18 @@
 //! time (a Newton method with an exact ratio test to the first kink cycles between sticking
 //! and sliding at one contact), and Lemke's pivoting can. fc2d_granularflowonwall_02020_00213
 //! is such a problem (BENCHMARKS.md, "The robust mode"). Lemke's dense tableau bounds the
-//! working set at [`super::lcp_finish::MAX_CONTACTS`] contacts. In 3D the polyhedral LCP is an
-//! approximation, so there is no such finish.
+//! working set at [`super::lcp_finish::MAX_CONTACTS`] contacts.
+//!
+//! In 3D the polyhedral LCP is an approximation, exact only for contacts that separate or
+//! stick (see [`super::lcp_finish`]). At each of the first two stalls it is solved (8, then 32
+//! directions) on the contacts that push or close, when that LCP has at most
+//! [`super::lcp_finish::MAX_UNKNOWNS_3D`] unknowns: its answer is kept when it passes on the
+//! exact problem (no contact slides), and otherwise Newton restarts from it in place of the
+//! NSGS sweeps, with eta at its floor: the start is near an answer, whose contact statuses
+//! the polygon has found together, and full steps reach it (restarting with the initial eta
+//! instead gave back about half of what the finish gains, docs/properties.md). A solve still
+//! unsolved at the end tries the whole problem's polyhedral LCPs, keeping an answer only when
+//! it passes.
 //!
 //! Why eta = 0.1 by default, and why the proximal loop is Newton's and not NSGS's: a large
 //! eta (10) makes every step a short projected step and fails where the problem is stiff; a
@@ -73,7 +83,7 @@ mod jacobian;
 mod newton;
 mod restart;
 
-use super::lcp_finish::{finish_2d, finish_2d_whole};
+use super::lcp_finish::{finish_2d, finish_2d_whole, polyhedral_3d, polyhedral_3d_whole, Finish};
 use super::projection::project_cone;
 use super::{measure_into, ContactMeasures, ContactProblem, ContactSolution, ContactStatus};
 use crate::error::{CoulombError, Result};
@@ -119,16 +129,40 @@ const MAX_RESTARTS: usize = 10;
 /// Newton steps taken after the test passes, for an answer whose projection on the cones
 /// passes too.
 const FEASIBILITY_STEPS: usize = 3;
+/// the polygons' directions of the 3D finish, one per stall (see the module notes).
+const FACETS_3D: [usize; 2] = [8, 32];
 
-/// How a run of [`solve_prox`] ended: Newton steps, restarts, the last eta, whether the
-/// restarts were spent, and the 2D LCP finish (working-set contacts, rounds, pivots) when it
-/// gave the answer.
+/// The LCP finish that gave the answer: its directions per contact (2 in 2D), working-set
+/// contacts, rounds and pivots.
+#[derive(Clone, Copy)]
+struct Finished {
+    facets: usize,
+    contacts: usize,
+    rounds: usize,
+    pivots: usize,
+}
+
+impl Finished {
+    fn of(fin: &Finish, facets: usize) -> Self {
+        Self {
+            facets,
+            contacts: fin.contacts,
+            rounds: fin.rounds,
+            pivots: fin.pivots,
+        }
+    }
+}
+
+/// How a run of [`solve_prox`] ended: Newton steps, restarts (from NSGS sweeps, and from the
+/// 3D polyhedral LCP's answers), the last eta, whether the restarts were spent, and the LCP
+/// finish when it gave the answer.
 struct Run {
     iterations: usize,
     restarts: usize,
+    polygon_starts: usize,
     eta: f64,
     stalled: bool,
-    finish: Option<(usize, usize, usize)>,
+    finish: Option<Finished>,
 }
 
 impl Run {
@@ -144,17 +178,37 @@ impl Run {
         let Self {
             iterations,
             restarts,
+            polygon_starts,
             eta,
             stalled,
             finish,
         } = *self;
-        let finished = match finish {
-            Some((contacts, rounds, pivots)) => format!(
+        let mut finished = match finish {
+            Some(Finished {
+                facets: 2,
+                contacts,
+                rounds,
+                pivots,
+            }) => format!(
                 " and the 2D LCP finish (Lemke, {pivots} pivots in {rounds} rounds on {contacts} of \
                  {nc} contacts)"
             ),
+            Some(Finished {
+                facets,
+                contacts,
+                rounds,
+                pivots,
+            }) => format!(
+                " and the 3D polyhedral LCP finish ({facets} directions, Lemke, {pivots} pivots in \
+                 {rounds} rounds on {contacts} of {nc} contacts; no contact slides)"
+            ),
             None => String::new(),
         };
+        if polygon_starts > 0 && finish.is_none() {
+            finished = format!(
+                ", restarted {polygon_starts} time(s) from the polyhedral LCP's answer{finished}"
+            );
+        }
         if measures.passes(s.tol) {
             (
                 ContactStatus::Solved,
@@ -260,7 +314,10 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
     let mut extra = 0usize;
     // the 2D LCP finish: tried once; (working-set contacts, rounds, pivots) when it solved
     let mut finish_tried = false;
-    let mut finish: Option<(usize, usize, usize)> = None;
+    let mut finish: Option<Finished> = None;
+    // the 3D polyhedral finishes tried (one per stall, see FACETS_3D), and the Newton
+    // restarts from their answers
+    let (mut polygon_tries, mut polygon_starts) = (0usize, 0usize);
     while iterations < s.max_iter {
         if crate::interrupt::poll(problem.size() * problem.size()) {
             break; // the caller's interrupt hook asked to stop (see crate::interrupt)
@@ -288,11 +345,31 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
             if !finish_tried && dim == 2 {
                 finish_tried = true;
                 if let Some(fin) = finish_2d(problem, &r, s.tol)? {
-                    r = fin.impulse;
-                    u = fin.velocity;
-                    measures = fin.measures;
-                    finish = Some((fin.contacts, fin.rounds, fin.pivots));
+                    finish = Some(Finished::of(&fin, 2));
+                    (r, u, measures) = (fin.impulse, fin.velocity, fin.measures);
                     break;
+                }
+            }
+            // in 3D, the polyhedral LCP: the answer if no contact slides, else a start
+            if dim == 3 && polygon_tries < FACETS_3D.len() {
+                let facets = FACETS_3D[polygon_tries];
+                polygon_tries += 1;
+                if let Some(fin) = polyhedral_3d(problem, (&r, &u), facets, s.tol)? {
+                    let passes = fin.measures.passes(s.tol);
+                    if passes {
+                        finish = Some(Finished::of(&fin, facets));
+                    }
+                    (r, u, measures) = (fin.impulse, fin.velocity, fin.measures);
+                    if passes {
+                        break;
+                    }
+                    polygon_starts += 1;
+                    phi = natural_map(dim, problem.mu, &rho, &r, &u, &mut f);
+                    stalled = false;
+                    eta = ETA_MIN;
+                    phi_mark = phi;
+                    iter_mark = iterations;
+                    continue;
                 }
             }
             // restart from NSGS sweeps (see the module notes)
@@ -381,15 +458,26 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
     // have missed the answer's contacts, or the stall came only at the end of the budget)
     if dim == 2 && !measures.passes(s.tol) && nc <= super::lcp_finish::MAX_CONTACTS {
         if let Some(fin) = finish_2d_whole(problem, s.tol)? {
-            r = fin.impulse;
-            u = fin.velocity;
-            measures = fin.measures;
-            finish = Some((fin.contacts, fin.rounds, fin.pivots));
+            finish = Some(Finished::of(&fin, 2));
+            (r, u, measures) = (fin.impulse, fin.velocity, fin.measures);
+        }
+    }
+    // 3D, not solved: the whole problem's polyhedral LCPs, kept only when one passes
+    if dim == 3 && !measures.passes(s.tol) {
+        for facets in FACETS_3D {
+            if let Some(fin) = polyhedral_3d_whole(problem, facets, s.tol)? {
+                if fin.measures.passes(s.tol) {
+                    finish = Some(Finished::of(&fin, facets));
+                    (r, u, measures) = (fin.impulse, fin.velocity, fin.measures);
+                    break;
+                }
+            }
         }
     }
     let run = Run {
         iterations,
         restarts,
+        polygon_starts,
         eta,
         stalled,
         finish,
