@@ -17,14 +17,11 @@ from __future__ import annotations
 import argparse
 import datetime
 import os
-import pathlib
 import time
 
 import coulomb
 import numpy as np
-
-TARGET = pathlib.Path(__file__).resolve().parent.parent / "BENCHMARKS.md"
-BEGIN, END = "<!-- batch-overhead:begin -->", "<!-- batch-overhead:end -->"
+from markers import write_block
 
 
 def problems(count: int, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
@@ -109,14 +106,7 @@ def main() -> int:
     print(body)
     if args.no_write:
         return 0
-    text = TARGET.read_text()
-    block = f"{BEGIN}\n{body}\n{END}"
-    if BEGIN in text and END in text:
-        text = text[:text.index(BEGIN)] + block + text[text.index(END) + len(END):]
-    else:
-        anchor = "<!-- peer-batch:end -->"
-        text = text.replace(anchor, anchor + "\n\n" + block, 1)
-    TARGET.write_text(text)
+    write_block("batch-overhead", body, after="peer-batch")
     return 0
 
 

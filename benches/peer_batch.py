@@ -40,11 +40,9 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import coulomb
 import numpy as np
+from markers import write_block
 
 ROOT = Path(__file__).resolve().parent.parent
-TARGET = ROOT / "BENCHMARKS.md"
-BEGIN = "<!-- peer-batch:begin -->"
-END = "<!-- peer-batch:end -->"
 HEADING = "## Batches"
 
 
@@ -321,13 +319,7 @@ def main() -> int:
     print(body)
     if args.no_write:
         return 0
-    text = TARGET.read_text()
-    block = f"{BEGIN}\n{body}\n{END}"
-    if BEGIN in text and END in text:
-        text = text[:text.index(BEGIN)] + block + text[text.index(END) + len(END):]
-    else:
-        text = text.rstrip("\n") + f"\n\n{HEADING}\n\n" + block + "\n"
-    TARGET.write_text(text)
+    write_block("peer-batch", body, heading=HEADING)
     return 0
 
 

@@ -35,10 +35,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from markers import write_block
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
-BEGIN_MARKER = "<!-- contact-peers:begin -->"
-END_MARKER = "<!-- contact-peers:end -->"
 SYSTEM_PYTHON = "/usr/bin/python3"
 QUICK = (
     "BoxesStack1-i100000-32",
@@ -339,15 +338,7 @@ def profile(runs: list[Run], solvers: list[str], tols: list[float], path: Path) 
 
 
 def write_markers(target: Path, body: str) -> None:
-    text = target.read_text() if target.exists() else ""
-    block = f"{BEGIN_MARKER}\n{body}\n{END_MARKER}"
-    if BEGIN_MARKER in text and END_MARKER in text:
-        start = text.index(BEGIN_MARKER)
-        end = text.index(END_MARKER) + len(END_MARKER)
-        text = text[:start] + block + text[end:]
-    else:
-        text = text.rstrip("\n") + "\n\n## Contact solvers against peers\n\n" + block + "\n"
-    target.write_text(text)
+    write_block("contact-peers", body, target, heading="## Contact solvers against peers")
 
 
 def main() -> None:

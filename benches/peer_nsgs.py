@@ -41,10 +41,9 @@ from pathlib import Path
 
 import numpy as np
 import scipy.sparse as sp
+from markers import write_block
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
-BEGIN = "<!-- nsgs-peers:begin -->"
-END = "<!-- nsgs-peers:end -->"
 SYSTEM_PYTHON = "/usr/bin/python3"
 
 
@@ -311,14 +310,8 @@ def main() -> None:
         else "Siconos not run.",
     ]
     body = "\n".join(lines)
-    text = args.output.read_text() if args.output.exists() else ""
-    block = f"{BEGIN}\n{body}\n{END}"
-    if BEGIN in text and END in text:
-        text = text[: text.index(BEGIN)] + block + text[text.index(END) + len(END):]
-    else:
-        head = "### NSGS against Siconos NSGS, sweep for sweep"
-        text = text.rstrip("\n") + f"\n\n{head}\n\n" + block + "\n"
-    args.output.write_text(text)
+    write_block("nsgs-peers", body, args.output,
+                heading="### NSGS against Siconos NSGS, sweep for sweep")
     print(body)
 
 

@@ -31,18 +31,17 @@ import json
 import math
 import os
 import platform
-import re
 import resource
 import subprocess
 import sys
 import time
 from pathlib import Path
 
+from markers import write_block
+
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 ROOT = Path(__file__).resolve().parents[1]
-BEGIN = "<!-- peer-scale:begin -->"
-END = "<!-- peer-scale:end -->"
 HEADING = "### The stepper's cost against the size of the scene"
 PLOT = ROOT / "benches" / "scale.png"
 G0 = 9.81
@@ -225,15 +224,7 @@ def plot(results: list[dict]) -> str:
 
 
 def write(block: str) -> None:
-    bench = ROOT / "BENCHMARKS.md"
-    text = bench.read_text()
-    wrapped = f"{BEGIN}\n{block}\n{END}"
-    if BEGIN in text:
-        text = re.sub(re.escape(BEGIN) + r".*?" + re.escape(END), lambda _: wrapped, text,
-                      flags=re.S)
-    else:
-        text = text.rstrip("\n") + "\n\n" + wrapped + "\n"
-    bench.write_text(text)
+    write_block("peer-scale", block)
 
 
 def main() -> int:

@@ -18,7 +18,6 @@ import itertools
 import math
 import os
 import platform
-import re
 import subprocess
 import sys
 import time
@@ -31,6 +30,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import coulomb
 import mujoco_scenes as mj
 from coulomb import Box, HalfSpace, Revolute, RigidBody3D, Scene, Sphere
+from markers import BENCHMARKS, write_block
 
 ROOT = Path(__file__).resolve().parents[1]
 G0 = 9.81
@@ -449,20 +449,8 @@ def main() -> int:
     table = "\n".join(lines)
     print(table)
     if not args.no_write:
-        bench = ROOT / "BENCHMARKS.md"
-        text = bench.read_text()
-        block = f"<!-- step-peers:begin -->\n{table}\n<!-- step-peers:end -->"
-        if "<!-- step-peers:begin -->" in text:
-            text = re.sub(
-                r"<!-- step-peers:begin -->.*?<!-- step-peers:end -->",
-                lambda _: block,
-                text,
-                flags=re.S,
-            )
-        else:
-            text = text.rstrip() + "\n\n" + block + "\n"
-        bench.write_text(text)
-        print(f"wrote {bench}", file=sys.stderr)
+        write_block("step-peers", table)
+        print(f"wrote {BENCHMARKS}", file=sys.stderr)
     return 0
 
 

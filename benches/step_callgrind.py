@@ -28,11 +28,10 @@ import sys
 import tempfile
 from pathlib import Path
 
+from markers import read_block, write_block
+
 ROOT = Path(__file__).resolve().parents[1]
-TARGET = ROOT / "BENCHMARKS.md"
 EXE = ROOT / "target" / "release" / "examples" / "step_profile"
-BEGIN = "<!-- step-callgrind:begin -->"
-END = "<!-- step-callgrind:end -->"
 MEASURE = "coulomb::contact::measures::measure_into"
 
 #: (row name, step_profile arguments)
@@ -140,11 +139,7 @@ def main() -> int:
         total, measure = count(argv)
         mine[name] = (_millions(total), _millions(measure))
         print(f"{name}: {total:,} instructions, measure {measure:,}", file=sys.stderr)
-    text = TARGET.read_text()
-    old = ""
-    if BEGIN in text and END in text:
-        old = text[text.index(BEGIN) + len(BEGIN):text.index(END)]
-    labels, cells = parse_table(old)
+    labels, cells = parse_table(read_block("step-callgrind"))
     labels = [lab for lab in labels if lab != label]
     if len(labels) > 1 + args.keep:
         labels = labels[:1] + labels[len(labels) - args.keep:]
@@ -162,12 +157,7 @@ def main() -> int:
     if args.no_write:
         print(body)
         return 0
-    block = f"{BEGIN}\n{body}\n{END}"
-    if BEGIN in text and END in text:
-        text = text[:text.index(BEGIN)] + block + text[text.index(END) + len(END):]
-    else:
-        text = text.rstrip("\n") + "\n\n" + block + "\n"
-    TARGET.write_text(text)
+    write_block("step-callgrind", body)
     print(body)
     return 0
 

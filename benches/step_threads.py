@@ -22,9 +22,9 @@ import subprocess
 import sys
 from pathlib import Path
 
+from markers import write_block
+
 ROOT = Path(__file__).resolve().parents[1]
-BEGIN = "<!-- step-threads:begin -->"
-END = "<!-- step-threads:end -->"
 SCENES = ["pile 1000 300", "pile 10000 200", "box-pile 216 300", "box-pile 1000 200",
           "dominoes 10 800", "dominoes 20 800", "tower 10 1000"]
 
@@ -89,14 +89,7 @@ def main() -> int:
     block = "\n".join(lines).replace("LOAD", f"{os.getloadavg()[0]:.1f}")
     print(block)
     if not args.no_write:
-        bench = ROOT / "BENCHMARKS.md"
-        text = bench.read_text()
-        wrapped = f"{BEGIN}\n{block}\n{END}"
-        if BEGIN not in text:
-            raise RuntimeError(f"BENCHMARKS.md has no {BEGIN} ... {END} block")
-        text = re.sub(re.escape(BEGIN) + r".*?" + re.escape(END), lambda _: wrapped, text,
-                      flags=re.S)
-        bench.write_text(text)
+        write_block("step-threads", block, required=True)
     return 0
 
 
