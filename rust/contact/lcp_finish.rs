@@ -55,6 +55,16 @@ pub struct Finish {
     pub velocity: Vec<f64>,
     /// the measures of r on the whole original problem.
     pub measures: ContactMeasures,
+    /// how Lemke's method found it.
+    pub run: FinishRun,
+}
+
+/// How a finish ran: the polygon's directions per contact (2 in 2D), the contacts in the last
+/// working set, the working-set rounds (LCP solves) and Lemke's pivots, all rounds together.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FinishRun {
+    /// tangent directions per frictional contact (2 in 2D).
+    pub facets: usize,
     /// contacts in the last working set.
     pub contacts: usize,
     /// working-set rounds (LCP solves).
@@ -209,9 +219,12 @@ fn finish_on(
             impulse: full,
             velocity: u,
             measures,
-            contacts: m,
-            rounds: round,
-            pivots,
+            run: FinishRun {
+                facets: settings.facets,
+                contacts: m,
+                rounds: round,
+                pivots,
+            },
         });
         if passes || !grew {
             return Ok(last);
@@ -240,8 +253,7 @@ mod tests {
         let f = finish_2d(&p, &[1.0, 0.0, 0.0, 0.0], 1e-12)
             .unwrap()
             .expect("solved");
-        assert_eq!(f.rounds, 2);
-        assert_eq!(f.contacts, 2);
+        assert_eq!((f.run.facets, f.run.rounds, f.run.contacts), (2, 2, 2));
         // contact 1 slides: r_n = 1, r_t = -0.3, u_t = 0.2; contact 2 sticks: r_n = 2
         let expect = [1.0, -0.3, 2.0, 0.0];
         for (a, b) in f.impulse.iter().zip(expect) {
@@ -285,7 +297,7 @@ mod tests {
         let h = polyhedral_3d(&p, (&[1.0, 0.0, 0.0, 0.0, 0.0, 0.0], &[0.0; 6]), 8, 1e-10)
             .unwrap()
             .expect("an answer");
-        assert_eq!((h.rounds, h.contacts), (2, 2));
+        assert_eq!((h.run.facets, h.run.rounds, h.run.contacts), (8, 2, 2));
         assert!(h.measures.passes(1e-10));
     }
 

@@ -83,7 +83,9 @@ mod jacobian;
 mod newton;
 mod restart;
 
-use super::lcp_finish::{finish_2d, finish_2d_whole, polyhedral_3d, polyhedral_3d_whole, Finish};
+use super::lcp_finish::{
+    finish_2d, finish_2d_whole, polyhedral_3d, polyhedral_3d_whole, FinishRun,
+};
 use super::projection::project_cone;
 use super::{measure_into, ContactMeasures, ContactProblem, ContactSolution, ContactStatus};
 use crate::error::{CoulombError, Result};
@@ -132,27 +134,6 @@ const FEASIBILITY_STEPS: usize = 3;
 /// the polygons' directions of the 3D finish, one per stall (see the module notes).
 const FACETS_3D: [usize; 2] = [8, 32];
 
-/// The LCP finish that gave the answer: its directions per contact (2 in 2D), working-set
-/// contacts, rounds and pivots.
-#[derive(Clone, Copy)]
-struct Finished {
-    facets: usize,
-    contacts: usize,
-    rounds: usize,
-    pivots: usize,
-}
-
-impl Finished {
-    fn of(fin: &Finish, facets: usize) -> Self {
-        Self {
-            facets,
-            contacts: fin.contacts,
-            rounds: fin.rounds,
-            pivots: fin.pivots,
-        }
-    }
-}
-
 /// How a run of [`solve_prox`] ended: Newton steps, restarts (from NSGS sweeps, and from the
 /// 3D polyhedral LCP's answers), the last eta, whether the restarts were spent, and the LCP
 /// finish when it gave the answer.
@@ -162,7 +143,7 @@ struct Run {
     polygon_starts: usize,
     eta: f64,
     stalled: bool,
-    finish: Option<Finished>,
+    finish: Option<FinishRun>,
 }
 
 impl Run {
@@ -184,7 +165,7 @@ impl Run {
             finish,
         } = *self;
         let mut finished = match finish {
-            Some(Finished {
+            Some(FinishRun {
                 facets: 2,
                 contacts,
                 rounds,
@@ -193,7 +174,7 @@ impl Run {
                 " and the 2D LCP finish (Lemke, {pivots} pivots in {rounds} rounds on {contacts} of \
                  {nc} contacts)"
             ),
-            Some(Finished {
+            Some(FinishRun {
                 facets,
                 contacts,
                 rounds,
@@ -314,7 +295,7 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
     let mut extra = 0usize;
     // the 2D LCP finish: tried once; (working-set contacts, rounds, pivots) when it solved
     let mut finish_tried = false;
-    let mut finish: Option<Finished> = None;
+    let mut finish: Option<FinishRun> = None;
     // the 3D polyhedral finishes tried (one per stall, see FACETS_3D), and the Newton
     // restarts from their answers
     let (mut polygon_tries, mut polygon_starts) = (0usize, 0usize);
@@ -345,7 +326,7 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
             if !finish_tried && dim == 2 {
                 finish_tried = true;
                 if let Some(fin) = finish_2d(problem, &r, s.tol)? {
-                    finish = Some(Finished::of(&fin, 2));
+                    finish = Some(fin.run);
                     (r, u, measures) = (fin.impulse, fin.velocity, fin.measures);
                     break;
                 }
@@ -357,7 +338,7 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
                 if let Some(fin) = polyhedral_3d(problem, (&r, &u), facets, s.tol)? {
                     let passes = fin.measures.passes(s.tol);
                     if passes {
-                        finish = Some(Finished::of(&fin, facets));
+                        finish = Some(fin.run);
                     }
                     (r, u, measures) = (fin.impulse, fin.velocity, fin.measures);
                     if passes {
@@ -456,9 +437,9 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
 
     // 2D, not solved: the whole problem as one LCP (the working set of the first stall may
     // have missed the answer's contacts, or the stall came only at the end of the budget)
-    if dim == 2 && !measures.passes(s.tol) && nc <= super::lcp_finish::MAX_CONTACTS {
+    if dim == 2 && !measures.passes(s.tol) {
         if let Some(fin) = finish_2d_whole(problem, s.tol)? {
-            finish = Some(Finished::of(&fin, 2));
+            finish = Some(fin.run);
             (r, u, measures) = (fin.impulse, fin.velocity, fin.measures);
         }
     }
@@ -467,7 +448,7 @@ pub fn solve_prox(problem: &ContactProblem<'_>, s: &ProxSettings) -> Result<Cont
         for facets in FACETS_3D {
             if let Some(fin) = polyhedral_3d_whole(problem, facets, s.tol)? {
                 if fin.measures.passes(s.tol) {
-                    finish = Some(Finished::of(&fin, facets));
+                    finish = Some(fin.run);
                     (r, u, measures) = (fin.impulse, fin.velocity, fin.measures);
                     break;
                 }
