@@ -26,6 +26,8 @@ fn settings() -> NsgsSettings {
     NsgsSettings {
         tol: 1e-300,
         max_iter: SWEEPS,
+        // plain sweeps: the cost of one sweep, not of a sticking-set solve
+        sticking: false,
         ..Default::default()
     }
 }

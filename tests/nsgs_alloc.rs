@@ -20,6 +20,8 @@ fn allocations(
         tol: 1e-300,
         max_iter: sweeps,
         initial: warm.map(|w| w.to_vec()),
+        // the sweeps alone: the sticking-set solve factors a matrix when it is tried
+        sticking: false,
         ..Default::default()
     };
     let before = count();

@@ -46,6 +46,7 @@ fn main() {
     let s = NsgsSettings {
         tol: 1e-300,
         max_iter: sweeps,
+        sticking: false,
         ..Default::default()
     };
     let (nc, solution) = match args.get(2).map(String::as_str) {

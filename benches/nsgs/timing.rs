@@ -80,6 +80,8 @@ fn main() {
         let s = NsgsSettings {
             tol: 1e-300,
             max_iter: sweeps,
+            // plain sweeps: the cost of one sweep, not of a sticking-set solve
+            sticking: false,
             ..Default::default()
         };
         let one = NsgsSettings {

@@ -120,6 +120,7 @@ def solve_batch(
     facets: int | None = None,
     eta: float | None = None,
     order: str = "forward",
+    sticking: bool = True,
     settings: NSGSSettings | PolyhedralSettings | ProxSettings | None = None,
     threads: int | None = None,
 ) -> ContactBatchResult:
@@ -140,7 +141,7 @@ def solve_batch(
         One friction coefficient for every contact of every problem, one row of coefficients
         per problem, or per problem anything :func:`solve` takes as ``mu`` (a scalar, ``(nc,)``
         or anisotropic ``(nc, 2)``).
-    dim, method, tol, max_iter, relaxation, facets, eta, settings
+    dim, method, tol, max_iter, relaxation, facets, eta, sticking, settings
         As for :func:`solve`, the same for every problem.
     initial : sequence, optional
         One warm start (``(nc, dim)`` or ``(dim nc,)``, or None) per problem (``"nsgs"`` and
@@ -167,6 +168,7 @@ def solve_batch(
         dim, method, tol, max_iter, relaxation, facets, eta)
     if method != "prox" and eta is not None:
         raise InvalidParameterError("eta applies to method='prox' only")
+    sticks = _validate.sticking(sticking, method)
     if method == "lemke":
         if initial is not None:
             raise InvalidParameterError(
@@ -222,6 +224,6 @@ def solve_batch(
     out = _core.contact_solve_batch(
         Wa, qa, mua, dim, method, float(tol), None if max_iter is None else int(max_iter),
         float(relaxation), init, facets, pairs, None if eta is None else float(eta), order,
-        n_threads)
+        n_threads, sticks)
     shape = (qa.shape[1] // dim, dim) if isinstance(qa, np.ndarray) else None
     return ContactBatchResult(out, time.perf_counter() - wall, dim, shape)

@@ -253,6 +253,7 @@ def contact_solve(
     eta: float | None = None,
     order: str = "forward",
     permutation: list[int] | None = None,
+    sticking: bool = True,
 ) -> _ContactSolveDict: ...
 def lcp_solve_batch(
     ms: _F64 | list[_F64],
@@ -285,6 +286,7 @@ def contact_solve_batch(
     eta: float | None = None,
     order: str = "forward",
     threads: int | None = None,
+    sticking: bool = True,
 ) -> _ContactBatchDict: ...
 def read_siconos_fc(path: _Path) -> _SiconosLocalFcDict | _SiconosGlobalFcDict: ...
 

@@ -234,6 +234,15 @@ def contact_options(
     return int(dim), t, it, om, fa, et
 
 
+def sticking(value: Any, method: str) -> bool:
+    """The ``sticking`` option of a contact solve: a bool, and off only for ``"nsgs"`` (the
+    other methods have no sweeps to end)."""
+    on = boolean("sticking", value)
+    if not on and method != "nsgs":
+        raise InvalidParameterError(f"sticking does not apply to method={method!r} (nsgs only)")
+    return on
+
+
 def compressed_indices(
     name: str, indptr: Any, indices: Any, major: int, minor: int, where: str = ""
 ) -> tuple[NDArray[np.int64], NDArray[np.int64]]:

@@ -225,6 +225,7 @@ def solve(
     facets: int | None = None,
     eta: float | None = None,
     order: str | ArrayLike = "forward",
+    sticking: bool = True,
     settings: NSGSSettings | PolyhedralSettings | ProxSettings | None = None,
 ) -> ContactResult:
     """Solve the friction-contact problem ``u = W r + q`` with Coulomb's law at every contact.
@@ -271,9 +272,16 @@ def solve(
         ``"nsgs"`` only: the order in which a sweep visits the contacts; ``"symmetric"`` is a
         forward then a backward pass (no directional bias in stacks and chains, twice the cost
         per sweep); an array is a permutation of the contacts.
+    sticking : bool
+        ``"nsgs"`` only: when the sweeps slow down, also try the exact answer on the
+        contacts' current cases, the least-norm impulses that stop the sticking contacts
+        (default True; kept only when it passes ``tol`` or halves ``scaled_error``). False
+        gives plain Gauss-Seidel sweeps, the method the literature's tables time sweep for
+        sweep.
     settings : NSGSSettings, PolyhedralSettings or ProxSettings, optional
         The method and its options as one object (:mod:`coulomb.settings`), in place of
-        ``method`` and ``tol``, ``max_iter``, ``relaxation``, ``order``, ``facets``, ``eta``;
+        ``method`` and ``tol``, ``max_iter``, ``relaxation``, ``order``, ``sticking``,
+        ``facets``, ``eta``;
         ``initial`` combines with it. A keyword also given in it raises
         :class:`~coulomb.errors.SettingsConflictError`.
 
@@ -293,6 +301,7 @@ def solve(
         dim, method, tol, max_iter, relaxation, facets, eta)
     if method != "prox" and eta is not None:
         raise InvalidParameterError("eta applies to method='prox' only")
+    sticks = _validate.sticking(sticking, method)
     if method == "lemke":
         if initial is not None:
             raise InvalidParameterError(
@@ -345,6 +354,7 @@ def solve(
         eta=None if eta is None else float(eta),
         order=order_name,
         permutation=permutation,
+        sticking=sticks,
     )
     return ContactResult(out, status=Status(out["status"]))
 

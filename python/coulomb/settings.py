@@ -10,7 +10,7 @@ problem: ``warm_start``, ``initial``) combine freely with a settings object.
 >>> import coulomb
 >>> fast = coulomb.NSGSSettings(tol=1e-6, max_iter=200)
 >>> fast
-NSGSSettings(tol=1e-06, max_iter=200, relaxation=1.0, order='forward')
+NSGSSettings(tol=1e-06, max_iter=200, relaxation=1.0, order='forward', sticking=True)
 >>> r = coulomb.contact.solve([[0.5, 0.0], [0.0, 0.5]], [-3.0, 1.0], 0.2, dim=2, settings=fast)
 >>> r.status, r.impulse.round(12).tolist()
 (Status.SOLVED, [[6.0, -1.2]])
@@ -131,20 +131,25 @@ class NSGSSettings:
     order : {"forward", "backward", "symmetric"}
         The order a sweep visits the contacts in (default ``"forward"``; the stepper sweeps
         forward only).
+    sticking : bool
+        When the sweeps slow down, also try the exact solve on the contacts' current cases
+        (default True; the stepper always does). False: plain Gauss-Seidel sweeps.
 
     Notes
     -----
-    In the stepper, when the sweeps slow down NSGS also tries the exact solve on the
-    contacts' current cases (stick, slide, separate): the least-norm impulses of the
-    sticking set, which fixes the impulses of redundant face contacts (four corners of a box
-    on a box) where the sweeps drift along the null directions. A ten-box tower then stands
-    with drift at rounding over 10 s at h = 1 ms. :func:`coulomb.contact.solve` does not try it.
+    The sticking-set solve: when the sweeps slow down, NSGS also tries the exact answer on
+    the contacts' current cases (stick, slide, separate), the least-norm impulses of the
+    sticking set, and keeps it only when it passes the tolerance or halves ``scaled_error``.
+    It fixes the impulses of redundant face contacts (four corners of a box on a box), where
+    the sweeps drift along W's null directions: a ten-box tower then stands with drift at
+    rounding over 10 s at h = 1 ms.
     """
 
     tol: float | None = None
     max_iter: int | None = None
     relaxation: float = 1.0
     order: Literal["forward", "backward", "symmetric"] = "forward"
+    sticking: bool = True
 
     def __post_init__(self) -> None:
         _tol(self.tol)
@@ -152,6 +157,7 @@ class NSGSSettings:
         _validate.real("relaxation", self.relaxation, low=0.0, high=2.0, low_open=True,
                        high_open=True)
         _validate.choice("order", self.order, ("forward", "backward", "symmetric"))
+        _validate.boolean("sticking", self.sticking)
 
 
 @dataclass(frozen=True)
@@ -260,6 +266,10 @@ class StepSettings:
         if isinstance(self.solver, NSGSSettings) and self.solver.order != "forward":
             raise InvalidParameterError(
                 "the stepper's NSGS sweeps the contacts forward: leave order out")
+        if isinstance(self.solver, NSGSSettings) and not self.solver.sticking:
+            raise InvalidParameterError(
+                "the stepper's NSGS always tries the sticking-set solve (a face's redundant "
+                "contacts drift without it): leave sticking out")
         _validate.real("gap_tolerance", self.gap_tolerance, low=0.0)
         _validate.boolean("warm_start", self.warm_start)
         _validate.boolean("fallback", self.fallback)
@@ -290,7 +300,9 @@ def _keywords(settings: Any) -> dict[str, Any]:
         if isinstance(value, (NSGSSettings, PolyhedralSettings)):
             out["solver"] = _METHOD_OF[type(value)]
             sub = _keywords(value)
-            sub.pop("order", None)  # the stepper sweeps forward (checked in StepSettings)
+            # the stepper sweeps forward and tries the sticking set (checked in StepSettings)
+            sub.pop("order", None)
+            sub.pop("sticking", None)
             out.update(sub)
         elif value is not None:
             out[f.name] = value
@@ -302,7 +314,8 @@ def _field_names(settings: Any) -> set[str]:
     for f in dataclasses.fields(settings):
         value = getattr(settings, f.name)
         if isinstance(value, (NSGSSettings, PolyhedralSettings)):
-            names |= {"solver"} | {g.name for g in dataclasses.fields(value)} - {"order"}
+            names |= ({"solver"} | {g.name for g in dataclasses.fields(value)}
+                      - {"order", "sticking"})
         else:
             names.add(f.name)
     return names

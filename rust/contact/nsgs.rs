@@ -34,7 +34,7 @@
 //! contacts' current faces), the iterate moves along that step to the first contact that
 //! changes case, where the sweeps would have taken it ([`extrapolate`]).
 //!
-//! Optionally ([`NsgsSettings::sticking`]), when the error decreases slowly the exact answer
+//! By default ([`NsgsSettings::sticking`]), when the error decreases slowly the exact answer
 //! on the contacts' current cases is tried: the least-norm impulses that stop the sticking
 //! contacts, by one sparse Cholesky factor ([`stick`]); on boxes resting face on face, whose
 //! four coplanar points make W singular, it ends the slow sweeps at once.
@@ -75,8 +75,9 @@ pub struct NsgsSettings {
     /// the order in which a sweep visits the contacts.
     pub order: ContactOrder,
     /// when the sweeps slow down, also try the exact solve on the contacts' current cases
-    /// (the sticking-set solve of redundant face contacts, see the module notes); off by
-    /// default here, on in the stepper's NSGS ([`crate::step::StepSettings::new`]).
+    /// (the sticking-set solve of redundant face contacts, see the module notes); on by
+    /// default. Off, the solve is plain Gauss-Seidel sweeps (the method the literature's
+    /// tables time sweep for sweep).
     pub sticking: bool,
 }
 
@@ -104,7 +105,7 @@ impl Default for NsgsSettings {
             relaxation: 1.0,
             initial: None,
             order: ContactOrder::Forward,
-            sticking: false,
+            sticking: true,
         }
     }
 }

@@ -408,6 +408,7 @@ struct ContactOptions<'a> {
     facets: Option<usize>,
     eta: Option<f64>,
     order: &'a str,
+    sticking: bool,
 }
 
 /// The contact methods of a batch: one for all problems, or one per problem when warm starts
@@ -433,6 +434,7 @@ fn contact_methods(
             o.relaxation,
             init,
             order.clone(),
+            o.sticking,
         ))),
         "lemke" => Ok(contact::Method::Polyhedral(settings::lemke(
             o.dim, o.tol, o.max_iter, o.facets,
@@ -491,7 +493,8 @@ fn optional_slices<'a>(
 /// anisotropic pairs per problem (or None), `initial` the warm starts per problem.
 #[pyfunction]
 #[pyo3(signature = (ws, qs, mus, dim, method, tol, max_iter=None, relaxation=1.0, initial=None,
-                    facets=None, mu_pairs=None, eta=None, order="forward", threads=None))]
+                    facets=None, mu_pairs=None, eta=None, order="forward", threads=None,
+                    sticking=true))]
 #[allow(clippy::too_many_arguments)]
 fn contact_solve_batch<'py>(
     py: Python<'py>,
@@ -509,6 +512,7 @@ fn contact_solve_batch<'py>(
     eta: Option<f64>,
     order: &str,
     threads: Option<usize>,
+    sticking: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let prepared = (|| {
         batch::thread_count(threads)?;
@@ -527,6 +531,7 @@ fn contact_solve_batch<'py>(
             facets,
             eta,
             order,
+            sticking,
         };
         let methods = contact_methods(&options, initials)?;
         let problems = batch::contact_problems(dim, &w_parts, &q_parts, &mu_parts, &pair_parts)?;

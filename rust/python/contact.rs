@@ -121,7 +121,7 @@ fn block_csr(
 #[pyfunction]
 #[pyo3(signature = (w, q, mu, dim, method, tol, max_iter=None, relaxation=1.0, initial=None,
                     facets=None, w_csr=None, mu_pair=None, eta=None,
-                    order="forward", permutation=None))]
+                    order="forward", permutation=None, sticking=true))]
 #[allow(clippy::too_many_arguments)]
 fn contact_solve<'py>(
     py: Python<'py>,
@@ -145,6 +145,7 @@ fn contact_solve<'py>(
     eta: Option<f64>,
     order: &str,
     permutation: Option<Vec<usize>>,
+    sticking: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let qs = slice1(py, "q", &q)?;
     let order = match (order, permutation) {
@@ -172,7 +173,9 @@ fn contact_solve<'py>(
         None => None,
     };
     let settings = match method {
-        "nsgs" => ContactSettings::Nsgs(settings::nsgs(tol, max_iter, relaxation, init, order)),
+        "nsgs" => ContactSettings::Nsgs(settings::nsgs(
+            tol, max_iter, relaxation, init, order, sticking,
+        )),
         "lemke" => ContactSettings::Lemke(settings::lemke(dim, tol, max_iter, facets)),
         "prox" => {
             let d = ProxSettings::default();

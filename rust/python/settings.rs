@@ -146,13 +146,15 @@ pub(super) fn restitution(
 pub(super) const NSGS_MAX_ITER: usize = 1000;
 
 /// Nonsmooth Gauss-Seidel on the exact friction disk: `max_iter` sweeps (default
-/// [`NSGS_MAX_ITER`]), over-relaxation `relaxation`, warm start `initial`, contact order `order`.
+/// [`NSGS_MAX_ITER`]), over-relaxation `relaxation`, warm start `initial`, contact order
+/// `order`, the sticking-set solve when the sweeps slow down unless `sticking` is false.
 pub(super) fn nsgs(
     tol: f64,
     max_iter: Option<usize>,
     relaxation: f64,
     initial: Option<Vec<f64>>,
     order: ContactOrder,
+    sticking: bool,
 ) -> NsgsSettings {
     NsgsSettings {
         tol,
@@ -160,7 +162,7 @@ pub(super) fn nsgs(
         relaxation,
         initial,
         order,
-        sticking: false,
+        sticking,
     }
 }
 

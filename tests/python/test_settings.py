@@ -119,6 +119,7 @@ def test_settings_are_frozen_with_a_readable_repr() -> None:
     s = NSGSSettings(tol=1e-6)
     with pytest.raises(dataclasses.FrozenInstanceError):
         s.tol = 1e-3  # type: ignore[misc]
-    assert repr(s) == "NSGSSettings(tol=1e-06, max_iter=None, relaxation=1.0, order='forward')"
+    assert repr(s) == ("NSGSSettings(tol=1e-06, max_iter=None, relaxation=1.0, order='forward', "
+                       "sticking=True)")
     with pytest.raises(ArgumentTypeError):
         coulomb.lcp.solve(M, Q3, settings=NSGSSettings())

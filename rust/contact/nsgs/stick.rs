@@ -49,6 +49,9 @@ use super::project_friction_cone;
 const DELTA: f64 = 1e-9;
 /// the iterations of the regularised solve at most.
 const REFINE: usize = 6;
+/// the residual of the regularised solve, relative to its right-hand side, above which the
+/// sticking set's equations count as having no solution.
+const CONSISTENT: f64 = 1e-6;
 /// a contact counts as sliding when `||r_t|| >= (1 - INSIDE) mu r_n`.
 const INSIDE: f64 = 1e-9;
 /// the solves at most, each after the previous one's contacts that left their case are fixed.
@@ -328,12 +331,13 @@ impl StickSolve {
         }
         let mut y = vec![0.0; m];
         let mut rhs = vec![0.0; m];
+        let mut step: f64 = 0.0;
         for _ in 0..REFINE {
             for ((b, &ck), &yk) in rhs.iter_mut().zip(&c).zip(&y) {
                 *b = ck + DELTA * yk;
             }
             llt.solve_in_place(&mut rhs);
-            let mut step: f64 = 0.0;
+            step = 0.0;
             let mut size: f64 = 0.0;
             for (yk, &b) in y.iter_mut().zip(&rhs) {
                 step = step.max((b - *yk).abs());
@@ -344,7 +348,11 @@ impl StickSolve {
                 break;
             }
         }
-        if y.iter().any(|v| !v.is_finite()) {
+        // the iteration gives `S y - c = δ (y_prev - y)`: a residual that stays of the size of
+        // c means c is not in S's range, no impulses stop these contacts (a problem without
+        // solution, or cases guessed wrong), and the iterates only grow along S's null space
+        let c_max = c.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+        if y.iter().any(|v| !v.is_finite()) || DELTA * step > CONSISTENT * c_max {
             return None;
         }
         for (yk, s) in y.iter_mut().zip(&scale) {
