@@ -37,7 +37,8 @@
 //! By default ([`NsgsSettings::sticking`]), when the error decreases slowly the exact answer
 //! on the contacts' current cases is tried: the least-norm impulses that stop the sticking
 //! contacts, by one sparse Cholesky factor ([`stick`]); on boxes resting face on face, whose
-//! four coplanar points make W singular, it ends the slow sweeps at once.
+//! four coplanar points make W singular, it ends the slow sweeps at once. It is tried once
+//! more on the last iterate when the sweeps' budget is spent (the message then says so).
 
 mod best;
 mod closed;
@@ -79,6 +80,9 @@ pub struct NsgsSettings {
     /// default. Off, the solve is plain Gauss-Seidel sweeps (the method the literature's
     /// tables time sweep for sweep).
     pub sticking: bool,
+    /// with `sticking`, also try that solve on the last iterate when the sweeps' budget is
+    /// spent; on by default, off in the stepper (whose steps have their own fallbacks).
+    pub sticking_at_limit: bool,
 }
 
 /// The order of the contacts in an NSGS sweep. Gauss-Seidel's result depends on it: a
@@ -106,6 +110,7 @@ impl Default for NsgsSettings {
             initial: None,
             order: ContactOrder::Forward,
             sticking: true,
+            sticking_at_limit: true,
         }
     }
 }
@@ -414,6 +419,15 @@ pub(crate) fn solve_nsgs_measured(
         // interrupted between two measures: the verdict is the returned iterate's
         measures = measure_into(problem, &r, &mut u);
     }
+    // the budget spent: the exact answer on the last iterate's cases, once more whatever the
+    // tries made (kept, as in the sweeps, only when it passes or halves the error)
+    let finished = s.sticking
+        && s.sticking_at_limit
+        && sweeps >= s.max_iter
+        && !measures.passes(s.tol)
+        && measures.scaled_error.is_finite()
+        && stick.try_at(problem, &mut r, &mut u, &mut measures, sweeps, s.tol)
+        && measures.passes(s.tol);
     let restored = if measures.passes(s.tol) {
         None
     } else {
@@ -424,7 +438,12 @@ pub(crate) fn solve_nsgs_measured(
         (
             ContactStatus::Solved,
             format!(
-                "solved in {sweeps} sweeps (scaled_error {})",
+                "solved in {sweeps} sweeps{} (scaled_error {})",
+                if finished {
+                    " and the sticking-set solve after the last"
+                } else {
+                    ""
+                },
                 Readable(measures.scaled_error)
             ),
         )

@@ -163,6 +163,7 @@ pub(super) fn nsgs(
         initial,
         order,
         sticking,
+        sticking_at_limit: sticking,
     }
 }
 

@@ -17,7 +17,7 @@ mod joints;
 mod rollout;
 #[path = "step_stream.rs"]
 mod stream;
-use crate::contact::ContactOrder;
+use crate::contact::{ContactOrder, NsgsSettings};
 use crate::error::CoulombError;
 use crate::geometry::{Shape2, Shape3};
 use crate::step::{
@@ -338,14 +338,11 @@ pub(super) fn settings_from(
     let solver = match solver {
         // the steps' NSGS tries the exact solve on the sticking set when its sweeps slow
         // down (redundant face contacts), as `StepSettings::new` does
-        "nsgs" => StepSolver::Nsgs(settings::nsgs(
-            tol,
-            max_iter,
-            relaxation,
-            None,
-            ContactOrder::Forward,
-            true,
-        )),
+        // (not at the budget's end: a step NSGS leaves unsolved goes to the fallbacks)
+        "nsgs" => StepSolver::Nsgs(NsgsSettings {
+            sticking_at_limit: false,
+            ..settings::nsgs(tol, max_iter, relaxation, None, ContactOrder::Forward, true)
+        }),
         "lemke" => StepSolver::Lemke(settings::lemke(dim, tol, max_iter, facets)),
         other => {
             return Err(to_py(

@@ -116,9 +116,12 @@ pub(super) fn impact_law(
             let mu = [mu];
             let mut problem = ContactProblem::new(dim, &w[..dim * dim], &q[..dim], &mu)?;
             problem.error_q_tol = Some(super::solve::STEP_ERROR_Q_TOL);
+            // one contact: its local solve is exact, no sticking set to solve
             let nsgs = NsgsSettings {
                 tol: 1e-14,
                 max_iter: 100,
+                sticking: false,
+                sticking_at_limit: false,
                 ..NsgsSettings::default()
             };
             let sol = solve_nsgs(&problem, &nsgs)?;

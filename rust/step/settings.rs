@@ -114,6 +114,7 @@ impl StepSettings {
             solver: StepSolver::Nsgs(NsgsSettings {
                 tol: 1e-12,
                 sticking: true,
+                sticking_at_limit: false,
                 ..NsgsSettings::default()
             }),
             gap_tolerance: 1e-9,

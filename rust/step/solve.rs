@@ -311,6 +311,7 @@ fn lemke_fallback(
     let nsgs = NsgsSettings {
         tol: s.lemke.tol,
         sticking: true,
+        sticking_at_limit: false,
         initial: Some(ws.impulse.clone()),
         ..NsgsSettings::default()
     };

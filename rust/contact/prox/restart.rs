@@ -53,6 +53,7 @@ pub(super) fn nsgs_sweeps(
         initial: Some(r.to_vec()),
         order: ContactOrder::Forward,
         sticking: false,
+        sticking_at_limit: false,
     };
     let out = solve_nsgs(problem, &sweep)?;
     Ok(out
@@ -74,6 +75,7 @@ pub(super) fn exact_sweep(problem: &ContactProblem<'_>, r: &mut [f64], tol: f64)
         initial: None,
         order: ContactOrder::Forward,
         sticking: false,
+        sticking_at_limit: false,
     };
     for i in 0..problem.nc {
         let o = i * dim;
