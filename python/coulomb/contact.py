@@ -273,11 +273,11 @@ def solve(
         forward then a backward pass (no directional bias in stacks and chains, twice the cost
         per sweep); an array is a permutation of the contacts.
     sticking : bool
-        ``"nsgs"`` only: when the sweeps slow down, also try the exact answer on the
-        contacts' current cases, the least-norm impulses that stop the sticking contacts
-        (default True; kept only when it passes ``tol`` or halves ``scaled_error``). False
-        gives plain Gauss-Seidel sweeps, the method the literature's tables time sweep for
-        sweep.
+        ``"nsgs"`` only: when the sweeps slow down, and once more on the last iterate when
+        ``max_iter`` is spent, also try the exact answer on the contacts' current cases, the
+        least-norm impulses that stop the sticking contacts (default True; kept only when it
+        passes ``tol`` or halves ``scaled_error``). False gives plain Gauss-Seidel sweeps,
+        the method the literature's tables time sweep for sweep.
     settings : NSGSSettings, PolyhedralSettings or ProxSettings, optional
         The method and its options as one object (:mod:`coulomb.settings`), in place of
         ``method`` and ``tol``, ``max_iter``, ``relaxation``, ``order``, ``sticking``,

@@ -132,8 +132,10 @@ class NSGSSettings:
         The order a sweep visits the contacts in (default ``"forward"``; the stepper sweeps
         forward only).
     sticking : bool
-        When the sweeps slow down, also try the exact solve on the contacts' current cases
-        (default True; the stepper always does). False: plain Gauss-Seidel sweeps.
+        When the sweeps slow down, and in :func:`coulomb.contact.solve` once more when
+        ``max_iter`` is spent, also try the exact solve on the contacts' current cases
+        (default True; the stepper always does, and leaves a step its sweeps do not solve to
+        its fallbacks). False: plain Gauss-Seidel sweeps.
 
     Notes
     -----
