@@ -81,7 +81,9 @@ pub struct NsgsSettings {
     /// tables time sweep for sweep).
     pub sticking: bool,
     /// with `sticking`, also try that solve on the last iterate when the sweeps' budget is
-    /// spent; on by default, off in the stepper (whose steps have their own fallbacks).
+    /// spent; on by default, off in the stepper's settings ([`crate::step::StepSettings::new`]
+    /// and the Python stepper's), whose unsolved steps go to their Lemke and robust-mode
+    /// fallbacks instead.
     pub sticking_at_limit: bool,
 }
 

@@ -336,9 +336,9 @@ pub(super) fn settings_from(
     locate_impacts: bool,
 ) -> PyResult<StepSettings> {
     let solver = match solver {
-        // the steps' NSGS tries the exact solve on the sticking set when its sweeps slow
-        // down (redundant face contacts), as `StepSettings::new` does
-        // (not at the budget's end: a step NSGS leaves unsolved goes to the fallbacks)
+        // as `StepSettings::new`: the steps' NSGS tries the exact solve on the sticking set
+        // when its sweeps slow down (redundant face contacts), not at the budget's end (a
+        // step NSGS leaves unsolved goes to the fallbacks)
         "nsgs" => StepSolver::Nsgs(NsgsSettings {
             sticking_at_limit: false,
             ..settings::nsgs(tol, max_iter, relaxation, None, ContactOrder::Forward, true)

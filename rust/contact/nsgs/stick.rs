@@ -133,11 +133,11 @@ impl StickSolve {
         let qmax = problem.q.iter().fold(0.0f64, |a, b| a.max(b.abs()));
         for _ in 0..ROUNDS {
             let m = self.mark(problem);
-            // a factor cannot be stopped once begun: the caller's interrupt hook is asked
-            // before each (its work counted as the factor's rows and their entries)
             if m == 0 {
                 break;
             }
+            // a factor cannot be stopped once begun: the caller's interrupt hook is asked
+            // before each (its work counted as the factor's rows and their entries)
             if crate::interrupt::poll(m.saturating_mul(64)) {
                 return false;
             }
