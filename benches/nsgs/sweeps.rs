@@ -5,8 +5,9 @@
 //! Siconos friction-contact `.dat` file (given dense, as `nsgs_survey` gives it): a solve with a
 //! tolerance no iterate reaches, so exactly SWEEPS sweeps from zero; prints the sweeps done and
 //! the final `scaled_error` and a digest of the impulses' bits (equal digests: bitwise equal
-//! iterates, to compare two builds). Under `valgrind --tool=callgrind`, the inclusive count of the sweep
-//! function (`Sweep::visit`) divided by SWEEPS and nc is the instructions per contact per sweep
+//! iterates, to compare two builds); with `REPEAT=K` it first times K solves (see [`timed`]).
+//! Under `valgrind --tool=callgrind`, the inclusive count of the sweep function
+//! (`Sweep::visit`) divided by SWEEPS and nc is the instructions per contact per sweep
 //! (`benches/nsgs/callgrind.py` does this).
 
 use coulomb::contact::{solve_nsgs, BlockCsr, ContactProblem, NsgsSettings};
@@ -40,6 +41,25 @@ fn read_raw(path: &str) -> Option<Dense> {
     (w.len() == n * n && q.len() == n && mu.len() == nc).then_some((dim, w, q, mu))
 }
 
+/// With `REPEAT=K` in the environment: the best of K whole solves (setup included), printed
+/// in nanoseconds per contact per sweep, for A/B timings of two builds without Python.
+fn timed(problem: &ContactProblem<'_>, s: &NsgsSettings, nc: usize) {
+    let Some(reps) = std::env::var("REPEAT")
+        .ok()
+        .and_then(|v| v.parse::<usize>().ok())
+    else {
+        return;
+    };
+    let mut best = f64::INFINITY;
+    for _ in 0..reps {
+        let t = std::time::Instant::now();
+        let sweeps = solve_nsgs(problem, s).map_or(0, |r| r.iterations);
+        let per = t.elapsed().as_secs_f64() / (sweeps.max(1) * nc.max(1)) as f64;
+        best = best.min(per);
+    }
+    println!("best of {reps}: {:.1} ns per contact-sweep", best * 1e9);
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let sweeps: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(100);
@@ -59,6 +79,7 @@ fn main() {
             let Ok(problem) = ContactProblem::with_block_sparse(&w, &p.q, &p.mu) else {
                 panic!("bad pile")
             };
+            timed(&problem, &s, nc);
             (nc, solve_nsgs(&problem, &s))
         }
         Some(path) => {
@@ -68,6 +89,7 @@ fn main() {
             let Ok(problem) = ContactProblem::new(dim, &w, &q, &mu) else {
                 panic!("refused {path}")
             };
+            timed(&problem, &s, mu.len());
             (mu.len(), solve_nsgs(&problem, &s))
         }
         None => panic!("usage: nsgs_sweeps SWEEPS (pile NC | FILE)"),

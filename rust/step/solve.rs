@@ -384,6 +384,17 @@ fn reuse_warm_start(
         }));
     }
     if m.passes(POLISH_NEAR * s.tol) && few {
+        if m.passes(POLISH_TOL * s.tol) && m.cone_violation == 0.0 {
+            // already at the polish's tolerance: NSGS would stop after 0 sweeps, so its
+            // setup (blocks, rows, buffers) is skipped
+            ws.impulse.clear();
+            ws.impulse.extend_from_slice(init);
+            return Ok(Warm::Done(Outcome {
+                status: ContactStatus::Solved,
+                iterations: 0,
+                measures: m,
+            }));
+        }
         let polish = NsgsSettings {
             initial: Some(init.to_vec()),
             max_iter: s.max_iter.min(POLISH_SWEEPS),

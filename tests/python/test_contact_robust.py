@@ -121,23 +121,23 @@ def test_problems_where_nsgs_stalls_are_solved(name):
     assert r.iterations <= 60
     err, err_q = contact_error(p.W, p.q, p.mu, p.dim, r.impulse)
     assert err_q <= TOL and err <= TOL
-    # contrast: plain NSGS sweeps do not reach 1e-8 within 2000 sweeps on those they still
-    # stall on; OneObject-i100000-316 stalled only while NSGS symmetrised the diagonal blocks
-    # of its slightly unsymmetric W, and is solved since. BoxesStack1's stall is the face
-    # contacts' drift along W's null directions, which the sticking-set solve (the default)
-    # ends: solved in 12 sweeps (Siconos's NSGS: not converged in 10,000)
+    # contrast: plain NSGS sweeps stall within 2000 sweeps only on BoxesStack1, whose stall
+    # is the face contacts' drift along W's null directions; the sticking-set solve (the
+    # default) ends it in 12 sweeps (Siconos's NSGS: not converged in 10,000).
+    # OneObject-i100000-316 stalled while NSGS symmetrised the diagonal blocks of its slightly
+    # unsymmetric W; OneObject-i100000-499 while a contact that others act on repeated its
+    # normal / tangential passes within a sweep (one pass per sweep solves it; Siconos's NSGS
+    # stalls at 1e-3)
     plain = contact.solve(p.W, p.q, p.mu, p.dim, method="nsgs", tol=TOL, max_iter=2000,
                           sticking=False)
     n = contact.solve(p.W, p.q, p.mu, p.dim, method="nsgs", tol=TOL, max_iter=2000)
-    if name == "OneObject-i100000-316.hdf5":
+    if name.startswith("OneObject"):
         assert plain.success and plain.error_q <= TOL, plain.message
+        assert max(contact_error(p.W, p.q, p.mu, p.dim, plain.impulse)) <= TOL
     else:
         assert not plain.success and plain.error_q > 10 * TOL
-    if name == "OneObject-i100000-499.hdf5":
-        assert not n.success and n.error_q > 10 * TOL
-    else:
-        assert n.success and n.iterations <= 1000, n.message
-        assert max(contact_error(p.W, p.q, p.mu, p.dim, n.impulse)) <= TOL
+    assert n.success and n.iterations <= 2000, n.message
+    assert max(contact_error(p.W, p.q, p.mu, p.dim, n.impulse)) <= TOL
 
 
 def redundant_planar_problem(seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
