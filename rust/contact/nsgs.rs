@@ -11,7 +11,7 @@
 //!
 //! The one-contact problem is solved on the diagonal block as stored (not symmetrised: the
 //! fixed point would then miss the problem's solution by its asymmetry) by the case split in
-//! 2D and by normal / tangential block descent in 3D (one pass per sweep for a contact that
+//! 2D and by normal / tangential block descent in 3D (two passes per sweep for a contact that
 //! others act on), the tangential step a 2x2 trust-region problem on the friction disk or
 //! ellipse, solved exactly ([`local`]). This was chosen over a
 //! single projected gradient step (step 1 / λ_max(T)) because it is exact for anisotropic T in
@@ -51,7 +51,7 @@ mod schedule;
 mod slide;
 mod stick;
 
-pub use local::LOCAL_ITERS;
+pub use local::{LOCAL_ITERS, SHARED_PASSES};
 
 use closed::{local_2d_exact, local_3d_closed, Closed};
 use local::{local_descent, LocalBlock};
@@ -276,12 +276,12 @@ impl Sweep<'_, '_> {
 /// contact that nothing else acts on by Newton on the slip angle ([`slide`]); `None` leaves
 /// it to the passes of [`local_descent`].
 ///
-/// A contact that others act on gets one normal / tangential pass per sweep, even though
-/// Newton solves its local problem exactly: the sweeps converge differently. On a single body
-/// held by 25 contacts (FCLib's OneObject-i100000-316, a rank-deficient W with strongly
-/// coupled blocks) one pass per sweep reaches 1e-8 in under 900 sweeps while exact local
-/// solutions (Newton, or the passes run to convergence) stall near 2e-2 (Siconos NSGS, also
-/// exact, stalls at 1.7e-3).
+/// A contact that others act on gets two normal / tangential passes per sweep
+/// ([`SHARED_PASSES`]), even though Newton solves its local problem exactly: the sweeps
+/// converge differently. On a single body held by 25 contacts (FCLib's OneObject-i100000-316,
+/// a rank-deficient W with strongly coupled blocks) two passes per sweep reach 1e-8 in under
+/// 900 sweeps while exact local solutions (Newton, or the passes run to convergence) stall near
+/// 2e-2 (Siconos NSGS, also exact, stalls at 1.7e-3).
 #[inline]
 fn local_3d(blk: &LocalBlock, mu: f64, b: &[f64; 3], old: &[f64; 3]) -> Option<[f64; 3]> {
     match local_3d_closed(blk, mu, b) {

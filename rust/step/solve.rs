@@ -190,7 +190,19 @@ pub(super) fn solve_polyhedral_warm(
             }
         }
     }
-    let status = LemkeVerdict::of(problem.dim, ls.status, &measures, s.lemke.tol).status();
+    let mut status = LemkeVerdict::of(problem.dim, ls.status, &measures, s.lemke.tol).status();
+    // in 3D the polygon's law is the disk's where no contact slides, so there the step's
+    // verdict is the exact rule, the one its record is measured by: a sticking answer at
+    // error_q's rounding floor that misses it goes to the fallback (NSGS on the disk from
+    // these impulses) instead of counting as solved
+    let slides = (0..nc).any(|i| lcp.slip_speed(i, &ls.z).is_some_and(|v| v > 0.0));
+    if problem.dim == 3
+        && status == ContactStatus::Solved
+        && !slides
+        && !measures.passes(s.lemke.tol)
+    {
+        status = ContactStatus::NumericalFailure;
+    }
     Ok(Outcome {
         status,
         iterations: ls.pivots,

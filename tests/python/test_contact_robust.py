@@ -126,7 +126,7 @@ def test_problems_where_nsgs_stalls_are_solved(name):
     # default) ends it in 12 sweeps (Siconos's NSGS: not converged in 10,000).
     # OneObject-i100000-316 stalled while NSGS symmetrised the diagonal blocks of its slightly
     # unsymmetric W; OneObject-i100000-499 while a contact that others act on repeated its
-    # normal / tangential passes within a sweep (one pass per sweep solves it; Siconos's NSGS
+    # normal / tangential passes within a sweep (two passes per sweep solve it; Siconos's NSGS
     # stalls at 1e-3)
     plain = contact.solve(p.W, p.q, p.mu, p.dim, method="nsgs", tol=TOL, max_iter=2000,
                           sticking=False)

@@ -27,17 +27,19 @@
 //! equation ([`super::disk`]); its fixed points are exactly the local solutions with the stored
 //! A. When `c_n`, `c_t` and k vanish (a particle, or a frame aligned with the principal axes)
 //! one pass (normal, then tangential) is exact. Otherwise a contact that other contacts act on
-//! gets one pass per sweep: the sweep is then Gauss-Seidel over the finer partition of the
-//! unknowns into each contact's normal impulse and its tangential impulse, whose fixed points
-//! are the same (a fixed point of the pass is a local solution). Only a contact that nothing
-//! else acts on, whose local solution is final, repeats the passes until the impulse no longer
-//! changes, at most [`LOCAL_ITERS`].
+//! gets [`SHARED_PASSES`] passes per sweep, and the outer sweeps refine the rest: the fixed
+//! points are the same (a fixed point of the passes is a local solution). Only a contact that
+//! nothing else acts on, whose local solution is final, repeats the passes until the impulse
+//! no longer changes, at most [`LOCAL_ITERS`].
 //!
-//! One pass was chosen over repeating the passes to 1e-2 of the first pass's change (the rule
-//! before): on FCLib's OneObject and RockPile problems and Siconos' Capsules set a sweep costs
-//! 1.3 to 2.3 times less, the sweeps to 1e-8 change by a few percent either way, and
-//! OneObject-i100000-499, which neither that rule nor Siconos NSGS solves in 10,000 sweeps, is
-//! solved in about 1,900 (BENCHMARKS.md, "Sweep for sweep against Siconos").
+//! Two passes were chosen over one and over repeating them to 1e-2 of the first pass's change
+//! (the rule before), by the sweeps to 1e-8 and the cost of a sweep on the FCLib and Siconos
+//! problems (BENCHMARKS.md, "Sweep for sweep against Siconos"): a sweep costs 1.3 to 1.7 times
+//! less than with the old rule on OneObject, RockPile, PerioBox and Siconos' Capsules, the
+//! sweeps to 1e-8 stay within a few percent but for one Capsules problem, whose count moves
+//! with the last bit, and OneObject-i100000-499, which neither the old rule nor Siconos NSGS
+//! solves in 10,000 sweeps, is solved in about 1,900. One pass costs a fifth less again, but
+//! LMGC_100_PR_PerioBox takes 2079 sweeps instead of 867.
 //!
 //! The cases decided without iterating (separation, sticking, and in 2D the whole case split)
 //! are in [`super::closed`]; this module is the sliding case and the blocks both read.
@@ -53,8 +55,12 @@ use super::closed::inverse3;
 use super::disk::{disk_qp_from, Eig2};
 
 /// passes of the normal / tangential block descent inside a contact that nothing else acts on
-/// (dim 3, and the 2D fallback); any other contact gets one pass per sweep.
+/// (dim 3, and the 2D fallback).
 pub const LOCAL_ITERS: usize = 8;
+
+/// passes of the descent per sweep inside a contact that other contacts act on (see the
+/// module notes).
+pub const SHARED_PASSES: usize = 2;
 
 /// The diagonal block of one contact as stored (see the module notes), with the
 /// eigendecomposition of its tangential symmetric part.
@@ -141,10 +147,10 @@ pub(super) fn local_descent(
 ) {
     // one pass is exact for an uncoupled block; a coupled one that others act on is refined
     // by the outer sweeps (see the module notes)
-    let passes = if blk.coupled && blk.isolated {
-        LOCAL_ITERS
-    } else {
-        1
+    let passes = match (blk.coupled, blk.isolated) {
+        (false, _) => 1,
+        (true, false) => SHARED_PASSES,
+        (true, true) => LOCAL_ITERS,
     };
     for _ in 0..passes {
         let old = *r;
