@@ -24,9 +24,11 @@ Methods:
 
 ``"nsgs"`` (default)
     Nonsmooth Gauss-Seidel with the exact friction disk: contact after contact, the one-contact
-    problem with the others frozen is solved exactly (2D by case split, 3D by a normal /
-    tangential block descent whose tangential step is the exact disk-constrained quadratic),
-    with relaxation and warm start.
+    problem with the others frozen is solved (2D exactly by case split; 3D by a normal /
+    tangential block descent whose tangential step is the exact disk-constrained quadratic,
+    run to convergence on a contact nothing else acts on and two passes per sweep on the
+    others, whose fixed points are the same exact local solutions), with relaxation and warm
+    start.
     With anisotropic friction (an ellipse), the tangential step is the exact minimiser over
     the ellipse (the ellipse projection when the contact's tangential block is a multiple of
     the identity).
