@@ -195,11 +195,11 @@ pub(super) fn solve_polyhedral_warm(
     // verdict is the exact rule, the one its record is measured by: a sticking answer at
     // error_q's rounding floor that misses it goes to the fallback (NSGS on the disk from
     // these impulses) instead of counting as solved
-    let slides = (0..nc).any(|i| lcp.slip_speed(i, &ls.z).is_some_and(|v| v > 0.0));
+    let slides = || (0..nc).any(|i| lcp.slip_speed(i, &ls.z).is_some_and(|v| v > 0.0));
     if problem.dim == 3
         && status == ContactStatus::Solved
-        && !slides
         && !measures.passes(s.lemke.tol)
+        && !slides()
     {
         status = ContactStatus::NumericalFailure;
     }
@@ -386,7 +386,14 @@ fn reuse_warm_start(
     // up to LEMKE_FALLBACK_MAX contacts the polish below is tried; above, NSGS starts from
     // the warm start
     let few = problem.nc.max(ws.step_nc) <= LEMKE_FALLBACK_MAX;
-    if m.passes(s.tol) && m.cone_violation == 0.0 && !(ws.corrected && few) {
+    // a corrected warm start is polished (see above) unless it is already at the polish's
+    // tolerance, where NSGS would stop after 0 sweeps: its setup is then skipped
+    let reuse = if ws.corrected && few {
+        m.passes(POLISH_TOL * s.tol)
+    } else {
+        m.passes(s.tol)
+    };
+    if reuse && m.cone_violation == 0.0 {
         ws.impulse.clear();
         ws.impulse.extend_from_slice(init);
         return Ok(Warm::Done(Outcome {
@@ -396,17 +403,6 @@ fn reuse_warm_start(
         }));
     }
     if m.passes(POLISH_NEAR * s.tol) && few {
-        if m.passes(POLISH_TOL * s.tol) && m.cone_violation == 0.0 {
-            // already at the polish's tolerance: NSGS would stop after 0 sweeps, so its
-            // setup (blocks, rows, buffers) is skipped
-            ws.impulse.clear();
-            ws.impulse.extend_from_slice(init);
-            return Ok(Warm::Done(Outcome {
-                status: ContactStatus::Solved,
-                iterations: 0,
-                measures: m,
-            }));
-        }
         let polish = NsgsSettings {
             initial: Some(init.to_vec()),
             max_iter: s.max_iter.min(POLISH_SWEEPS),
