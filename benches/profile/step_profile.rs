@@ -20,8 +20,8 @@
 //!
 //! NSGS's sweep order, relaxation and sweep limit can be changed for experiments through the
 //! environment: `SOLVER=lemke` solves the steps by Lemke on the polyhedral cone (default
-//! settings) instead of NSGS; `ORDER=symmetric|backward|forward`, `RELAX=1.3`, `MAXIT=100`; `STICK=1` turns on
-//! NSGS's sticking-set solve. `QUIET=1` lists no steps, `CONTACTS=K` prints the contacts of the
+//! settings) instead of NSGS; `ORDER=symmetric|backward|forward`, `RELAX=1.3`, `MAXIT=100`; `STICK=0` turns off
+//! NSGS's sticking-set solve (on by default), `STICK=1` on. `QUIET=1` lists no steps, `CONTACTS=K` prints the contacts of the
 //! first K steps; `UNIT=1e-4` builds the dominoes with lengths in that unit (gravity, inertia
 //! and the gap tolerance with them); `THREADS=k` solves each step's islands on k threads (all
 //! the cores by default); the boxes' drift (largest displacement from the start) and the
@@ -461,10 +461,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     {
         s.max_iter = w.parse()?;
     }
-    if let (Ok(_), coulomb::step::StepSolver::Nsgs(s)) =
+    if let (Ok(on), coulomb::step::StepSolver::Nsgs(s)) =
         (std::env::var("STICK"), &mut settings.solver)
     {
-        s.sticking = true;
+        s.sticking = on != "0";
     }
     // THREADS=k: each step's islands on k threads (all the cores by default)
     let threads = std::env::var("THREADS")

@@ -97,7 +97,7 @@ impl Stepper {
             body,
             x,
             x_size: x.iter().fold(0.0f64, |m, v| m.max(v.abs())),
-            bounds: self.speed_bounds[body],
+            bounds: self.speeds.own[body],
         }
     }
 

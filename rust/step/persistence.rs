@@ -119,8 +119,10 @@ impl Stepper {
         for k in 0..nb {
             let (body, p, r) = self.balls[k];
             let (_, c) = self.world_point(body, p);
-            let [lin, ang] = self.speed_bounds[body];
-            let reach = lin + ang * (norm3(p) + r);
+            // the ball's own speed bound: a pair of balls that only the solve's impulses turn
+            // towards each other must be a candidate for the search on v_trial (module
+            // `settle`), which relative bounds from v_k and v_free alone would leave out
+            let reach = self.speeds.against_static(body, norm3(p) + r);
             let size = c.iter().fold(0.0f64, |m, x| m.max(x.abs()));
             // a hair of slack: rounding must never drop a pair the exact test keeps
             let grown = (r + half_tol + 2.0 * h * reach) * (1.0 + 1e-9) + 4.0 * f64::EPSILON * size;

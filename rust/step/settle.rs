@@ -30,26 +30,15 @@
 //! others); a lowered problem the solver fails on gives the step back the answer that passed.
 //! Contacts only join and terms only fall, at most [`SETTLE_PASSES`] times.
 
-use super::bodies::{norm3, BodyInfo};
+use super::bodies::norm3;
 use super::law::curvature_term;
 use super::narrow::Geometry;
-use super::{BodyKind, Restitution, StepRecord, Stepper};
+use super::{Restitution, StepRecord, Stepper};
 use crate::contact::ContactStatus;
 use crate::error::Result;
 
 /// the solves again at most after the first (each adds a contact or lowers a term).
 pub(super) const SETTLE_PASSES: usize = 4;
-
-/// a bound on body b's point speeds in v: its linear and angular speeds.
-pub(super) fn speed_bound(b: &BodyInfo, v: &[f64]) -> [f64; 2] {
-    let vb = &v[b.off_v..b.off_v + b.nv];
-    let norm = |x: &[f64]| x.iter().map(|y| y * y).sum::<f64>().sqrt();
-    match b.kind {
-        BodyKind::Particle => [norm(vb), 0.0],
-        BodyKind::Planar => [norm(&vb[..2]), vb[2].abs()],
-        BodyKind::Spatial => [norm(&vb[..3]), norm(&vb[3..6])],
-    }
-}
 
 impl Stepper {
     /// `v_free + M^{-1} G P` of the current impulses, projected on the joints' rows, into
@@ -80,11 +69,7 @@ impl Stepper {
     /// merely faster in `v_trial` than the bounds assumed is no reason: a search that finds
     /// nothing new costs a fifth of a one-body step.
     fn search_again(&mut self) -> bool {
-        for (b, sb) in self.bodies.iter().zip(&mut self.speed_bounds) {
-            let [lin, ang] = speed_bound(b, &self.v_trial);
-            sb[0] = sb[0].max(lin);
-            sb[1] = sb[1].max(ang);
-        }
+        self.speeds.widen_own(&self.bodies, &self.v_trial);
         if !self.trial_closes_another() {
             return false;
         }
@@ -226,9 +211,9 @@ impl Stepper {
     fn turns_too_little(&self, geo: &Geometry, tol: f64) -> bool {
         let h = self.settings.h;
         let mut phi: f64 = 0.0;
-        let mut length = 2.0 * geo.gap.abs() + h * self.reach(geo);
+        let mut length = 2.0 * geo.gap.abs() + h * self.own_reach(geo);
         for &(body, _, r) in &geo.sides[..geo.nsides] {
-            phi = phi.max(h * self.speed_bounds[body][1]);
+            phi = phi.max(h * self.speeds.own[body][1]);
             length += norm3(r);
         }
         phi <= 1.0 && 4.0 * phi * length <= 1e-3 * tol

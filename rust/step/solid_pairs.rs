@@ -283,13 +283,15 @@ impl Stepper {
         for i in 0..sp.solids.len() {
             let (world, reach) = match (sp.solids[i].body, sp.local[i]) {
                 (Some(body), Some(local)) => {
-                    let [lin, ang] = self.speed_bounds[body];
                     let world = match (self.body_pose(body), local) {
                         (Pose::Planar(b), Pose::Planar(l)) => Pose::Planar(b * l),
                         (Pose::Spatial(b), Pose::Spatial(l)) => Pose::Spatial(b * l),
                         (b, _) => b,
                     };
-                    (world, lin + ang * sp.bound[i])
+                    // a solid's own speed bound, also between two bodies' solids: the
+                    // broad phase must hold the pairs the search on v_trial may find
+                    // (module `reach`)
+                    (world, self.speeds.against_static(body, sp.bound[i]))
                 }
                 _ => (sp.solids[i].isometry(), 0.0),
             };

@@ -30,6 +30,8 @@ mod law;
 mod narrow;
 #[path = "persistence.rs"]
 mod persistence;
+#[path = "reach.rs"]
+mod reach;
 #[path = "record.rs"]
 mod record;
 #[path = "settle.rs"]
@@ -164,7 +166,8 @@ pub struct Stepper {
     /// at the prepared state each one's gap floor where it was skipped as far.
     point_groups: Vec<far::PointGroup>,
     group_floors: Vec<Option<f64>>,
-    speed_bounds: Vec<[f64; 2]>,
+    /// how fast each body's points move at the prepared state (module `reach`).
+    speeds: reach::SpeedBounds,
     qc: Vec<f64>,
     /// each active contact's curvature term in `qc` (module `curvature`).
     curvature: Vec<f64>,
@@ -252,7 +255,7 @@ impl Stepper {
             geo_cache: Vec::new(),
             group_floors: vec![None; point_groups.len()],
             point_groups,
-            speed_bounds: vec![[0.0; 2]; scene.bodies.len()],
+            speeds: reach::SpeedBounds::default(),
             qc: Vec::new(),
             curvature: Vec::new(),
             v_trial: Vec::new(),
@@ -310,13 +313,12 @@ impl Stepper {
                 tol,
             );
         }
-        // a bound on each body's point speeds (v_k and v_free): a candidate farther than
-        // 2 h times its bound cannot close within the step, whatever its normal
-        for (bi, b) in self.bodies.iter().enumerate() {
-            let [l0, a0] = settle::speed_bound(b, &self.v);
-            let [l1, a1] = settle::speed_bound(b, &self.v_free);
-            self.speed_bounds[bi] = [l0.max(l1), a0.max(a1)];
-        }
+        // bounds on each body's point speeds (v_k and v_free), alone and relative to the
+        // others: a candidate farther than 2 h times its bound cannot close within the step,
+        // whatever its normal
+        self.speeds.clear(self.bodies.len());
+        self.speeds.widen(&self.bodies, &self.v);
+        self.speeds.widen(&self.bodies, &self.v_free);
         self.save_solid_state();
         if self.auto.is_some() {
             self.broad_phase();
@@ -466,15 +468,23 @@ impl Stepper {
         }
     }
 
-    /// a bound on how fast a candidate's gap can close: the speed bounds of its sides' bodies
-    /// at its witness points (`lin + ang |r|` summed over the sides).
+    /// a bound on how fast a candidate's gap can close (module `reach`): its body's point
+    /// speed against the static world, the smaller of two bounds between two bodies.
+    #[inline]
     fn reach(&self, geo: &Geometry) -> f64 {
-        let mut reach = 0.0;
-        for &(body, _, r) in &geo.sides[..geo.nsides] {
-            let [lin, ang] = self.speed_bounds[body];
-            reach += lin + ang * norm3(r);
+        match geo.sides[..geo.nsides] {
+            [(a, _, ra), (b, _, rb)] => self.speeds.between(a, norm3(ra), b, norm3(rb)),
+            _ => self.own_reach(geo),
         }
-        reach
+    }
+
+    /// a bound on how far a candidate's witness points can move within a step, over h: the
+    /// speeds of its sides' points (`lin + ang |r|` summed over the sides).
+    fn own_reach(&self, geo: &Geometry) -> f64 {
+        geo.sides[..geo.nsides]
+            .iter()
+            .map(|&(body, _, r)| self.speeds.against_static(body, norm3(r)))
+            .sum()
     }
 
     /// an active contact from a candidate's geometry, into `act` (a default one): per side,

@@ -4,15 +4,18 @@
 //! dynamic trees, here over a uniform grid).
 //!
 //! At a rebuild every ball i is grown to `F_i = R_i^0 + m` and the grid finds every pair with
-//! `||c_i^0 - c_j^0|| <= F_i + F_j`. Later, with centres `c_i` moved by `d_i = ||c_i - c_i^0||`
-//! and radii `R_i`, a pair not kept has
+//! `||c_i^0 - c_j^0|| <= F_i + F_j`. Later, with centres `c_i` moved by
+//! `d_i = ||c_i - c_i^0 - s||` for any shift s common to all, and radii `R_i`, a pair not kept
+//! has
 //!
 //! ```text
 //!     ||c_i - c_j|| >= ||c_i^0 - c_j^0|| - d_i - d_j > (R_i^0 + m - d_i) + (R_j^0 + m - d_j)
 //! ```
 //!
 //! so it cannot meet while every ball keeps `R_i + d_i <= R_i^0 + m` (less a slack for the
-//! rounding of the distances). The pairs that meet are then exactly the kept pairs that pass
+//! rounding of the distances). The test is made with no shift, and where that fails with the
+//! mean of the balls' displacements: balls moving together (a falling pile) keep their pairs
+//! however far they travel. The pairs that meet are then exactly the kept pairs that pass
 //! [`balls_meet`], in the kept list's order (sorted at the rebuild): the output is the set the
 //! grid would give, sorted, at every call, whether or not the grid ran.
 
@@ -59,7 +62,9 @@ impl KeptBroadPhase {
         out.clear();
         let n = centres.len().min(radii.len());
         let (centres, radii) = (&centres[..n], &radii[..n]);
-        if !self.covers(centres, radii) {
+        if !self.covers(centres, radii, [0.0; 3])
+            && !self.covers(centres, radii, self.shift(centres))
+        {
             self.rebuild(centres, radii);
         }
         if self.all_finite {
@@ -82,19 +87,41 @@ impl KeptBroadPhase {
         }
     }
 
+    /// the mean displacement since the rebuild (zero where it is not finite or the balls are
+    /// not those of the rebuild).
+    fn shift(&self, centres: &[[f64; 3]]) -> [f64; 3] {
+        let mut s = [0.0; 3];
+        if centres.len() != self.centres0.len() || centres.is_empty() {
+            return s;
+        }
+        for (c, c0) in centres.iter().zip(&self.centres0) {
+            for k in 0..3 {
+                s[k] += c[k] - c0[k];
+            }
+        }
+        let n = centres.len() as f64;
+        s.map(|x| if (x / n).is_finite() { x / n } else { 0.0 })
+    }
+
     /// whether the kept pairs hold every pair that can meet now: as many balls, each within
-    /// its margin (`R_i + d_i <= R_i^0 + m`, less a slack for rounding).
-    fn covers(&self, centres: &[[f64; 3]], radii: &[f64]) -> bool {
+    /// its margin after the common shift s (`R_i + d_i <= R_i^0 + m`, less a slack for
+    /// rounding).
+    fn covers(&self, centres: &[[f64; 3]], radii: &[f64], s: [f64; 3]) -> bool {
         // a finite ball within a finite margin of a finite rebuild is finite itself
         if self.rebuilds == 0 || centres.len() != self.centres0.len() || !self.all_finite {
             return false;
         }
         let m = self.margin;
+        let shift_size = s.iter().fold(0.0f64, |a, x| a.max(x.abs()));
         for (i, (c, &r)) in centres.iter().zip(radii).enumerate() {
             let c0 = self.centres0[i];
-            let d = [c[0] - c0[0], c[1] - c0[1], c[2] - c0[2]];
+            let d = [
+                c[0] - c0[0] - s[0],
+                c[1] - c0[1] - s[1],
+                c[2] - c0[2] - s[2],
+            ];
             let moved = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-            let size = c.iter().chain(&c0).fold(0.0f64, |s, x| s.max(x.abs()));
+            let size = c.iter().chain(&c0).fold(shift_size, |s, x| s.max(x.abs()));
             let room = self.radii0[i] + m;
             // the distances' rounding, relative to the balls and to the coordinates
             let slack = 1e-9 * room + 16.0 * f64::EPSILON * size;
@@ -205,6 +232,43 @@ mod tests {
             rebuilds * 3 < calls,
             "the margin must spare most rebuilds: {rebuilds} of {calls}"
         );
+    }
+
+    /// balls travelling together far beyond their margin at every call (a falling pile), each
+    /// also jittering on its own, at scales 1e-8..1e8: the brute force's pairs at every call,
+    /// and the grid runs only when the jitter passes the margin, not as the group travels.
+    #[test]
+    fn balls_moving_together_keep_their_pairs_as_they_travel() {
+        let mut rng = SplitMix64::new(29);
+        for case in 0..17 {
+            let scale = 10f64.powi(case - 8);
+            let n = 60;
+            let mut centres: Vec<[f64; 3]> = (0..n)
+                .map(|_| [0.0, 0.0, 0.0].map(|_: f64| rng.range(0.0, 4.0) * scale))
+                .collect();
+            let radii: Vec<f64> = (0..n).map(|_| rng.range(0.2, 0.5) * scale).collect();
+            let mut bp = KeptBroadPhase::new();
+            let mut out = vec![];
+            let mut found = 0;
+            for step in 0..100 {
+                // the group moves by 3 radii a call, faster and faster
+                let travel = [1.0, -2.0, -3.0].map(|x: f64| x * scale * (1.0 + 0.01 * step as f64));
+                for c in &mut centres {
+                    for k in 0..3 {
+                        c[k] += travel[k] + rng.range(-1e-3, 1e-3) * scale;
+                    }
+                }
+                bp.pairs(&centres, &radii, &mut out);
+                assert_eq!(out, brute(&centres, &radii), "case {case}, step {step}");
+                found += out.len();
+            }
+            assert!(found > 100, "the balls must touch: {found}");
+            assert!(
+                bp.rebuilds() <= 10,
+                "case {case}: {} rebuilds",
+                bp.rebuilds()
+            );
+        }
     }
 
     /// balls that only grow: a pair beyond the grown balls at the rebuild meets once the
