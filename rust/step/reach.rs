@@ -58,10 +58,9 @@ impl SpeedBounds {
         self.fresh = true;
     }
 
-    /// the own bounds widened to velocity v, the relative ones dropped: the search again on
-    /// `v_trial` (module `settle`) tests its candidates by the own speeds, as a step's first
-    /// search costs the common part's pass and a square root per body, which the few
-    /// candidates the second search looks at do not repay.
+    /// the own bounds widened to velocity v, the relative ones dropped (a pair's bound is then
+    /// its own speeds'): for the search again on `v_trial` (module `settle`), whose few
+    /// candidates do not repay the common part's pass and a square root per body.
     pub(super) fn widen_own(&mut self, bodies: &[BodyInfo], v: &[f64]) {
         if self.fresh {
             self.own.fill([0.0; 2]);
