@@ -43,90 +43,37 @@ pub(super) struct SpeedBounds {
     pub(super) relative: Vec<f64>,
     /// whether `relative` bounds every velocity read (not after [`Self::widen_own`]).
     relative_valid: bool,
-    /// whether no velocity was read since [`Self::clear`] (the next one's bounds are written
-    /// over the last step's).
-    fresh: bool,
 }
 
 impl SpeedBounds {
-    /// bounds for `n` bodies, made by the velocities read next (the first one written over
-    /// the last step's).
+    /// zero bounds for `n` bodies (no velocity read yet).
     pub(super) fn clear(&mut self, n: usize) {
+        self.own.clear();
         self.own.resize(n, [0.0; 2]);
+        self.relative.clear();
         self.relative.resize(n, 0.0);
         self.relative_valid = true;
-        self.fresh = true;
     }
 
     /// the own bounds widened to velocity v, the relative ones dropped (a pair's bound is then
     /// its own speeds'): for the search again on `v_trial` (module `settle`), whose few
     /// candidates do not repay the common part's pass and a square root per body.
     pub(super) fn widen_own(&mut self, bodies: &[BodyInfo], v: &[f64]) {
-        if self.fresh {
-            self.own.fill([0.0; 2]);
-            self.fresh = false;
-        }
         self.relative_valid = false;
         for (b, own) in bodies.iter().zip(&mut self.own) {
-            let vb = &v[b.off_v..b.off_v + b.nv];
-            let norm = |x: &[f64]| x.iter().map(|y| y * y).sum::<f64>().sqrt();
-            let (lin, ang) = match b.kind {
-                BodyKind::Particle => (norm(vb), 0.0),
-                BodyKind::Planar => (norm(&vb[..2]), vb[2].abs()),
-                BodyKind::Spatial => (norm(&vb[..3]), norm(&vb[3..6])),
-            };
-            // as f64::max: a NaN speed leaves the bound as it was
-            if lin > own[0] {
-                own[0] = lin;
-            }
-            if ang > own[1] {
-                own[1] = ang;
-            }
+            let (lin, ang, _) = squares(b, v, [0.0; 3]);
+            raise(own, lin.sqrt(), ang.sqrt());
         }
     }
 
     /// the bounds widened to velocity v of the bodies.
     pub(super) fn widen(&mut self, bodies: &[BodyInfo], v: &[f64]) {
         let c = common_velocity(bodies, v);
-        // the first velocity's bounds are written over the last step's (0 for a NaN speed,
-        // as the largest with 0 would give)
-        let fresh = std::mem::replace(&mut self.fresh, false);
         for ((b, own), rel) in bodies.iter().zip(&mut self.own).zip(&mut self.relative) {
-            let vb = &v[b.off_v..b.off_v + b.nv];
-            // the squares of the linear speed, of the angular one and of the linear velocity
-            // less c
-            let sq = |x: f64| x * x;
-            let (lin, ang, off) = match (b.kind, vb) {
-                (BodyKind::Spatial, &[x, y, z, wx, wy, wz]) => (
-                    sq(x) + sq(y) + sq(z),
-                    sq(wx) + sq(wy) + sq(wz),
-                    sq(x - c[0]) + sq(y - c[1]) + sq(z - c[2]),
-                ),
-                (BodyKind::Planar, &[x, y, w]) => {
-                    (sq(x) + sq(y), sq(w), sq(x - c[0]) + sq(y - c[1]))
-                }
-                _ => {
-                    let (mut lin, mut off) = (0.0, 0.0);
-                    for (x, c) in vb.iter().zip(c) {
-                        lin += x * x;
-                        off += (x - c) * (x - c);
-                    }
-                    (lin, 0.0, off)
-                }
-            };
-            let (lin, ang) = (lin.sqrt(), ang.sqrt());
+            let (lin, ang, off) = squares(b, v, c);
+            let lin = lin.sqrt();
+            raise(own, lin, ang.sqrt());
             let r = off.sqrt() + ROUNDING * lin;
-            if fresh {
-                *own = [0.0; 2];
-                *rel = r;
-            }
-            // as f64::max: a NaN speed leaves the own bound as it was
-            if lin > own[0] {
-                own[0] = lin;
-            }
-            if ang > own[1] {
-                own[1] = ang;
-            }
             // NaN propagates here (the pair's bound is then NaN: never far)
             if r.is_nan() || r > *rel {
                 *rel = r;
@@ -158,6 +105,41 @@ impl SpeedBounds {
         } else {
             own.min(relative)
         }
+    }
+}
+
+/// body b's squared linear speed, squared angular speed and squared distance of its linear
+/// velocity from c, in v.
+#[inline]
+fn squares(b: &BodyInfo, v: &[f64], c: [f64; 3]) -> (f64, f64, f64) {
+    let vb = &v[b.off_v..b.off_v + b.nv];
+    let sq = |x: f64| x * x;
+    match (b.kind, vb) {
+        (BodyKind::Spatial, &[x, y, z, wx, wy, wz]) => (
+            sq(x) + sq(y) + sq(z),
+            sq(wx) + sq(wy) + sq(wz),
+            sq(x - c[0]) + sq(y - c[1]) + sq(z - c[2]),
+        ),
+        (BodyKind::Planar, &[x, y, w]) => (sq(x) + sq(y), sq(w), sq(x - c[0]) + sq(y - c[1])),
+        _ => {
+            let (mut lin, mut off) = (0.0, 0.0);
+            for (x, c) in vb.iter().zip(c) {
+                lin += x * x;
+                off += (x - c) * (x - c);
+            }
+            (lin, 0.0, off)
+        }
+    }
+}
+
+/// an own bound `[lin, ang]` raised to these speeds (as f64::max: a NaN speed leaves it).
+#[inline]
+fn raise(own: &mut [f64; 2], lin: f64, ang: f64) {
+    if lin > own[0] {
+        own[0] = lin;
+    }
+    if ang > own[1] {
+        own[1] = ang;
     }
 }
 
