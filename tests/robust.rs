@@ -153,7 +153,8 @@ fn problems_where_nsgs_stalls_are_solved_at_1e_8() {
         )
         .unwrap();
         assert!(again.success() && again.iterations <= 1, "{name}");
-        // a tight iteration limit is reported as such
+        // a tight iteration limit is reported as such, unless the polyhedral LCPs tried at the
+        // end solve the problem (BoxesStack1: every contact sticks or separates)
         let short = solve_prox(
             &p,
             &ProxSettings {
@@ -162,8 +163,18 @@ fn problems_where_nsgs_stalls_are_solved_at_1e_8() {
             },
         )
         .unwrap();
-        assert_eq!(short.status, ContactStatus::IterationLimit, "{name}");
-        assert!(short.measures.error_q > 1e-8 && short.iterations == 1);
+        assert_eq!(short.iterations, 1, "{name}");
+        if short.status == ContactStatus::Solved {
+            assert!(
+                short.message.contains("polyhedral"),
+                "{name}: {}",
+                short.message
+            );
+            assert!(short.measures.passes(1e-8), "{name}");
+        } else {
+            assert_eq!(short.status, ContactStatus::IterationLimit, "{name}");
+            assert!(short.measures.error_q > 1e-8, "{name}");
+        }
     }
 }
 
