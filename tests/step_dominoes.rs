@@ -167,3 +167,39 @@ fn a_plank_sliding_down_a_turning_plank_does_not_sink_into_it() {
         );
     }
 }
+
+/// The step's verdict follows the one rule both ways on a scene whose fallback decides many
+/// steps (planks leaning on each other): a step is solved exactly when its recorded measures
+/// pass its tolerance, `max(tol, 1e-9)` for a step the fallback decided, with `error_q`
+/// against `max(that, 1e-9, error_q_floor)`. Before, a fallback's best answer within 1e-9, or
+/// islands whose own `error_q` missed while the whole step's passed, left the step unsolved.
+#[test]
+fn a_step_is_solved_exactly_when_its_measures_pass_the_steps_rule() {
+    let (count, h, steps) = (10, 1e-3, 900);
+    let settings = StepSettings::new(h, steps);
+    let tol = match &settings.solver {
+        coulomb::step::StepSolver::Nsgs(s) => s.tol,
+        coulomb::step::StepSolver::Lemke(_) => unreachable!("the default solver is NSGS"),
+    };
+    let tr = simulate(&row(count, 1.5 * critical_push()), &settings).expect("the row runs");
+    let (mut solves, mut decided, mut unsolved) = (0, 0, 0);
+    for (k, s) in tr.steps.iter().enumerate() {
+        let Some(status) = s.status else { continue };
+        solves += 1;
+        let t = if s.fallback { tol.max(1e-9) } else { tol };
+        let passes = s.scaled_error <= t && s.error_q <= t.max(1e-9).max(s.error_q_floor);
+        let solved = status == coulomb::contact::ContactStatus::Solved;
+        assert_eq!(
+            solved, passes,
+            "step {k}: {status:?}, scaled_error {:e}, error_q {:e}, fallback {}",
+            s.scaled_error, s.error_q, s.fallback
+        );
+        decided += usize::from(s.fallback);
+        unsolved += usize::from(!solved);
+    }
+    // the scene exercises the rule: many fallback steps, some left unsolved
+    assert!(
+        solves > 800 && decided > 100 && unsolved > 0,
+        "{solves} {decided} {unsolved}"
+    );
+}

@@ -144,8 +144,9 @@ class Trajectory:
         A closed contact took its restitution from the approach velocity of the step that
         closed it.
     fallback : ndarray of bool, shape (N,)
-        The step's solver missed its tolerance and the fallback's answer was used (see
-        ``fallback`` of ``Scene.simulate``).
+        The step's solver missed its tolerance and the fallback decided the step: its
+        answer was used, or judged at the fallback's ``max(tol, 1e-9)`` (see ``fallback`` of
+        ``Scene.simulate``).
     projection : ndarray, shape (N,)
         The largest coordinate change of the drift projection (0 without it).
     contact_step : ndarray of int, shape (n_records,)
@@ -434,7 +435,7 @@ class Trajectory:
         complementarity, sticking or sliding) is judged by the rule and the measure of the
         step's own verdict: the step's ``solver_scaled_error`` (the unit-consistent residual of
         :mod:`coulomb.contact`, relative to the step's impulses) at most the solver's ``tol``
-        (``max(tol, 1e-9)`` for a step decided by the Lemke fallback) and its
+        (``max(tol, 1e-9)`` for a step the fallback decided) and its
         ``solver_error_q`` at most ``max(tol, 1e-9, solver_error_q_floor)`` (a step holds the
         literature's half at 1e-9 when its ``tol`` is tighter: on a stack ``error_q`` divides by
         a ``||q||`` far below the terms the bottom impulses cancel). The raw figures

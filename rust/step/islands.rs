@@ -224,7 +224,7 @@ impl Islands {
             isl.outcome = Some(isl.solve_alone(settings, error_q_tol, warm));
         };
         solve_all(&mut self.work[..count], problem.nc >= PARALLEL_FROM, solve)?;
-        self.scatter(count, problem, nsgs, fallback, ws)
+        self.scatter(count, problem, nsgs, settings.fallback, fallback, ws)
     }
 
     /// the bits of each contact's variables in Lemke's guessed basis, read back from the
@@ -290,12 +290,18 @@ impl Islands {
         isl.outcome = None;
     }
 
-    /// the islands' answers into `ws`, judged on the whole problem.
+    /// the islands' answers into `ws`, judged on the whole problem: an island's verdict is
+    /// its own problem's, whose `error_q` divides by that island's `||q||`, so an island that
+    /// missed its tolerance can leave the step solved by the step's rule, and one that passed
+    /// can leave it unsolved (then the whole problem is solved instead). With `fallback_rule`
+    /// (the step's fallback on) a step where some island missed its tolerance is judged as
+    /// the fallback judges, at `max(tol, 1e-9)`.
     fn scatter(
         &mut self,
         count: usize,
         problem: &ContactProblem<'_>,
         nsgs: &NsgsSettings,
+        fallback_rule: bool,
         fallback: &mut bool,
         ws: &mut SolveBuffers,
     ) -> Result<Split> {
@@ -329,11 +335,11 @@ impl Islands {
             iterations = iterations.max(out.iterations);
             any_fallback |= isl.fallback;
         }
-        *fallback |= any_fallback;
         ws.velocity.resize(nc * dim, 0.0);
         let measures = measure_into(problem, &ws.impulse, &mut ws.velocity);
-        // a fallback's polygon passes at most at 1e-9 (`nsgs_fallback`)
-        let tol = if any_fallback {
+        // a fallback's answer passes at most at 1e-9 (`nsgs_fallback`)
+        let missed = fallback_rule && status == ContactStatus::IterationLimit;
+        let tol = if any_fallback || missed {
             nsgs.tol.max(1e-9)
         } else {
             nsgs.tol
@@ -341,6 +347,11 @@ impl Islands {
         if status == ContactStatus::Solved && !measures.passes(tol) {
             return Ok(Split::Retry);
         }
+        if missed && measures.passes(tol) {
+            status = ContactStatus::Solved;
+            any_fallback = true;
+        }
+        *fallback |= any_fallback;
         Ok(Split::Solved(Outcome {
             status,
             iterations,

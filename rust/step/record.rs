@@ -43,9 +43,10 @@ pub struct StepRecord {
     /// energy is judged across the two steps. Only a rebound owed is counted: the landing had
     /// an approach `v_n^- < 0` (Newton's law) or a compression (Poisson's), and `e > 0`.
     pub resumed: bool,
-    /// NSGS missed its tolerance and the polyhedral Lemke's answer, better on the exact-disk
-    /// error, was used instead; or Lemke failed and NSGS's answer, which passes the exact
-    /// rule, was (see [`super::StepSettings::fallback`]).
+    /// NSGS missed its tolerance and the fallback decided the step: another solver's answer
+    /// (the robust mode's, the polyhedral Lemke's) was used, or the best answer was judged at
+    /// the fallback's `max(tol, 1e-9)`; or Lemke failed and NSGS's answer, which passes the
+    /// exact rule, was (see [`super::StepSettings::fallback`]).
     pub fallback: bool,
     /// the largest position change of the drift projection (m or rad), 0 without it.
     pub projection: f64,

@@ -496,8 +496,13 @@ fn nsgs_fallback(
         }
         best.offer(Best::Nsgs(third));
     }
-    *fallback = !matches!(best, Best::Nsgs(_));
-    Ok(match best {
+    // the fallback's rule, the polygon's above: an answer within max(tol, 1e-9) solves the
+    // step (marked as the fallback's), as the islands' scatter and the trajectory's checks
+    // judge such a step
+    let within = best.measures().passes(tol);
+
+    *fallback = within || !matches!(best, Best::Nsgs(_));
+    let mut out = match best {
         Best::Nsgs(sol) | Best::Other(sol) => ws.take(sol),
         // NSGS's contract is the exact cone: a polygon's answer (3D) that misses it keeps
         // NSGS's verdict
@@ -509,7 +514,11 @@ fn nsgs_fallback(
             },
             ..out
         },
-    })
+    };
+    if within {
+        out.status = ContactStatus::Solved;
+    }
+    Ok(out)
 }
 
 /// The best answer of a step's fallback so far (the lowest unit-consistent error): a
@@ -521,6 +530,13 @@ enum Best {
 }
 
 impl Best {
+    fn measures(&self) -> &ContactMeasures {
+        match self {
+            Best::Nsgs(s) | Best::Other(s) => &s.measures,
+            Best::Polygon(o) => &o.measures,
+        }
+    }
+
     fn error(&self) -> f64 {
         match self {
             Best::Nsgs(s) | Best::Other(s) => s.measures.scaled_error,
