@@ -300,16 +300,19 @@ fn local_3d(blk: &LocalBlock, mu: f64, b: &[f64; 3], old: &[f64; 3]) -> Option<[
 
 /// Solves the friction-contact problem by nonsmooth Gauss-Seidel (see the module notes).
 pub fn solve_nsgs(problem: &ContactProblem<'_>, s: &NsgsSettings) -> Result<ContactSolution> {
-    solve_nsgs_measured(problem, s, None)
+    solve_nsgs_measured(problem, s, None, true)
 }
 
 /// [`solve_nsgs`] given the measures and velocity `u = W r + q` of its initial impulses
 /// (`s.initial`) on this problem, as a caller that has just measured them holds them: they
 /// are taken instead of measured again when the sweeps start from those very impulses.
+/// Without `described` the answer's message is left empty: the stepper reads only the status
+/// and the measures, and formatting the figures cost it about 2 % of a sphere pile's step.
 pub(crate) fn solve_nsgs_measured(
     problem: &ContactProblem<'_>,
     s: &NsgsSettings,
     start: Option<(ContactMeasures, &[f64])>,
+    described: bool,
 ) -> Result<ContactSolution> {
     crate::lcp::check_tol(s.tol)?;
     if !(s.relaxation > 0.0 && s.relaxation < 2.0) {
@@ -437,38 +440,44 @@ pub(crate) fn solve_nsgs_measured(
         best.restore(extrapolation.far_moves(), &mut r, &mut u, &mut measures)
     };
 
+    // the message only when asked for (see `described`)
+    let text = |say: &dyn Fn() -> String| if described { say() } else { String::new() };
     let (status, message) = if measures.passes(s.tol) {
+        let extra = if finished {
+            " and the sticking-set solve after the last"
+        } else {
+            ""
+        };
         (
             ContactStatus::Solved,
-            format!(
-                "solved in {sweeps} sweeps{} (scaled_error {})",
-                if finished {
-                    " and the sticking-set solve after the last"
-                } else {
-                    ""
-                },
-                Readable(measures.scaled_error)
-            ),
+            text(&|| {
+                format!(
+                    "solved in {sweeps} sweeps{extra} (scaled_error {})",
+                    Readable(measures.scaled_error)
+                )
+            }),
         )
     } else if !measures.scaled_error.is_finite() || r.iter().any(|v| !v.is_finite()) {
         (
             ContactStatus::NumericalFailure,
-            format!("the iterates became non-finite after {sweeps} sweeps"),
+            text(&|| format!("the iterates became non-finite after {sweeps} sweeps")),
         )
     } else if let Some(&i) = degenerate.first() {
         (
             ContactStatus::NumericalFailure,
-            format!(
-                "contact {i} has no normal stiffness (W_nn = {} <= 0) and the answer stays \
-                 at {} after {sweeps} sweeps",
-                Readable(blocks[i].a),
-                measures.shortfall(s.tol)
-            ),
+            text(&|| {
+                format!(
+                    "contact {i} has no normal stiffness (W_nn = {} <= 0) and the answer stays \
+                     at {} after {sweeps} sweeps",
+                    Readable(blocks[i].a),
+                    measures.shortfall(s.tol)
+                )
+            }),
         )
     } else {
         (
             ContactStatus::IterationLimit,
-            match restored {
+            text(&|| match restored {
                 None => format!(
                     "stopped at max_iter = {} with {}",
                     s.max_iter,
@@ -480,7 +489,7 @@ pub(crate) fn solve_nsgs_measured(
                     s.max_iter,
                     measures.shortfall(s.tol)
                 ),
-            },
+            }),
         )
     };
     Ok(ContactSolution {

@@ -291,6 +291,7 @@ pub(super) fn solve_or_reuse(
                 problem,
                 &nsgs,
                 ws.warm_measures.take().map(|m| (m, &ws.velocity[..])),
+                false,
             )?;
             if first.success() || !settings.fallback {
                 return Ok(ws.take(first));
@@ -409,7 +410,7 @@ fn reuse_warm_start(
             tol: s.tol * POLISH_TOL,
             ..s.clone()
         };
-        let p = solve_nsgs(problem, &polish)?;
+        let p = solve_nsgs_measured(problem, &polish, None, false)?;
         if p.measures.passes(s.tol) {
             let mut out = ws.take(p);
             out.status = ContactStatus::Solved;
