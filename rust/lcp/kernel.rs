@@ -162,9 +162,14 @@ pub fn max_abs_scaled(x: &[f64], s: &[f64]) -> f64 {
             lanes[k] = if v > lanes[k] { v } else { lanes[k] };
         }
     }
-    let mut m = lanes
-        .iter()
-        .fold(0.0f64, |m, v| if *v > m { *v } else { m });
+    // the lanes are all zero on a short row: no fold
+    let mut m = if split == 0 {
+        0.0
+    } else {
+        lanes
+            .iter()
+            .fold(0.0f64, |m, v| if *v > m { *v } else { m })
+    };
     for (a, b) in x[split..].iter().zip(&s[split..]) {
         let v = (a * b).abs();
         m = if v > m { v } else { m };
@@ -283,6 +288,10 @@ pub fn dot_and_abs(isa: Isa, a: &[f64], b: &[f64]) -> (f64, f64) {
     #[cfg(target_arch = "x86_64")]
     if isa == Isa::Avx512 {
         let n = a.len().min(b.len());
+        if n < LANES {
+            let (d, s) = short_lanes(&a[..n], &b[..n]);
+            return (reduce_lanes(&d), reduce_lanes(&s));
+        }
         // SAFETY: `detect` found AVX-512F on this CPU; both slices hold n entries.
         return unsafe { super::simd512::dot_and_abs(a, b, n) };
     }
@@ -298,7 +307,7 @@ pub fn matvec_and_abs(isa: Isa, m: &[f64], z: &[f64], out: &mut [f64], abs: &mut
     let rows = out.len().min(abs.len()).min(m.len() / n.max(1));
     let mut i = 0;
     #[cfg(target_arch = "x86_64")]
-    if isa == Isa::Avx512 {
+    if isa == Isa::Avx512 && n >= LANES {
         while i + 4 <= rows {
             // SAFETY: `detect` found AVX-512F on this CPU; rows i..i+4 lie inside m.
             let (d, s) = unsafe { super::simd512::dot_and_abs4(&m[i * n..(i + 4) * n], z, n) };
@@ -321,6 +330,9 @@ pub fn dot(isa: Isa, a: &[f64], b: &[f64]) -> f64 {
     #[cfg(target_arch = "x86_64")]
     if isa == Isa::Avx512 {
         let n = a.len().min(b.len());
+        if n < LANES {
+            return reduce_lanes(&short_lanes(&a[..n], &b[..n]).0);
+        }
         // SAFETY: as in `dot_and_abs`.
         return unsafe { super::simd512::dot(a, b, n) };
     }
@@ -333,7 +345,7 @@ pub fn dot(isa: Isa, a: &[f64], b: &[f64]) -> f64 {
 #[inline(always)]
 pub fn ruiz_row(isa: Isa, x: &[f64], s: &[f64], r: f64, colmax: &mut [f64]) -> f64 {
     #[cfg(target_arch = "x86_64")]
-    if isa == Isa::Avx512 {
+    if isa == Isa::Avx512 && x.len().min(s.len()).min(colmax.len()) >= LANES {
         let n = x.len().min(s.len()).min(colmax.len());
         // SAFETY: as in `dot_and_abs`; the three slices hold n entries.
         return unsafe { super::simd512::ruiz_row(x, s, r, colmax, n) };
@@ -363,7 +375,7 @@ pub fn ruiz_sweep(
     colmax.iter_mut().for_each(|c| *c = 0.0);
     let mut i = 0;
     #[cfg(target_arch = "x86_64")]
-    if isa == Isa::Avx512 && colmax.len() >= n {
+    if isa == Isa::Avx512 && colmax.len() >= n && n >= LANES {
         while i + 4 <= rows {
             let r = [row[i], row[i + 1], row[i + 2], row[i + 3]];
             // SAFETY: `detect` found AVX-512F on this CPU; rows i..i+4 lie inside m.
@@ -443,12 +455,90 @@ pub fn axpy_max(isa: Isa, y: &mut [f64], a: f64, x: &[f64]) -> f64 {
     max_magnitude_portable(y)
 }
 
+/// Below one vector of eight the ratio test's AVX-512 forms cost more than their loops: a
+/// masked load of entries just written by scalar stores cannot be forwarded from the store
+/// buffer and waits for them to reach the cache (about a third of a 3x3 Lemke solve's time).
+/// Shorter vectors take the loops, which give bitwise the AVX-512 forms' answers: maxima and
+/// comparisons are exact, [`min_ratio_short`] divides each row's ratio on its own as the
+/// single masked group does, and the sums add their lanes in the vector reduction's order
+/// ([`reduce_lanes`]; `kernel_tests` checks every form bitwise). The fused `axpy_max` keeps
+/// its vector form at every length.
+#[cfg(target_arch = "x86_64")]
+const LANES: usize = 8;
+
+/// The eight lanes of AVX-512's dot product and sum of magnitudes over one masked group of
+/// fewer than [`LANES`] entries: lane i holds `0 + a_i b_i` (the accumulator starts at +0,
+/// which turns a product of -0 into +0), the lanes past the end +0.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn short_lanes(a: &[f64], b: &[f64]) -> ([f64; 8], [f64; 8]) {
+    let (mut d, mut s) = ([0.0f64; 8], [0.0f64; 8]);
+    // a fixed count of eight, so the lanes stay in registers
+    for i in 0..LANES {
+        let p = a.get(i).zip(b.get(i)).map_or(0.0, |(x, y)| x * y);
+        d[i] = 0.0 + p;
+        s[i] = 0.0 + p.abs();
+    }
+    (d, s)
+}
+
+/// The sum of eight lanes in the order of `_mm512_reduce_add_pd`: the two halves added, then
+/// their halves, then the last pair.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn reduce_lanes(l: &[f64; 8]) -> f64 {
+    ((l[0] + l[4]) + (l[2] + l[6])) + ((l[1] + l[5]) + (l[3] + l[7]))
+}
+
+/// [`max_abs_pair`] for fewer than [`LANES`] entries: the same maxima where every entry is
+/// finite, NaN for a vector that holds a non-finite one.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn max_abs_pair_short(a: &[f64], b: &[f64]) -> (f64, f64) {
+    let top = |x: &[f64]| {
+        let (mut m, mut finite) = (0.0f64, true);
+        for v in x {
+            let u = v.abs();
+            m = if u > m { u } else { m };
+            finite &= u.is_finite();
+        }
+        if finite {
+            m
+        } else {
+            f64::NAN
+        }
+    };
+    (top(a), top(b))
+}
+
+/// [`min_ratio`] for fewer than [`LANES`] rows on a CPU with AVX-512, bitwise its vector
+/// form's answer: there every row is a lane of its own, its ratio `b_i / f_i` divided once at
+/// the end, and the least kept (the portable form compares fractions in a chain instead,
+/// which can keep a different one of two ratios equal to rounding).
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn min_ratio_short(f: &[f64], b: &mut [f64], piv_tol: f64, zero: f64) -> f64 {
+    let mut theta = f64::INFINITY;
+    for (fi, bi) in f.iter().zip(b.iter_mut()) {
+        let v = if *bi <= zero { 0.0 } else { *bi };
+        *bi = v;
+        if *fi > piv_tol {
+            let t = v / fi;
+            theta = if t < theta { t } else { theta };
+        }
+    }
+    theta
+}
+
 /// [`max_abs_pair_portable`] with the AVX-512 form on CPUs that have it.
 #[inline(always)]
 pub fn max_abs_pair(isa: Isa, a: &[f64], b: &[f64]) -> (f64, f64) {
     #[cfg(target_arch = "x86_64")]
     if isa == Isa::Avx512 {
         let n = a.len().min(b.len());
+        if n < LANES {
+            return max_abs_pair_short(&a[..n], &b[..n]);
+        }
         // SAFETY: `detect` found AVX-512F on this CPU; both slices hold n entries.
         return unsafe { super::simd512::max_abs_pair(a, b, n) };
     }
@@ -462,6 +552,9 @@ pub fn min_ratio(isa: Isa, f: &[f64], b: &mut [f64], piv_tol: f64, zero: f64) ->
     #[cfg(target_arch = "x86_64")]
     if isa == Isa::Avx512 {
         let n = f.len().min(b.len());
+        if n < LANES {
+            return min_ratio_short(&f[..n], &mut b[..n], piv_tol, zero);
+        }
         // SAFETY: as in `max_abs_pair`.
         return unsafe { super::simd512::min_ratio(f, b, n, piv_tol, zero) };
     }
@@ -480,7 +573,7 @@ pub fn find_ties(
     visit: impl FnMut(usize) -> bool,
 ) -> Option<usize> {
     #[cfg(target_arch = "x86_64")]
-    if isa == Isa::Avx512 {
+    if isa == Isa::Avx512 && f.len().min(b.len()) >= LANES {
         let n = f.len().min(b.len());
         // SAFETY: as in `max_abs_pair`.
         return unsafe { super::simd512::find_ties(f, b, n, piv_tol, bound, visit) };

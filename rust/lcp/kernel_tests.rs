@@ -146,3 +146,130 @@ fn ratio_test_kernels_agree_with_the_ratios() {
         assert_eq!(theta, f64::INFINITY);
     }
 }
+
+/// Below eight entries the ratio test's loops stand in for the AVX-512 forms: every answer
+/// must be bitwise theirs (degenerate rows, ties, signed zeros, entries of every size).
+#[cfg(target_arch = "x86_64")]
+#[test]
+fn short_vectors_give_the_avx512_forms_answers_bitwise() {
+    if detect() != Isa::Avx512 {
+        eprintln!("skipped: this CPU has no AVX-512, so the loops are the only forms");
+        return;
+    }
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut next = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        state
+    };
+    let special = [
+        0.0, -0.0, 1.0, -1.0, 1e-300, -1e-300, 1e300, 5e-324, 1e-13, 1e-11,
+    ];
+    let draw = |next: &mut dyn FnMut() -> u64| -> f64 {
+        let r = next();
+        match r % 4 {
+            0 => special[(r >> 8) as usize % special.len()],
+            1 => ((r >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 4.0,
+            // a few values so that ratios tie
+            2 => [0.5, 1.0, 2.0, -0.5][(r >> 8) as usize % 4],
+            _ => {
+                let e = ((r >> 20) % 80) as i32 - 40;
+                ((r >> 11) as f64 / (1u64 << 53) as f64) * 10f64.powi(e)
+            }
+        }
+    };
+    for case in 0..20_000 {
+        let n = 1 + case % 7;
+        let f: Vec<f64> = (0..n).map(|_| draw(&mut next)).collect();
+        let b0: Vec<f64> = (0..n).map(|_| draw(&mut next)).collect();
+        let s: Vec<f64> = (0..n).map(|_| draw(&mut next)).collect();
+        let (piv_tol, zero) = (1e-11 * (1 + case % 3) as f64, [0.0, 1e-13, 0.25][case % 3]);
+        let (mut b1, mut b2) = (b0.clone(), b0.clone());
+        // SAFETY: `detect` reported AVX-512F; every slice holds n entries.
+        let theta = unsafe { crate::lcp::simd512::min_ratio(&f, &mut b1, n, piv_tol, zero) };
+        let short = min_ratio(Isa::Avx512, &f, &mut b2, piv_tol, zero);
+        assert_eq!(
+            theta.to_bits(),
+            short.to_bits(),
+            "case {case}: {f:?} {b0:?}"
+        );
+        assert!(b1.iter().zip(&b2).all(|(x, y)| x.to_bits() == y.to_bits()));
+        let bound = if theta.is_finite() {
+            theta * (1.0 + 1e-9)
+        } else {
+            1.0
+        };
+        let (mut seen1, mut seen2) = (Vec::new(), Vec::new());
+        let stop = |i: usize| i + 1 == n;
+        // SAFETY: as above.
+        let r1 = unsafe {
+            crate::lcp::simd512::find_ties(&f, &b1, n, piv_tol, bound, |i| {
+                seen1.push(i);
+                stop(i)
+            })
+        };
+        let r2 = find_ties(Isa::Avx512, &f, &b2, piv_tol, bound, |i| {
+            seen2.push(i);
+            stop(i)
+        });
+        assert_eq!((r1, &seen1), (r2, &seen2), "case {case}");
+        // SAFETY: as above.
+        let (a1, c1) = unsafe { crate::lcp::simd512::max_abs_pair(&f, &b0, n) };
+        let (a2, c2) = max_abs_pair(Isa::Avx512, &f, &b0);
+        assert_eq!((a1.to_bits(), c1.to_bits()), (a2.to_bits(), c2.to_bits()));
+        let r = draw(&mut next);
+        let (mut cm1, mut cm2) = (s.clone(), s.clone());
+        for v in cm1.iter_mut().chain(cm2.iter_mut()) {
+            *v = v.abs();
+        }
+        // SAFETY: as above.
+        let m1 = unsafe { crate::lcp::simd512::ruiz_row(&f, &s, r, &mut cm1, n) };
+        let m2 = ruiz_row(Isa::Avx512, &f, &s, r, &mut cm2);
+        assert_eq!(m1.to_bits(), m2.to_bits(), "case {case}");
+        assert!(cm1
+            .iter()
+            .zip(&cm2)
+            .all(|(x, y)| x.to_bits() == y.to_bits()));
+        // SAFETY: as above.
+        let (d1, a1) = unsafe { crate::lcp::simd512::dot_and_abs(&f, &s, n) };
+        let (d2, a2) = dot_and_abs(Isa::Avx512, &f, &s);
+        assert_eq!(
+            (d1.to_bits(), a1.to_bits()),
+            (d2.to_bits(), a2.to_bits()),
+            "case {case}"
+        );
+        // SAFETY: as above.
+        let d3 = unsafe { crate::lcp::simd512::dot(&f, &s, n) };
+        assert_eq!(
+            d3.to_bits(),
+            dot(Isa::Avx512, &f, &s).to_bits(),
+            "case {case}"
+        );
+        // four rows: the vector form's four-row products and Ruiz maxima
+        let m: Vec<f64> = (0..4 * n).map(|_| draw(&mut next)).collect();
+        // SAFETY: as above; m holds 4 n entries.
+        let (d4, s4) = unsafe { crate::lcp::simd512::dot_and_abs4(&m, &s, n) };
+        let (mut out, mut abs) = ([0.0; 4], [0.0; 4]);
+        matvec_and_abs(Isa::Avx512, &m, &s, &mut out, &mut abs);
+        for r in 0..4 {
+            assert_eq!(d4[r].to_bits(), out[r].to_bits(), "case {case} row {r}");
+            assert_eq!(s4[r].to_bits(), abs[r].to_bits(), "case {case} row {r}");
+        }
+        let rows = [1.0, 0.5, 4.0, 0.25];
+        let col: Vec<f64> = (0..n).map(|j| [1.0, 2.0, 0.125][j % 3]).collect();
+        let mut cm4 = vec![0.0; n];
+        // SAFETY: as above.
+        let mx = unsafe { crate::lcp::simd512::ruiz_row4(&m, &col, rows, &mut cm4, n) };
+        let (mut rowmax, mut cm) = ([0.0; 4], vec![0.0; n]);
+        ruiz_sweep(Isa::Avx512, &m, &rows, &col, &mut rowmax, &mut cm);
+        for r in 0..4 {
+            assert_eq!(
+                (rows[r] * mx[r]).to_bits(),
+                rowmax[r].to_bits(),
+                "case {case}"
+            );
+        }
+        assert!(cm4.iter().zip(&cm).all(|(x, y)| x.to_bits() == y.to_bits()));
+    }
+}

@@ -404,9 +404,10 @@ pub fn solve_lemke_into(
     if ws.size() != lcp.n {
         *ws = LemkeWorkspace::new(lcp.n);
     }
-    let mut scratch = std::mem::take(&mut ws.scratch);
+    // the scratch is taken out for the solve, whose path borrows the rest of `ws`
+    let mut scratch = ws.scratch.take().unwrap_or_default();
     solve_on(ws, &mut scratch, lcp, settings, out);
-    ws.scratch = scratch;
+    ws.scratch = Some(scratch);
     Ok(())
 }
 

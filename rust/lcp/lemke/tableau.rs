@@ -62,7 +62,9 @@ pub struct LemkeWorkspace {
     ties_next: Vec<usize>,
     isa: Isa,
     pub(super) product_form: RevisedLemke,
-    pub(super) scratch: super::Scratch,
+    /// boxed so that a solve moves a pointer, not the struct, when it takes it out (None
+    /// only while a solve holds it)
+    pub(super) scratch: Option<Box<super::Scratch>>,
 }
 
 impl LemkeWorkspace {
@@ -100,7 +102,7 @@ impl LemkeWorkspace {
             ties_next: Vec::with_capacity(n),
             isa: kernel::detect(),
             product_form: RevisedLemke::new(if product_form { n } else { 0 }),
-            scratch: super::Scratch::default(),
+            scratch: Some(Box::default()),
         }
     }
 
