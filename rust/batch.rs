@@ -402,11 +402,31 @@ pub fn rollout(
     threads: Option<usize>,
     watch: &mut dyn FnMut() -> bool,
 ) -> Result<Vec<(Trajectory, f64)>> {
+    rollout_then(scenes, threads, watch, |tr| tr)
+}
+
+/// [`rollout`], each trajectory passed through `finish` on the thread that simulated it (a
+/// caller's conversion of the records then runs in parallel too); the seconds are the run's
+/// alone.
+pub fn rollout_then<T, F>(
+    scenes: &[RolloutScene<'_>],
+    threads: Option<usize>,
+    watch: &mut dyn FnMut() -> bool,
+    finish: F,
+) -> Result<Vec<(T, f64)>>
+where
+    T: Send,
+    F: Fn(Trajectory) -> T + Sync,
+{
     check_rollout_records(scenes)?;
     map(scenes.len(), threads, watch, Instant::now, |last, i| {
         let s = &scenes[i];
         let tr = simulate_joints(s.scene, s.joints, s.settings, s.record_every)?;
-        Ok((tr, lap(last)))
+        let seconds = lap(last);
+        let out = finish(tr);
+        // the next scene's time starts after this one's conversion
+        *last = Instant::now();
+        Ok((out, seconds))
     })
 }
 

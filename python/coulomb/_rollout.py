@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Literal
+from typing import Any, Literal
 
 from . import _core
 from ._arguments import Solver
@@ -73,10 +73,18 @@ drift, drift_bias, restitution, record_every, locate_impacts, settings
         if not isinstance(s, Scene):
             raise ArgumentTypeError(f"scenes[{i}] must be a Scene, got {type(s).__name__}")
     n_threads = threads_option(threads)
-    options = [at_problem(i, s._run_args, t_end, h, solver, tol, max_iter, relaxation, facets,
-                          gap_tolerance, warm_start, fallback, drift, drift_bias, restitution,
-                          record_every, locate_impacts, what="scene")
-               for i, s in enumerate(scenes)]
+    # the options depend on a scene only through its dimension (and its having bodies):
+    # checked once per dimension, each scene given that dict
+    checked: dict[int, dict[str, Any]] = {}
+    options = []
+    for i, s in enumerate(scenes):
+        a = checked.get(s.dim)
+        if a is None or not s.bodies:
+            a = at_problem(i, s._run_args, t_end, h, solver, tol, max_iter, relaxation,
+                           facets, gap_tolerance, warm_start, fallback, drift, drift_bias,
+                           restitution, record_every, locate_impacts, what="scene")
+            checked[s.dim] = a
+        options.append(a)
     specs = [at_problem(i, s._spec, what="scene") for i, s in enumerate(scenes)]
     raws = _core.step_rollout(specs, options, n_threads)
     return [Trajectory._from_core(raw, scene=s, h=a["h"], solver=a["solver"],

@@ -40,7 +40,8 @@ if TYPE_CHECKING:
 FORMAT = "coulomb-trajectory"
 VERSION = 1
 
-#: the stored codes of the step statuses (an HDF5 enum, ``status`` in the file).
+#: the codes of the step statuses, as the core returns them and the file stores them (an HDF5
+#: enum, ``status``).
 STATUS_CODES = {"no_contact": 0, "solved": 1, "iteration_limit": 2, "numerical_failure": 3}
 
 #: the per-state, per-step and per-contact arrays, in the core's names.
@@ -128,10 +129,8 @@ class Writer:
             self.ctrl_c.check()
         offset = self.steps
         for name in ARRAYS:
-            if name == "status":
-                data = np.array([STATUS_CODES[s] for s in chunk[name]], dtype=np.uint8)
-            else:
-                data = np.asarray(chunk[name])
+            # a step's status comes as its code (STATUS_CODES)
+            data = np.asarray(chunk[name], dtype=np.uint8 if name == "status" else None)
             if name == "contact_step":
                 data = data + offset
             if name not in self.f:
@@ -149,7 +148,8 @@ class Writer:
             ds.resize(n + len(data), axis=0)
             ds[n:] = data
         self.steps += len(chunk["active"])
-        self.failed += sum(s not in ("solved", "no_contact") for s in chunk["status"])
+        self.failed += int(np.count_nonzero(np.asarray(chunk["status"])
+                                            > STATUS_CODES["solved"]))
         # the rows of whole chunks: a run stopped while a chunk was being appended is read
         # back up to the last whole one
         self.f.attrs.update(states=self.f["t"].shape[0], steps=self.steps,

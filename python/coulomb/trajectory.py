@@ -19,7 +19,6 @@ and falls back in flight), which is the integrator's and not a gain of the conta
 from __future__ import annotations
 
 import os
-from collections import Counter
 from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -27,12 +26,13 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from . import _stream
 from . import _trajectory_checks as _checks
 from ._extras import require
 from ._readable import readable
 from ._result import Result
 from ._status import Status
-from ._stream import Streamed
+from ._stream import STATUS_CODES, Streamed
 from .errors import CoulombError, InternalError, ProblemFormatError
 
 if TYPE_CHECKING:
@@ -56,6 +56,13 @@ def _load_power(scene: Scene | None, v: np.ndarray) -> np.ndarray:
     return np.asarray(v @ f, dtype=np.float64)
 
 
+
+
+#: the Status of each code of STATUS_CODES, and whether it counts as a solved step.
+_STATUS_BY_CODE = np.empty(len(STATUS_CODES), dtype=object)
+for _name, _code in STATUS_CODES.items():
+    _STATUS_BY_CODE[_code] = Status(_name)
+_SUCCEEDED = np.array([s in (Status.SOLVED, Status.NO_CONTACT) for s in _STATUS_BY_CODE])
 
 
 class TrajectoryCheckError(CoulombError, AssertionError):
@@ -300,13 +307,9 @@ class Trajectory:
                          else _load_power(scene, tr.v))
         tr.projection = (np.asarray(raw["projection"]) if "projection" in raw
                          else np.zeros(len(tr.active)))
-        # one Status per distinct name (a run has a handful), looked up step by step
-        names = raw["status"]
-        counts = Counter(names)
-        kinds = {name: Status(name) for name in counts}
-        statuses = np.empty(len(names), dtype=object)
-        statuses[:] = list(map(kinds.__getitem__, names))
-        tr.solver_status = statuses
+        # each step's status by its code (the core's and the files' STATUS_CODES)
+        codes = np.asarray(raw["status"]).astype(np.intp, copy=False)
+        tr.solver_status = _STATUS_BY_CODE[codes]
         tr.solver_error = np.asarray(raw["error"])
         tr.solver_scaled_error = np.asarray(raw["scaled_error"])
         # files streamed before error_q joined the verdict have neither column
@@ -315,8 +318,7 @@ class Trajectory:
                              else np.zeros(n_steps))
         tr.solver_error_q_floor = (np.asarray(raw["error_q_floor"]) if "error_q_floor" in raw
                                    else np.zeros(n_steps))
-        failed = sum(count for name, count in counts.items()
-                     if kinds[name] not in (Status.SOLVED, Status.NO_CONTACT))
+        failed = int(np.count_nonzero(~_SUCCEEDED[codes]))
         if tr.stopped is not None:
             tr.status, tr.message = Status.STOPPED, f"stopped early: {tr.stopped}"
         elif failed:
@@ -336,8 +338,6 @@ class Trajectory:
         require("h5py", extra="hdf5", what="Trajectory.load")
         import h5py
 
-        from . import _stream
-
         with h5py.File(Path(path), "r") as f:
             if f.attrs.get("format") != _stream.FORMAT:
                 raise ProblemFormatError(f"{str(path)!r} is not a coulomb trajectory file")
@@ -351,8 +351,13 @@ class Trajectory:
             raw: dict[str, Any] = {name: f[name][:rows[_stream.ROWS[name]]]
                                    for name in _stream.ARRAYS
                                    if name in f or name not in ("error_q", "error_q_floor")}
-            names = {code: name for name, code in _stream.STATUS_CODES.items()}
-            raw["status"] = [names[int(c)] for c in raw["status"]]
+            codes = np.asarray(raw["status"])
+            if codes.size and (codes.dtype.kind not in "iu" or codes.min() < 0
+                               or codes.max() >= len(_STATUS_BY_CODE)):
+                raise ProblemFormatError(
+                    f"{str(path)!r}: step status codes must be integers in "
+                    f"[0, {len(_STATUS_BY_CODE)}), got {codes.dtype} from {codes.min()} to "
+                    f"{codes.max()}")
             raw["dim"] = int(a["dim"])
             stopped = str(a.get("stopped", ""))
             if not bool(a.get("complete", False)):

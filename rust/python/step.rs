@@ -6,7 +6,7 @@ use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1};
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList, PyString};
+use pyo3::types::{PyDict, PyList};
 
 use super::settings::{self, Keyword};
 use super::{guarded, to_py};
@@ -17,7 +17,7 @@ mod joints;
 mod rollout;
 #[path = "step_stream.rs"]
 mod stream;
-use crate::contact::{ContactOrder, NsgsSettings};
+use crate::contact::{ContactOrder, ContactStatus, NsgsSettings};
 use crate::error::CoulombError;
 use crate::geometry::{Shape2, Shape3};
 use crate::step::{
@@ -369,127 +369,168 @@ pub(super) fn settings_from(
     })
 }
 
+/// a step's status as the code the trajectory's arrays and files store it by
+/// (`coulomb._stream.STATUS_CODES`): 0 no contact, 1 solved, 2 iteration limit, 3 numerical
+/// failure.
+fn status_code(status: Option<ContactStatus>) -> u8 {
+    match status {
+        None => 0,
+        Some(ContactStatus::Solved) => 1,
+        Some(ContactStatus::IterationLimit) => 2,
+        Some(ContactStatus::NumericalFailure) => 3,
+    }
+}
+
+/// A trajectory's records as the columns of `coulomb.trajectory.Trajectory`, formed without
+/// Python (a rollout forms them on the thread that ran the scene); [`columns_dict`] hands
+/// them over without a copy.
+pub(super) struct TrajectoryColumns {
+    dim: usize,
+    states: usize,
+    nq: usize,
+    nv: usize,
+    t: Vec<f64>,
+    q: Vec<f64>,
+    v: Vec<f64>,
+    kinetic_energy: Vec<f64>,
+    potential_energy: Vec<f64>,
+    min_gap: Vec<f64>,
+    negative_gaps: Vec<i64>,
+    /// per step: `active`, `iterations` (as i64); the status codes; the f64 checks by name;
+    /// `resumed`, `fallback`.
+    active: Vec<i64>,
+    iterations: Vec<i64>,
+    status: Vec<u8>,
+    checks: Vec<(&'static str, Vec<f64>)>,
+    resumed: Vec<bool>,
+    fallback: Vec<bool>,
+    /// per contact record.
+    records: usize,
+    contact_step: Vec<i64>,
+    contact_id: Vec<i64>,
+    contact_impulse: Vec<f64>,
+    contact_velocity: Vec<f64>,
+    contact_approach: Vec<f64>,
+    contact_gap: Vec<f64>,
+    contact_closed: Vec<bool>,
+    stopped: Option<String>,
+}
+
+/// a step record's f64 check.
+type Check = fn(&crate::step::StepRecord) -> f64;
+
+/// the step checks of a trajectory's f64 columns, by the core's names.
+const CHECKS: [(&str, Check); 9] = [
+    ("error", |r| r.error),
+    ("scaled_error", |r| r.scaled_error),
+    ("error_q", |r| r.error_q),
+    ("error_q_floor", |r| r.error_q_floor),
+    ("momentum_residual", |r| r.momentum_residual),
+    ("min_normal_impulse", |r| r.min_normal_impulse),
+    ("cone_violation", |r| r.cone_violation),
+    ("complementarity", |r| r.complementarity),
+    ("projection", |r| r.projection),
+];
+
+/// the columns of `tr` (see [`TrajectoryColumns`]).
+pub(super) fn columns(tr: Trajectory) -> TrajectoryColumns {
+    let s = &tr.steps;
+    let c = &tr.contacts;
+    let dim = tr.dim;
+    TrajectoryColumns {
+        dim,
+        states: tr.t.len(),
+        nq: tr.nq,
+        nv: tr.nv,
+        negative_gaps: tr.negative_gaps.iter().map(|&x| x as i64).collect(),
+        active: s.iter().map(|r| r.active as i64).collect(),
+        iterations: s.iter().map(|r| r.iterations as i64).collect(),
+        status: s.iter().map(|r| status_code(r.status)).collect(),
+        checks: CHECKS
+            .iter()
+            .map(|&(name, f)| (name, s.iter().map(f).collect()))
+            .collect(),
+        resumed: s.iter().map(|r| r.resumed).collect(),
+        fallback: s.iter().map(|r| r.fallback).collect(),
+        records: c.len(),
+        contact_step: c.iter().map(|r| r.step as i64).collect(),
+        contact_id: c.iter().map(|r| r.id as i64).collect(),
+        contact_impulse: c
+            .iter()
+            .flat_map(|r| r.impulse.into_iter().take(dim))
+            .collect(),
+        contact_velocity: c
+            .iter()
+            .flat_map(|r| r.velocity.into_iter().take(dim))
+            .collect(),
+        contact_approach: c.iter().map(|r| r.approach).collect(),
+        contact_gap: c.iter().map(|r| r.gap).collect(),
+        contact_closed: c.iter().map(|r| r.closed).collect(),
+        t: tr.t,
+        q: tr.q,
+        v: tr.v,
+        kinetic_energy: tr.kinetic_energy,
+        potential_energy: tr.potential_energy,
+        min_gap: tr.min_gap,
+        stopped: tr.stopped,
+    }
+}
+
 /// A trajectory as the dict of arrays `coulomb.trajectory.Trajectory` is made from.
 pub(super) fn trajectory_dict<'py>(
     py: Python<'py>,
     tr: Trajectory,
     seconds: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
+    columns_dict(py, columns(tr), seconds)
+}
+
+/// [`trajectory_dict`] of columns already formed: each becomes a NumPy array without a copy.
+pub(super) fn columns_dict<'py>(
+    py: Python<'py>,
+    c: TrajectoryColumns,
+    seconds: f64,
+) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
-    let n = tr.t.len();
-    let dim = tr.dim;
-    d.set_item("dim", dim)?;
-    d.set_item("t", PyArray1::from_vec(py, tr.t))?;
-    d.set_item("q", matrix(py, n, tr.nq, tr.q)?)?;
-    d.set_item("v", matrix(py, n, tr.nv, tr.v)?)?;
-    d.set_item("kinetic_energy", PyArray1::from_vec(py, tr.kinetic_energy))?;
+    let n = c.states;
+    d.set_item("dim", c.dim)?;
+    d.set_item("t", PyArray1::from_vec(py, c.t))?;
+    d.set_item("q", matrix(py, n, c.nq, c.q)?)?;
+    d.set_item("v", matrix(py, n, c.nv, c.v)?)?;
+    d.set_item("kinetic_energy", PyArray1::from_vec(py, c.kinetic_energy))?;
     d.set_item(
         "potential_energy",
-        PyArray1::from_vec(py, tr.potential_energy),
+        PyArray1::from_vec(py, c.potential_energy),
     )?;
-    d.set_item("min_gap", PyArray1::from_vec(py, tr.min_gap))?;
-    let neg: Vec<i64> = tr.negative_gaps.iter().map(|&x| x as i64).collect();
-    d.set_item("negative_gaps", PyArray1::from_vec(py, neg))?;
-    let s = &tr.steps;
-    let col_f = |f: fn(&crate::step::StepRecord) -> f64| -> Vec<f64> { s.iter().map(f).collect() };
-    d.set_item(
-        "active",
-        PyArray1::from_vec(py, s.iter().map(|r| r.active as i64).collect::<Vec<_>>()),
-    )?;
-    // one Python string per distinct status, shared by the steps
-    let mut names: Vec<(&str, Bound<'py, PyString>)> = Vec::new();
-    let mut status = Vec::with_capacity(s.len());
-    for r in s {
-        let name = r.status.map_or("no_contact", |x| x.as_str());
-        let obj = match names.iter().find(|(k, _)| *k == name) {
-            Some((_, o)) => o.clone(),
-            None => {
-                let o = PyString::intern(py, name);
-                names.push((name, o.clone()));
-                o
-            }
-        };
-        status.push(obj);
+    d.set_item("min_gap", PyArray1::from_vec(py, c.min_gap))?;
+    d.set_item("negative_gaps", PyArray1::from_vec(py, c.negative_gaps))?;
+    d.set_item("active", PyArray1::from_vec(py, c.active))?;
+    // each step's status as its code (`STATUS_CODES` of `coulomb._stream`): one small array,
+    // not a Python string per step
+    d.set_item("status", PyArray1::from_vec(py, c.status))?;
+    d.set_item("iterations", PyArray1::from_vec(py, c.iterations))?;
+    for (name, col) in c.checks {
+        d.set_item(name, PyArray1::from_vec(py, col))?;
     }
-    d.set_item("status", PyList::new(py, status)?)?;
-    d.set_item("error", PyArray1::from_vec(py, col_f(|r| r.error)))?;
+    d.set_item("resumed", PyArray1::from_vec(py, c.resumed))?;
+    d.set_item("fallback", PyArray1::from_vec(py, c.fallback))?;
+    d.set_item("contact_step", PyArray1::from_vec(py, c.contact_step))?;
+    d.set_item("contact_id", PyArray1::from_vec(py, c.contact_id))?;
     d.set_item(
-        "scaled_error",
-        PyArray1::from_vec(py, col_f(|r| r.scaled_error)),
-    )?;
-    d.set_item("error_q", PyArray1::from_vec(py, col_f(|r| r.error_q)))?;
-    d.set_item(
-        "error_q_floor",
-        PyArray1::from_vec(py, col_f(|r| r.error_q_floor)),
+        "contact_impulse",
+        matrix(py, c.records, c.dim, c.contact_impulse)?,
     )?;
     d.set_item(
-        "iterations",
-        PyArray1::from_vec(
-            py,
-            s.iter().map(|r| r.iterations as i64).collect::<Vec<_>>(),
-        ),
+        "contact_velocity",
+        matrix(py, c.records, c.dim, c.contact_velocity)?,
     )?;
-    d.set_item(
-        "momentum_residual",
-        PyArray1::from_vec(py, col_f(|r| r.momentum_residual)),
-    )?;
-    d.set_item(
-        "min_normal_impulse",
-        PyArray1::from_vec(py, col_f(|r| r.min_normal_impulse)),
-    )?;
-    d.set_item(
-        "cone_violation",
-        PyArray1::from_vec(py, col_f(|r| r.cone_violation)),
-    )?;
-    d.set_item(
-        "complementarity",
-        PyArray1::from_vec(py, col_f(|r| r.complementarity)),
-    )?;
-    d.set_item(
-        "resumed",
-        PyArray1::from_vec(py, s.iter().map(|r| r.resumed).collect::<Vec<_>>()),
-    )?;
-    d.set_item(
-        "fallback",
-        PyArray1::from_vec(py, s.iter().map(|r| r.fallback).collect::<Vec<_>>()),
-    )?;
-    d.set_item(
-        "projection",
-        PyArray1::from_vec(py, col_f(|r| r.projection)),
-    )?;
-    let c = &tr.contacts;
-    let nrec = c.len();
-    d.set_item(
-        "contact_step",
-        PyArray1::from_vec(py, c.iter().map(|r| r.step as i64).collect::<Vec<_>>()),
-    )?;
-    d.set_item(
-        "contact_id",
-        PyArray1::from_vec(py, c.iter().map(|r| r.id as i64).collect::<Vec<_>>()),
-    )?;
-    let imp: Vec<f64> = c
-        .iter()
-        .flat_map(|r| r.impulse.into_iter().take(dim))
-        .collect();
-    d.set_item("contact_impulse", matrix(py, nrec, dim, imp)?)?;
-    let vel: Vec<f64> = c
-        .iter()
-        .flat_map(|r| r.velocity.into_iter().take(dim))
-        .collect();
-    d.set_item("contact_velocity", matrix(py, nrec, dim, vel)?)?;
     d.set_item(
         "contact_approach",
-        PyArray1::from_vec(py, c.iter().map(|r| r.approach).collect::<Vec<_>>()),
+        PyArray1::from_vec(py, c.contact_approach),
     )?;
-    d.set_item(
-        "contact_gap",
-        PyArray1::from_vec(py, c.iter().map(|r| r.gap).collect::<Vec<_>>()),
-    )?;
-    d.set_item(
-        "contact_closed",
-        PyArray1::from_vec(py, c.iter().map(|r| r.closed).collect::<Vec<_>>()),
-    )?;
-    d.set_item("stopped", tr.stopped)?;
+    d.set_item("contact_gap", PyArray1::from_vec(py, c.contact_gap))?;
+    d.set_item("contact_closed", PyArray1::from_vec(py, c.contact_closed))?;
+    d.set_item("stopped", c.stopped)?;
     d.set_item("solve_time", seconds)?;
     Ok(d)
 }

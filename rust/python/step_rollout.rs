@@ -10,7 +10,7 @@ use pyo3::types::{PyDict, PyList};
 use super::super::batch::batch_guarded;
 use super::super::settings::Keyword;
 use super::joints::joints_from_dict;
-use super::{item, scene_from_dict, settings_from, to_py, trajectory_dict};
+use super::{columns, columns_dict, item, scene_from_dict, settings_from, to_py};
 use crate::batch::{self, at_problem, RolloutScene};
 use crate::error::CoulombError;
 use crate::step::{Joint, Scene, StepSettings};
@@ -122,10 +122,13 @@ pub(super) fn step_rollout<'py>(
             record_every: *record_every,
         })
         .collect();
-    let out = batch_guarded(py, |watch| batch::rollout(&runs, threads, watch))?;
+    // each trajectory's columns formed on the thread that ran it
+    let out = batch_guarded(py, |watch| {
+        batch::rollout_then(&runs, threads, watch, columns)
+    })?;
     let list = PyList::empty(py);
-    for (tr, seconds) in out {
-        list.append(trajectory_dict(py, tr, seconds)?)?;
+    for (cols, seconds) in out {
+        list.append(columns_dict(py, cols, seconds)?)?;
     }
     Ok(list)
 }

@@ -27,14 +27,45 @@ def _as_str_values(path: Path, type_name: str) -> set[str]:
     return values
 
 
+def _as_str_map(path: Path, type_name: str) -> dict[str, str]:
+    """Variant name -> the string `<type_name>::as_str` gives it."""
+    text = path.read_text()
+    block = re.search(
+        rf"impl {type_name} \{{.*?fn as_str\(self\) -> &'static str \{{(.*?)\n    \}}",
+        text,
+        re.S,
+    )
+    assert block is not None, f"no {type_name}::as_str in {path}"
+    return dict(re.findall(rf'{type_name}::(\w+) => "(\w+)"', block.group(1)))
+
+
+def _step_status_codes() -> dict[str, int]:
+    """The codes the core gives a trajectory's step statuses (`status_code` in step.rs), by
+    the status's string: `None` is a step without an active contact."""
+    src = (ROOT / "rust" / "python" / "step.rs").read_text()
+    block = re.search(r"fn status_code\(status: Option<ContactStatus>\) -> u8 \{(.*?)\n\}",
+                      src, re.S)
+    assert block is not None, "no status_code in rust/python/step.rs"
+    names = _as_str_map(ROOT / "rust" / "contact" / "mod.rs", "ContactStatus")
+    none = re.findall(r"None => (\d+)", block.group(1))
+    assert len(none) == 1, "status_code must give a step without contact one code"
+    codes = {"no_contact": int(none[0])}
+    for variant, c in re.findall(r"Some\(ContactStatus::(\w+)\) => (\d+)", block.group(1)):
+        codes[names[variant]] = int(c)
+    return codes
+
+
 def _core_statuses() -> set[str]:
     lcp = _as_str_values(ROOT / "rust" / "lcp" / "mod.rs", "LcpStatus")
     contact = _as_str_values(ROOT / "rust" / "contact" / "mod.rs", "ContactStatus")
-    step_src = (ROOT / "rust" / "python" / "step.rs").read_text()
-    # the stepper's record of a step without an active contact
-    step = set(re.findall(r'r\.status\.map_or\("(\w+)"', step_src))
-    assert step == {"no_contact"}
-    return lcp | contact | step
+    return lcp | contact | set(_step_status_codes())
+
+
+def test_the_core_s_step_status_codes_are_the_files_codes() -> None:
+    from coulomb._stream import STATUS_CODES
+
+    # every ContactStatus has a code, and no step without contact is taken for a solve
+    assert _step_status_codes() == STATUS_CODES
 
 
 def test_every_status_the_core_can_report_is_a_member() -> None:

@@ -86,6 +86,18 @@ def test_a_failed_step_in_the_stream_is_kept_and_counted(tmp_path):
     assert out.status == whole.status == coulomb.Status.SOLVER_FAILURES
 
 
+def test_a_file_with_a_step_status_code_out_of_range_is_refused(tmp_path):
+    path = tmp_path / "bad.h5"
+    landing_box().stream(path, 0.05, 1e-3, chunk=10)
+    with h5py.File(path, "r+") as f:
+        codes = f["status"][:].astype(np.uint8)
+        del f["status"]
+        codes[3] = 7
+        f.create_dataset("status", data=codes)
+    with pytest.raises(coulomb.errors.ProblemFormatError, match="status codes"):
+        coulomb.Trajectory.load(path)
+
+
 #: a child process that runs one call on the 3D pile and prints its peak resident memory (KiB).
 PEAK = """
 import resource, sys
