@@ -44,7 +44,6 @@ _LcpStatusName = Literal[
     "no_solution",
 ]
 _ContactStatusName = Literal["solved", "iteration_limit", "numerical_failure"]
-_StepStatusName = _ContactStatusName | Literal["no_contact"]
 
 class _LcpMeasuresDict(TypedDict):
     """``lcp_measures``: the error measures of a given z on (M, q)."""
@@ -184,7 +183,8 @@ class _StepSimulateDict(TypedDict):
     min_gap: _F64
     negative_gaps: _I64
     active: _I64
-    status: list[_StepStatusName]
+    status: NDArray[np.uint8]
+    """each step's status as its code: ``STATUS_CODES`` of ``coulomb._stream``."""
     error: _F64
     scaled_error: _F64
     error_q: _F64
