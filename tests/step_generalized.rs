@@ -161,9 +161,9 @@ fn a_particle_on_a_ramp_slides_and_sticks_as_the_scene() {
         let reference = simulate(&scene, &st).unwrap();
         same_run(&model.trajectory, &reference, 1e-12);
         // the power of gravity at each state: f . v
-        let last = model.load_power.len() - 1;
+        let last = model.trajectory.load_power.len() - 1;
         let v = &model.trajectory.v[2 * last..];
-        assert!((model.load_power[last] - (-2.0 * G * v[1])).abs() < 1e-12);
+        assert!((model.trajectory.load_power[last] - (-2.0 * G * v[1])).abs() < 1e-12);
     }
 }
 

@@ -180,8 +180,8 @@ fn a_located_elastic_bounce_keeps_the_apex_energy_over_100_bounces_as_the_scene(
             assert!(bounces >= 100, "{case}: {bounces}");
             let n = tr.t.len() - 1;
             let (e0, e1) = (
-                flight_energy(tr, &model.load_power, 0, h),
-                flight_energy(tr, &model.load_power, n, h),
+                flight_energy(tr, &model.trajectory.load_power, 0, h),
+                flight_energy(tr, &model.trajectory.load_power, n, h),
             );
             assert!(((e1 - e0) / e0).abs() < 1e-9, "{case}: {e0} -> {e1}");
             assert!(tr.steps.iter().all(|s| s.min_normal_impulse >= 0.0));
@@ -261,8 +261,8 @@ fn a_rod_end_impact_is_located_mid_step_as_the_scene() {
                 if mu == 0.0 && e == 1.0 {
                     let n = tr.t.len() - 1;
                     let (e0, e1) = (
-                        flight_energy(tr, &model.load_power, 0, h),
-                        flight_energy(tr, &model.load_power, n, h),
+                        flight_energy(tr, &model.trajectory.load_power, 0, h),
+                        flight_energy(tr, &model.trajectory.load_power, n, h),
                     );
                     assert!(((e1 - e0) / e0).abs() < 1e-12, "{case}: {e0} -> {e1}");
                 }

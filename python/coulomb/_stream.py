@@ -3,8 +3,8 @@
 The stepper hands its records out in chunks of at most ``chunk`` kept states; each chunk is
 appended to resizable datasets and dropped, so the memory of a run does not grow with its
 length. The file holds one dataset per array of :class:`~coulomb.trajectory.Trajectory`, by the
-same names (``t``, ``q``, ``v``, ``kinetic_energy``, ``potential_energy``, ``min_gap``,
-``negative_gaps``, the step checks ``active``, ``status``, ``error``, ``scaled_error``,
+same names (``t``, ``q``, ``v``, ``kinetic_energy``, ``potential_energy``, ``load_power``,
+``min_gap``, ``negative_gaps``, the step checks ``active``, ``status``, ``error``, ``scaled_error``,
 ``error_q``, ``error_q_floor``, ``iterations``, ``momentum_residual``, ``min_normal_impulse``,
 ``cone_violation``, ``complementarity``, ``resumed``, ``fallback``, ``projection``, and the
 contact records ``contact_step``, ``contact_id``, ``contact_impulse``, ``contact_velocity``,
@@ -46,7 +46,8 @@ STATUS_CODES = {"no_contact": 0, "solved": 1, "iteration_limit": 2, "numerical_f
 
 #: the per-state, per-step and per-contact arrays, in the core's names.
 ARRAYS = (
-    "t", "q", "v", "kinetic_energy", "potential_energy", "min_gap", "negative_gaps", "active",
+    "t", "q", "v", "kinetic_energy", "potential_energy", "load_power", "min_gap", "negative_gaps",
+    "active",
     "status", "error", "scaled_error", "error_q", "error_q_floor", "iterations",
     "momentum_residual", "min_normal_impulse", "cone_violation", "complementarity", "resumed",
     "fallback", "projection", "contact_step", "contact_id", "contact_impulse", "contact_velocity",
@@ -56,7 +57,7 @@ ARRAYS = (
 #: which row count of the file (its attributes ``states``, ``steps``, ``contacts``) each array
 #: has.
 ROWS = {name: ("states" if name in ("t", "q", "v", "kinetic_energy", "potential_energy",
-                                    "min_gap", "negative_gaps")
+                                    "load_power", "min_gap", "negative_gaps")
                else "contacts" if name.startswith("contact_") else "steps")
         for name in ARRAYS}
 
@@ -166,13 +167,14 @@ class Streamed:
     tolerance (as :attr:`Trajectory.success <coulomb.trajectory.Trajectory.success>`).
 
     The file holds one dataset per array of a trajectory, by the same names (``t``, ``q``,
-    ``v``, the energies, ``min_gap``, ``negative_gaps``, the step checks, ``status`` as an HDF5
-    enum of the status names, and the ``contact_*`` records, ``contact_step`` being the row in
-    the file's step arrays), in storage chunks of about 64 KiB, and the attributes
-    ``format = "coulomb-trajectory"``, ``version``, ``dim``, ``h``, ``solver``, ``tol``,
-    ``gap_tolerance``, ``record_every``, ``stopped`` (empty when every step ran),
-    ``solve_time``, ``complete`` (false until the run ended: a run cut short by Ctrl-C says
-    so) and ``states``, ``steps``, ``contacts`` (the rows of the whole chunks written)."""
+    ``v``, the energies, ``load_power``, ``min_gap``, ``negative_gaps``, the step checks,
+    ``status`` as an HDF5 enum of the status names, and the ``contact_*`` records,
+    ``contact_step`` being the row in the file's step arrays), in storage chunks of about
+    64 KiB, and the attributes ``format = "coulomb-trajectory"``, ``version``, ``dim``, ``h``,
+    ``solver``, ``tol``, ``gap_tolerance``, ``record_every``, ``stopped`` (empty when every
+    step ran), ``solve_time``, ``complete`` (false until the run ended: a run cut short by
+    Ctrl-C says so) and ``states``, ``steps``, ``contacts`` (the rows of the whole chunks
+    written)."""
 
     path: Path
     states: int

@@ -41,6 +41,10 @@ if TYPE_CHECKING:
 __all__ = ["Streamed", "Trajectory", "TrajectoryCheckError"]
 
 
+#: the arrays a trajectory file of the first version may lack.
+_LATER_ARRAYS = ("error_q", "error_q_floor", "load_power")
+
+
 def _load_power(scene: Scene | None, v: np.ndarray) -> np.ndarray:
     """``f . v`` per state of the constant loads ``m g + F`` of a scene's bodies (on their
     translational velocities); zeros without a scene."""
@@ -334,7 +338,7 @@ class Trajectory:
     def load(cls, path: str | os.PathLike[str], scene: Scene | None = None) -> Trajectory:
         """Reads a trajectory written by :meth:`Scene.stream <coulomb.model.Scene.stream>`
         (h5py, the optional extra ``coulomb[hdf5]``) into memory; ``scene`` (the one streamed)
-        gives :meth:`body` and the load power (zero without it)."""
+        gives :meth:`body` (and the load power of a file written before it was stored)."""
         require("h5py", extra="hdf5", what="Trajectory.load")
         import h5py
 
@@ -347,10 +351,11 @@ class Trajectory:
             if rows["states"] == 0:
                 raise ProblemFormatError(f"{str(path)!r} holds no states (its run stopped "
                                          "before the first chunk was written)")
-            # error_q and error_q_floor joined the file after its first version
+            # error_q, error_q_floor and load_power joined the file after its first version
+            # (an older file's load power is formed from ``scene``)
             raw: dict[str, Any] = {name: f[name][:rows[_stream.ROWS[name]]]
                                    for name in _stream.ARRAYS
-                                   if name in f or name not in ("error_q", "error_q_floor")}
+                                   if name in f or name not in _LATER_ARRAYS}
             codes = np.asarray(raw["status"])
             if codes.size and (codes.dtype.kind not in "iu" or codes.min() < 0
                                or codes.max() >= len(_STATUS_BY_CODE)):

@@ -205,9 +205,7 @@ pub(super) fn model_simulate<'py>(
         return Err(e);
     }
     let (tr, seconds) = run?;
-    let d = trajectory_dict(py, tr.trajectory, seconds)?;
-    d.set_item("load_power", PyArray1::from_vec(py, tr.load_power))?;
-    Ok(d)
+    trajectory_dict(py, tr.trajectory, seconds)
 }
 
 /// registers `model_simulate` in `coulomb._core`.

@@ -394,6 +394,7 @@ pub(super) struct TrajectoryColumns {
     v: Vec<f64>,
     kinetic_energy: Vec<f64>,
     potential_energy: Vec<f64>,
+    load_power: Vec<f64>,
     min_gap: Vec<f64>,
     negative_gaps: Vec<i64>,
     /// per step: `active`, `iterations` (as i64); the status codes; the f64 checks by name;
@@ -471,6 +472,7 @@ pub(super) fn columns(tr: Trajectory) -> TrajectoryColumns {
         v: tr.v,
         kinetic_energy: tr.kinetic_energy,
         potential_energy: tr.potential_energy,
+        load_power: tr.load_power,
         min_gap: tr.min_gap,
         stopped: tr.stopped,
     }
@@ -502,6 +504,7 @@ pub(super) fn columns_dict<'py>(
         "potential_energy",
         PyArray1::from_vec(py, c.potential_energy),
     )?;
+    d.set_item("load_power", PyArray1::from_vec(py, c.load_power))?;
     d.set_item("min_gap", PyArray1::from_vec(py, c.min_gap))?;
     d.set_item("negative_gaps", PyArray1::from_vec(py, c.negative_gaps))?;
     d.set_item("active", PyArray1::from_vec(py, c.active))?;

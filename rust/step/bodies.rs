@@ -308,8 +308,8 @@ impl Stepper {
     }
 
     /// kinetic and potential energy at the current state (bodies frozen at it).
-    pub(super) fn energies(&self) -> (f64, f64) {
-        let (mut t, mut v) = (0.0, 0.0);
+    pub(super) fn energies(&self) -> (f64, f64, f64) {
+        let (mut t, mut v, mut p) = (0.0, 0.0, 0.0);
         for (bi, b) in self.bodies.iter().enumerate() {
             let m = &self.frozen[bi].m;
             let vel = &self.v[b.off_v..b.off_v + b.nv];
@@ -325,9 +325,10 @@ impl Stepper {
             }
             for k in 0..self.dim {
                 v -= b.load[k] * self.q[b.off_q + k];
+                p += b.load[k] * vel[k];
             }
         }
-        (t, v)
+        (t, v, p)
     }
 
     /// `q <- q ⊕ dq` with dq in velocity coordinates (a rotation vector for spatial bodies).

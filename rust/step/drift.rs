@@ -41,7 +41,7 @@ impl Stepper {
     }
 
     fn total_energy(&self) -> f64 {
-        let (t, v) = self.energies();
+        let (t, v, _) = self.energies();
         t + v
     }
 

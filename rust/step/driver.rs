@@ -276,7 +276,7 @@ impl Driver for Stepper {
         Stepper::remember(self, v_next, contacts);
     }
     fn energy(&mut self) -> Result<f64> {
-        let (t, v) = self.energies();
+        let (t, v, _) = self.energies();
         Ok(t + v)
     }
     fn advance(&mut self, v_next: Vec<f64>) {

@@ -100,8 +100,6 @@ pub struct GeneralizedStepper<S: GeneralizedSystem> {
     saved_q: Vec<f64>,
     saved_v: Vec<f64>,
     mass_moved: bool,
-    /// `f . v` at each recorded state of the run.
-    load_power: Vec<f64>,
 }
 
 impl<S: GeneralizedSystem> Driver for GeneralizedStepper<S> {
@@ -233,7 +231,6 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
             saved_q: vec![0.0; nv],
             saved_v: vec![0.0; nv],
             mass_moved: false,
-            load_power: Vec::new(),
             laws,
         })
     }
@@ -462,7 +459,7 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
         Ok(self.kinetic() + self.system.potential(&self.q)?)
     }
 
-    /// records the current state into `out` (and `f . v` into `load_power`).
+    /// records the current state into `out` (`f . v` as its load power).
     fn push_state(&mut self, out: &mut Trajectory) -> Result<()> {
         self.prepare()?;
         out.t.push(self.t);
@@ -475,8 +472,7 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
             .push(self.gaps.iter().copied().fold(f64::INFINITY, f64::min));
         out.negative_gaps
             .push(self.gaps.iter().filter(|&&g| g < -tol).count());
-        let power = dot(&self.f, &self.v);
-        self.load_power.push(power);
+        out.load_power.push(dot(&self.f, &self.v));
         Ok(())
     }
 }
@@ -496,14 +492,12 @@ fn dot(x: &[f64], y: &[f64]) -> f64 {
     x.iter().zip(y).map(|(a, b)| a * b).sum()
 }
 
-/// The run of a [`GeneralizedSystem`]: the trajectory, and `f . v` at each recorded state
-/// (the power of the forces, for the energy balance `T + V + (h / 2) f . v`).
+/// The run of a [`GeneralizedSystem`]: the trajectory, its load power the forces'
+/// `f(q, v, t) . v` at each recorded state (for the energy balance `T + V + (h / 2) f . v`).
 #[derive(Clone, Debug)]
 pub struct GeneralizedTrajectory {
     /// states, step checks and contact records, as a scene's.
     pub trajectory: Trajectory,
-    /// `f(q, v, t) . v` per recorded state.
-    pub load_power: Vec<f64>,
 }
 
 /// Runs `settings.steps` steps of `system` from `(q0, v0)`, keeping the state after every
@@ -532,11 +526,6 @@ pub fn simulate_generalized<S: GeneralizedSystem>(
     )?;
     let reserve = rows.min(4096);
     let mut out = Trajectory::reserved(st.dim, nv, nv, reserve);
-    st.load_power = Vec::with_capacity(reserve);
     run_recorded(&mut st, steps, every, &mut out)?;
-    let load_power = std::mem::take(&mut st.load_power);
-    Ok(GeneralizedTrajectory {
-        trajectory: out,
-        load_power,
-    })
+    Ok(GeneralizedTrajectory { trajectory: out })
 }

@@ -95,6 +95,9 @@ pub struct Trajectory {
     pub kinetic_energy: Vec<f64>,
     /// potential energy of gravity and the constant forces per state, `-Σ (m g + F) . x` (J).
     pub potential_energy: Vec<f64>,
+    /// the power of those loads per state, `Σ (m g + F) . v` (W; a model's `f(q, v, t) . v`),
+    /// for the step's energy `T + V + (h / 2) f . v`.
+    pub load_power: Vec<f64>,
     /// the smallest gap over every candidate contact, per state (`+inf` without candidates).
     pub min_gap: Vec<f64>,
     /// how many candidate contacts have a gap below `-gap_tolerance`, per state.
@@ -242,6 +245,7 @@ impl Trajectory {
             v: Vec::with_capacity(reserve * nv),
             kinetic_energy: Vec::with_capacity(reserve),
             potential_energy: Vec::with_capacity(reserve),
+            load_power: Vec::with_capacity(reserve),
             min_gap: Vec::with_capacity(reserve),
             negative_gaps: Vec::with_capacity(reserve),
             steps: Vec::with_capacity(reserve),

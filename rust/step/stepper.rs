@@ -566,9 +566,10 @@ impl Stepper {
         out.t.push(self.t);
         out.q.extend_from_slice(&self.q);
         out.v.extend_from_slice(&self.v);
-        let (t, v) = self.energies();
+        let (t, v, p) = self.energies();
         out.kinetic_energy.push(t);
         out.potential_energy.push(v);
+        out.load_power.push(p);
         let (g, neg) = self.gap_summary();
         out.min_gap.push(g);
         out.negative_gaps.push(neg);

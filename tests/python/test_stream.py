@@ -76,6 +76,31 @@ def test_the_streamed_file_is_the_one_shot_trajectory_bit_for_bit(tmp_path, make
     assert_same(out.load(scene=make()), whole)
 
 
+def pushed_box() -> coulomb.Scene:
+    """2D: a box pushed along the floor by a constant force (a load besides gravity)."""
+    s = coulomb.Scene(dim=2)
+    b = s.add(coulomb.RigidBody2D(mass=2.0, inertia=0.2, position=(0.0, 0.55),
+                                  velocity=(0.3, 0.0), force=(3.0, -1.0)))
+    s.contact(s.attach(b, coulomb.Box((0.5, 0.5))), s.add(coulomb.HalfSpace()), mu=0.1, e=0.0)
+    return s
+
+
+def test_the_load_power_is_f_dot_v_with_or_without_the_scene(tmp_path):
+    scene = pushed_box()
+    path = tmp_path / "run.h5"
+    scene.stream(path, 0.3, 1e-3, chunk=40)
+    f = np.array([3.0, -1.0 - 2.0 * 9.81, 0.0])  # F + m g on (x, y, theta)
+    for back in (coulomb.Trajectory.load(path), coulomb.Trajectory.load(path, scene=scene)):
+        np.testing.assert_allclose(back.load_power, back.v @ f, rtol=1e-14, atol=1e-14)
+        assert np.ptp(back.load_power) > 0.5  # the force did work that changed over the run
+    # a file of the first version has no load power: it is formed from the scene
+    with h5py.File(path, "r+") as h:
+        del h["load_power"]
+    old = coulomb.Trajectory.load(path, scene=scene)
+    np.testing.assert_allclose(old.load_power, old.v @ f, rtol=1e-14, atol=1e-14)
+    np.testing.assert_array_equal(coulomb.Trajectory.load(path).load_power, 0.0)
+
+
 def test_a_failed_step_in_the_stream_is_kept_and_counted(tmp_path):
     kw = {"max_iter": 1, "fallback": False, "tol": 1e-14, "record_every": 50}
     whole = landing_box().simulate(1.0, 1e-3, **kw)
