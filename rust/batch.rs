@@ -24,7 +24,7 @@
 use std::ops::Range;
 use std::panic::{catch_unwind, resume_unwind, AssertUnwindSafe};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{mpsc, Arc, Mutex};
+use std::sync::{mpsc, Arc, Mutex, OnceLock};
 use std::time::Instant;
 
 use rayon::prelude::*;
@@ -54,10 +54,18 @@ const REUSED_WORKSPACE_MAX_N: usize = 256;
 /// the pools built so far, one per thread count, with the process that built them.
 static POOLS: Mutex<Vec<(usize, u32, Arc<ThreadPool>)>> = Mutex::new(Vec::new());
 
-/// the number of threads `threads` asks for: all the cores when `None`.
+/// the cores this process may run on, asked once: on Linux the standard library reads the
+/// affinity mask and the cgroup quota files at every call (tens of microseconds, more than a
+/// whole one-body simulation of 200 steps).
+static CORES: OnceLock<usize> = OnceLock::new();
+
+/// the number of threads `threads` asks for: all the cores when `None` (as the process found
+/// them at its first parallel call).
 pub fn thread_count(threads: Option<usize>) -> Result<usize> {
     match threads {
-        None => Ok(std::thread::available_parallelism().map_or(1, |n| n.get())),
+        None => {
+            Ok(*CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |n| n.get())))
+        }
         Some(t) if (1..=MAX_THREADS).contains(&t) => Ok(t),
         Some(t) => Err(CoulombError::InvalidParameter(format!(
             "threads must be an int in [1, {MAX_THREADS}], got {t}"
