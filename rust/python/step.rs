@@ -2,9 +2,9 @@
 //! `step_simulate`): a scene as a dict of plain lists in, the trajectory as a dict of numpy
 //! arrays out. The whole loop runs in Rust with the GIL released.
 
-use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray1};
+use numpy::{IntoPyArray, PyArrayMethods};
 use pyo3::exceptions::PyRuntimeError;
+use pyo3::intern;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
@@ -303,18 +303,6 @@ fn shape3(s: &Bound<'_, PyDict>, kind: &str) -> Result<Shape3, CoulombError> {
     })
 }
 
-fn matrix<'py, T: numpy::Element>(
-    py: Python<'py>,
-    rows: usize,
-    cols: usize,
-    data: Vec<T>,
-) -> PyResult<Bound<'py, PyAny>> {
-    Ok(Array2::from_shape_vec((rows, cols), data)
-        .map_err(|e| PyRuntimeError::new_err(format!("internal shape error: {e}")))?
-        .into_pyarray(py)
-        .into_any())
-}
-
 /// The step settings from the options of `step_simulate` and `model_simulate`.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn settings_from(
@@ -487,7 +475,42 @@ pub(super) fn trajectory_dict<'py>(
     columns_dict(py, columns(tr), seconds)
 }
 
-/// [`trajectory_dict`] of columns already formed: each becomes a NumPy array without a copy.
+/// columns up to this many entries are copied into arrays NumPy allocates; longer ones are
+/// handed over without a copy. Handing a `Vec` over costs a Python object that owns it
+/// besides the array (about 0.2 us, the trajectory of a short run having 30 columns), while
+/// copying a short column costs less than that.
+const COPIED_UP_TO: usize = 2048;
+
+/// `data` as a NumPy array of `shape` (`data.len()` its product).
+fn column<'py, T: numpy::Element + Copy, const D: usize>(
+    py: Python<'py>,
+    shape: [usize; D],
+    data: Vec<T>,
+) -> PyResult<Bound<'py, PyAny>>
+where
+    numpy::ndarray::Dim<[usize; D]>: numpy::ndarray::Dimension,
+    [usize; D]: numpy::ndarray::IntoDimension<Dim = numpy::ndarray::Dim<[usize; D]>>,
+{
+    if shape.iter().product::<usize>() != data.len() {
+        return Err(PyRuntimeError::new_err(format!(
+            "internal shape error: {} entries for shape {shape:?}",
+            data.len()
+        )));
+    }
+    if data.len() > COPIED_UP_TO {
+        let a = numpy::ndarray::Array::from_shape_vec(shape, data)
+            .map_err(|e| PyRuntimeError::new_err(format!("internal shape error: {e}")))?;
+        return Ok(a.into_pyarray(py).into_any());
+    }
+    let a = numpy::PyArray::<T, numpy::ndarray::Dim<[usize; D]>>::zeros(py, shape, false);
+    // SAFETY: the array was just made here, C-contiguous, and nothing else refers to it yet
+    unsafe { a.as_slice_mut() }
+        .map_err(|e| PyRuntimeError::new_err(format!("internal layout error: {e}")))?
+        .copy_from_slice(&data);
+    Ok(a.into_any())
+}
+
+/// [`trajectory_dict`] of columns already formed (see [`column`] for which are copied).
 pub(super) fn columns_dict<'py>(
     py: Python<'py>,
     c: TrajectoryColumns,
@@ -495,46 +518,52 @@ pub(super) fn columns_dict<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     let n = c.states;
-    d.set_item("dim", c.dim)?;
-    d.set_item("t", PyArray1::from_vec(py, c.t))?;
-    d.set_item("q", matrix(py, n, c.nq, c.q)?)?;
-    d.set_item("v", matrix(py, n, c.nv, c.v)?)?;
-    d.set_item("kinetic_energy", PyArray1::from_vec(py, c.kinetic_energy))?;
-    d.set_item(
-        "potential_energy",
-        PyArray1::from_vec(py, c.potential_energy),
-    )?;
-    d.set_item("load_power", PyArray1::from_vec(py, c.load_power))?;
-    d.set_item("min_gap", PyArray1::from_vec(py, c.min_gap))?;
-    d.set_item("negative_gaps", PyArray1::from_vec(py, c.negative_gaps))?;
-    d.set_item("active", PyArray1::from_vec(py, c.active))?;
+    let r = c.records;
+    // the keys interned: made once per process, not per call
+    d.set_item(intern!(py, "dim"), c.dim)?;
+    d.set_item(intern!(py, "t"), column(py, [n], c.t)?)?;
+    d.set_item(intern!(py, "q"), column(py, [n, c.nq], c.q)?)?;
+    d.set_item(intern!(py, "v"), column(py, [n, c.nv], c.v)?)?;
+    let kinetic = column(py, [n], c.kinetic_energy)?;
+    d.set_item(intern!(py, "kinetic_energy"), kinetic)?;
+    let potential = column(py, [n], c.potential_energy)?;
+    d.set_item(intern!(py, "potential_energy"), potential)?;
+    d.set_item(intern!(py, "load_power"), column(py, [n], c.load_power)?)?;
+    d.set_item(intern!(py, "min_gap"), column(py, [n], c.min_gap)?)?;
+    let negative = column(py, [n], c.negative_gaps)?;
+    d.set_item(intern!(py, "negative_gaps"), negative)?;
+    let steps = c.active.len();
+    d.set_item(intern!(py, "active"), column(py, [steps], c.active)?)?;
     // each step's status as its code (`STATUS_CODES` of `coulomb._stream`): one small array,
     // not a Python string per step
-    d.set_item("status", PyArray1::from_vec(py, c.status))?;
-    d.set_item("iterations", PyArray1::from_vec(py, c.iterations))?;
+    d.set_item(intern!(py, "status"), column(py, [steps], c.status)?)?;
+    d.set_item(
+        intern!(py, "iterations"),
+        column(py, [steps], c.iterations)?,
+    )?;
     for (name, col) in c.checks {
-        d.set_item(name, PyArray1::from_vec(py, col))?;
+        d.set_item(name, column(py, [steps], col)?)?;
     }
-    d.set_item("resumed", PyArray1::from_vec(py, c.resumed))?;
-    d.set_item("fallback", PyArray1::from_vec(py, c.fallback))?;
-    d.set_item("contact_step", PyArray1::from_vec(py, c.contact_step))?;
-    d.set_item("contact_id", PyArray1::from_vec(py, c.contact_id))?;
+    d.set_item(intern!(py, "resumed"), column(py, [steps], c.resumed)?)?;
+    d.set_item(intern!(py, "fallback"), column(py, [steps], c.fallback)?)?;
     d.set_item(
-        "contact_impulse",
-        matrix(py, c.records, c.dim, c.contact_impulse)?,
+        intern!(py, "contact_step"),
+        column(py, [r], c.contact_step)?,
     )?;
+    d.set_item(intern!(py, "contact_id"), column(py, [r], c.contact_id)?)?;
+    let impulse = column(py, [r, c.dim], c.contact_impulse)?;
+    d.set_item(intern!(py, "contact_impulse"), impulse)?;
+    let velocity = column(py, [r, c.dim], c.contact_velocity)?;
+    d.set_item(intern!(py, "contact_velocity"), velocity)?;
+    let approach = column(py, [r], c.contact_approach)?;
+    d.set_item(intern!(py, "contact_approach"), approach)?;
+    d.set_item(intern!(py, "contact_gap"), column(py, [r], c.contact_gap)?)?;
     d.set_item(
-        "contact_velocity",
-        matrix(py, c.records, c.dim, c.contact_velocity)?,
+        intern!(py, "contact_closed"),
+        column(py, [r], c.contact_closed)?,
     )?;
-    d.set_item(
-        "contact_approach",
-        PyArray1::from_vec(py, c.contact_approach),
-    )?;
-    d.set_item("contact_gap", PyArray1::from_vec(py, c.contact_gap))?;
-    d.set_item("contact_closed", PyArray1::from_vec(py, c.contact_closed))?;
-    d.set_item("stopped", c.stopped)?;
-    d.set_item("solve_time", seconds)?;
+    d.set_item(intern!(py, "stopped"), c.stopped)?;
+    d.set_item(intern!(py, "solve_time"), seconds)?;
     Ok(d)
 }
 
