@@ -426,6 +426,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 tr.steps.len(),
                 1e6 * sec / tr.steps.len() as f64
             );
+            // the whole trajectory's bits folded, to compare builds (not a figure)
+            let fold = tr.q.iter().chain(&tr.v).fold(0u64, |h, x| {
+                (h ^ x.to_bits()).wrapping_mul(0x100_0000_01b3)
+            });
+            println!("trajectory bits folded: {fold:016x}");
             return Ok(());
         }
         other => {
