@@ -409,16 +409,16 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
         }
     }
 
-    /// the momentum balance of the step ([`super::record::momentum_residual`]), M one block.
+    /// the momentum balance of the step ([`super::momentum::momentum_residual`]), M one block.
     fn momentum_residual(&self, v_next: &[f64]) -> f64 {
-        let blocks = std::iter::once(super::record::MassBlock {
+        let blocks = std::iter::once(super::momentum::MassBlock {
             m: &self.m[..],
             stride: self.nv,
             off: 0,
             n: self.nv,
             lead: 0,
         });
-        super::record::momentum_residual(blocks, v_next, &self.v_free, &self.gp)
+        super::momentum::momentum_residual(blocks, v_next, &self.v_free, &self.gp)
     }
 
     /// The contacts' memory and records ([`driver::remember_contacts`], as the scenes'):

@@ -26,6 +26,8 @@ pub use islands::with_threads;
 mod joints;
 #[path = "law.rs"]
 mod law;
+#[path = "momentum.rs"]
+mod momentum;
 #[path = "narrow.rs"]
 mod narrow;
 #[path = "persistence.rs"]
@@ -549,16 +551,16 @@ impl Stepper {
         }
     }
 
-    /// the momentum balance of the step ([`record::momentum_residual`]), body by body.
+    /// the momentum balance of the step ([`momentum::momentum_residual`]), body by body.
     fn momentum_residual(&self, v_next: &[f64]) -> f64 {
-        let blocks = (self.bodies.iter().zip(&self.frozen)).map(|(b, f)| record::MassBlock {
+        let blocks = (self.bodies.iter().zip(&self.frozen)).map(|(b, f)| momentum::MassBlock {
             m: &f.m[..],
             stride: 6,
             off: b.off_v,
             n: b.nv,
             lead: b.lead,
         });
-        record::momentum_residual(blocks, v_next, &self.v_free, &self.gp)
+        momentum::momentum_residual(blocks, v_next, &self.v_free, &self.gp)
     }
 
     fn push_state(&mut self, out: &mut Trajectory) {
