@@ -55,7 +55,7 @@ from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
-from . import _core, _validate
+from . import _core, _scene_spec, _validate
 from ._arguments import Solver, _dim, _positive, _solver_options, _steps, _vector
 from ._batch import threads_option
 from ._bodies import (
@@ -230,19 +230,6 @@ class Scene:
         self._needs_solid(other)
         self.pairs.append(("solid", shape, other, mu, e))
 
-    def _solid_of(self, shape: Shape) -> dict[str, Any] | None:
-        """a shape's solid form, checked, or None (no volume, or a degenerate hull of a
-        point shape's points)."""
-        form = shape._solid(self.dim)
-        if form is None:
-            return None
-        if shape._point_form:
-            try:
-                _check_solid(form, self.dim)
-            except InvalidParameterError:
-                return None
-        return form
-
     def _needs_solid(self, shape: Shape) -> None:
         form = shape._solid(self.dim)
         if form is not None and shape._point_form:
@@ -300,91 +287,8 @@ class Scene:
         self.pairs.append(("solids", 0, 0, mu, e))
 
     def _spec(self) -> dict[str, Any]:
-        bodies = []
-        for b in self.bodies:
-            spec = b._spec(self.dim)
-            f = b.force if b.force is not None else [0.0] * self.dim
-            spec["force"] = _vector("force", f, self.dim)
-            bodies.append(spec)
-        body_index = {id(b): i for i, b in enumerate(self.bodies)}
-        shapes: list[dict[str, Any]] = []
-        shape_index: dict[int, int] = {}
-        for body, shape in self.shapes:
-            if shape._point_form:
-                pts, r = shape._points(self.dim)
-                shape_index[id(shape)] = len(shapes)
-                shapes.append({"body": body_index[id(body)], "points": pts, "radius": r})
-        auto = any(p[0] == "solids" for p in self.pairs)
-        wanted = {id(x) for k, a, b, _, _ in self.pairs if k in ("solid", "solid_half_space")
-                  for x in (a, b)}
-        solids: list[dict[str, Any]] = []
-        solid_index: dict[int, int] = {}
-        for body, shape in self.shapes:
-            form = self._solid_of(shape) if (auto or id(shape) in wanted) else None
-            if form is not None:
-                form["body"] = body_index[id(body)]
-                solid_index[id(shape)] = len(solids)
-                solids.append(form)
-        for st in self.statics:
-            form = st._solid(self.dim)
-            form["body"] = None
-            solid_index[id(st)] = len(solids)
-            solids.append(form)
-        hs_index = {id(h): i for i, h in enumerate(self.half_spaces)}
-        pairs = []
-        for k, a, b, mu, e in self.pairs:
-            if k in ("spheres", "solids"):
-                ia = ib = 0
-            elif k == "half_space":
-                ia, ib = shape_index[id(a)], hs_index[id(b)]
-            elif k == "solid_half_space":
-                ia, ib = solid_index[id(a)], hs_index[id(b)]
-            elif k == "sphere" and not (auto and id(a) in solid_index
-                                        and id(b) in solid_index):
-                ia, ib = shape_index[id(a)], shape_index[id(b)]
-            else:
-                # a declared sphere pair under contact_all is a solid pair, so the broad
-                # phase leaves it to the declaration
-                k, ia, ib = "solid", solid_index[id(a)], solid_index[id(b)]
-            pairs.append({"kind": k, "a": ia, "b": ib, "mu": mu, "e": e})
-        pairs += self._all_half_space_pairs(shape_index, solid_index, hs_index)
-        return {
-            "dim": self.dim,
-            "gravity": self.gravity,
-            "bodies": bodies,
-            "shapes": shapes,
-            "half_spaces": [
-                {"point": _vector("point", h.point, self.dim),
-                 "normal": _vector("normal", h.normal, self.dim)}
-                for h in self.half_spaces
-            ],
-            "pairs": pairs,
-            "solids": solids,
-            "joints": [j._spec(self.dim, self._body_index) for j in self.joints],
-        }
-
-    def _all_half_space_pairs(self, shape_index: dict[int, int], solid_index: dict[int, int],
-                              hs_index: dict[int, int]) -> list[dict[str, Any]]:
-        """Under :meth:`contact_all`, every attached shape against every half-space not
-        declared by :meth:`contact`, in the order of the shapes, then of the half-spaces (the
-        order the same pairs declared by hand would have), with contact_all's mu and e."""
-        auto = [p for p in self.pairs if p[0] == "solids"]
-        if not auto:
-            return []
-        _, _, _, mu, e = auto[0]
-        declared = {(id(a), id(b)) for k, a, b, _, _ in self.pairs
-                    if k in ("half_space", "solid_half_space")}
-        out = []
-        for _, shape in self.shapes:
-            for h in self.half_spaces:
-                if (id(shape), id(h)) in declared:
-                    continue
-                if shape._point_form:
-                    kind, ia = "half_space", shape_index[id(shape)]
-                else:
-                    kind, ia = "solid_half_space", solid_index[id(shape)]
-                out.append({"kind": kind, "a": ia, "b": hs_index[id(h)], "mu": mu, "e": e})
-        return out
+        """the scene as the core reads it (module ``_scene_spec``)."""
+        return _scene_spec.scene_spec(self)
 
     def layout(self) -> list[tuple[slice, slice]]:
         """The slices of each body's coordinates and velocities in ``q`` and ``v``."""
