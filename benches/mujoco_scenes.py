@@ -37,10 +37,10 @@ class PeerRun:
 REPEATS = 3
 
 
-def _rollout(xml: str, qvel0: dict[int, float] | None, t_end: float, h: float,
-             repeats: int | None = None):
+def initial_state(xml: str, qvel0: dict[int, float] | None, h: float):
+    """MuJoCo's model of ``xml`` at step h, its data, and the full-physics state to roll out
+    from (the velocities ``qvel0`` set)."""
     import mujoco
-    from mujoco import rollout
 
     model = mujoco.MjModel.from_xml_string(xml)
     model.opt.timestep = h
@@ -51,6 +51,14 @@ def _rollout(xml: str, qvel0: dict[int, float] | None, t_end: float, h: float,
     spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
     state0 = np.empty(mujoco.mj_stateSize(model, spec))
     mujoco.mj_getState(model, data, state0, spec)
+    return model, data, state0
+
+
+def _rollout(xml: str, qvel0: dict[int, float] | None, t_end: float, h: float,
+             repeats: int | None = None):
+    from mujoco import rollout
+
+    model, data, state0 = initial_state(xml, qvel0, h)
     nstep = round(t_end / h)
     best = math.inf
     states = None
@@ -97,12 +105,10 @@ def ramp(h: float = 1e-3, t_end: float = 10.0, mu: float = 0.4, theta_deg: float
     )
 
 
-def floor_impact(
-    h: float = 1e-3, v_impact: float = 3.0, radius: float = 0.1, t_end: float = 0.2
-) -> PeerRun:
-    """A 0.5 kg sphere hits the floor at 3 m/s (e = 0.6 asked; MuJoCo has no coefficient, so
-    its default soft contact decides). Figure: rebound speed / impact speed."""
-    xml = f"""
+def floor_impact_xml(radius: float = 0.1) -> str:
+    """MuJoCo's floor impact: a 0.5 kg sphere of ``radius`` 1 cm above a plane, no gravity
+    (the impact speed is set as its initial velocity)."""
+    return f"""
 <mujoco>
   <option gravity="0 0 0"/>
   <worldbody>
@@ -113,6 +119,14 @@ def floor_impact(
     </body>
   </worldbody>
 </mujoco>"""
+
+
+def floor_impact(
+    h: float = 1e-3, v_impact: float = 3.0, radius: float = 0.1, t_end: float = 0.2
+) -> PeerRun:
+    """A 0.5 kg sphere hits the floor at 3 m/s (e = 0.6 asked; MuJoCo has no coefficient, so
+    its default soft contact decides). Figure: rebound speed / impact speed."""
+    xml = floor_impact_xml(radius)
     _t, _qpos, qvel, n, sec = _rollout(xml, {2: -v_impact}, t_end, h)
     return PeerRun(
         "floor impact",

@@ -21,32 +21,12 @@ import platform
 import subprocess
 import time
 
-import numpy as np
-from coulomb import HalfSpace, RigidBody3D, Scene, Sphere
 from markers import write_block
+from mujoco_scenes import floor_impact_xml, initial_state
+from peer_step import impact_scene
 
 STEPS = (1, 10, 100, 1000)
 H = 1e-3
-
-BALL_XML = """
-<mujoco>
-  <option gravity="0 0 0" timestep="0.001"/>
-  <worldbody>
-    <geom type="plane" size="5 5 0.1"/>
-    <body pos="0 0 0.11"><freejoint/>
-      <geom type="sphere" size="0.1" mass="0.5"/>
-    </body>
-  </worldbody>
-</mujoco>"""
-
-
-def ball() -> Scene:
-    scene = Scene(dim=3, gravity=(0.0, 0.0, 0.0))
-    body = scene.add(RigidBody3D(mass=0.5, inertia=(0.002,) * 3, position=(0.0, 0.0, 0.11),
-                                 velocity=(0.0, 0.0, -3.0)))
-    floor = scene.add(HalfSpace((0.0, 0.0, 0.0), (0.0, 0.0, 1.0)))
-    scene.contact(scene.attach(body, Sphere(0.1)), floor, e=0.6)
-    return scene
 
 
 def best_of(call, calls: int) -> float:
@@ -59,21 +39,15 @@ def best_of(call, calls: int) -> float:
 
 
 def coulomb_times(calls: int) -> list[float]:
-    scene = ball()
+    scene = impact_scene()
     scene.simulate(H, H)  # the first call loads the extension's lazy parts
     return [best_of(lambda n=n: scene.simulate(n * H, H, "nsgs"), calls) for n in STEPS]
 
 
 def mujoco_times(calls: int) -> list[float]:
-    import mujoco
     from mujoco import rollout
 
-    model = mujoco.MjModel.from_xml_string(BALL_XML)
-    data = mujoco.MjData(model)
-    data.qvel[2] = -3.0
-    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
-    state0 = np.empty(mujoco.mj_stateSize(model, spec))
-    mujoco.mj_getState(model, data, state0, spec)
+    model, data, state0 = initial_state(floor_impact_xml(), {2: -3.0}, H)
     rollout.rollout(model, data, state0[None, :], nstep=1)
     return [best_of(lambda n=n: rollout.rollout(model, data, state0[None, :], nstep=n), calls)
             for n in STEPS]
