@@ -139,7 +139,9 @@ mod tests {
 
     #[test]
     fn an_unmoved_block_gives_the_general_sums_to_the_bit() {
-        // a rigid body's block `diag(m I, I_world)`, signed zeros and nonzero G P included
+        // every block kind: a spatial body's `diag(m I, I_world)` (lead 3 of 6), a planar
+        // body's (2 of 3), a particle's (all diagonal) and a model's full M (lead 0); signed
+        // zeros and nonzero G P included
         let mut seed = 0x9e37_79b9_7f4a_7c15u64;
         let mut next = || {
             seed ^= seed << 13;
@@ -147,47 +149,49 @@ mod tests {
             seed ^= seed << 17;
             (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
         };
-        for case in 0..200 {
-            let mut m = [0.0; 36];
-            for a in 0..3 {
-                m[a * 6 + a] = 0.5 + next().abs();
-            }
-            for a in 3..6 {
-                for c in 3..6 {
-                    m[a * 6 + c] = next();
+        for (lead, n) in [(3usize, 6usize), (2, 3), (3, 3), (0, 5)] {
+            for case in 0..200i32 {
+                let mut m = vec![0.0; n * n];
+                for a in 0..lead {
+                    m[a * n + a] = 0.5 + next().abs();
                 }
+                for a in lead..n {
+                    for c in lead..n {
+                        m[a * n + c] = next();
+                    }
+                }
+                let vf: Vec<f64> = (0..n as i32)
+                    .map(|k| match (case + k) % 4 {
+                        0 => 0.0,
+                        1 => -0.0,
+                        _ => next() * 10f64.powi(case % 7 - 3),
+                    })
+                    .collect();
+                // equal entry by entry, zeros of either sign
+                let vn: Vec<f64> = vf.iter().map(|&x| if x == 0.0 { -x } else { x }).collect();
+                let gp: Vec<f64> = (0..n as i32)
+                    .map(|k| match (case + 2 * k) % 3 {
+                        0 => 0.0,
+                        1 => -0.0,
+                        _ => next(),
+                    })
+                    .collect();
+                let b = MassBlock {
+                    m: &m,
+                    stride: n,
+                    off: 0,
+                    n,
+                    lead,
+                };
+                let (mut fast, mut general) = ([0.0; 4], [0.0; 4]);
+                unmoved_sums(&b, lead, &vf, &gp, &mut fast);
+                moved_sums(&b, lead, &vn, &vf, &gp, &mut general);
+                assert_eq!(
+                    fast.map(f64::to_bits),
+                    general.map(f64::to_bits),
+                    "block ({lead}, {n}), case {case}"
+                );
             }
-            let vf: Vec<f64> = (0..6)
-                .map(|k| match (case + k) % 4 {
-                    0 => 0.0,
-                    1 => -0.0,
-                    _ => next() * 10f64.powi(case % 7 - 3),
-                })
-                .collect();
-            // equal entry by entry, zeros of either sign
-            let vn: Vec<f64> = vf.iter().map(|&x| if x == 0.0 { -x } else { x }).collect();
-            let gp: Vec<f64> = (0..6)
-                .map(|k| match (case + 2 * k) % 3 {
-                    0 => 0.0,
-                    1 => -0.0,
-                    _ => next(),
-                })
-                .collect();
-            let b = MassBlock {
-                m: &m,
-                stride: 6,
-                off: 0,
-                n: 6,
-                lead: 3,
-            };
-            let (mut fast, mut general) = ([0.0; 4], [0.0; 4]);
-            unmoved_sums(&b, 3, &vf, &gp, &mut fast);
-            moved_sums(&b, 3, &vn, &vf, &gp, &mut general);
-            assert_eq!(
-                fast.map(f64::to_bits),
-                general.map(f64::to_bits),
-                "case {case}"
-            );
         }
     }
 }
