@@ -81,7 +81,8 @@ fn scene() -> Scene {
 fn settled_steps_allocate_nothing() {
     let steps = 400;
     let mut st = Stepper::new(&scene(), &StepSettings::new(1e-3, steps)).expect("valid");
-    let mut contacts = Vec::with_capacity(10 * steps);
+    let mut contacts = st.records();
+    contacts.reserve(10 * steps);
     let (mut settled, mut quiet) = (0, 0);
     for k in 0..steps {
         let before = count();

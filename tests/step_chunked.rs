@@ -52,14 +52,13 @@ fn bouncing(dim: usize) -> Scene {
 fn joined(scene: &Scene, settings: &StepSettings, every: usize, rows: usize) -> Trajectory {
     let mut run = ChunkedRun::new(scene, &[], settings, every).expect("valid scene");
     let mut all: Option<Trajectory> = None;
-    while let Some(mut c) = run.next_chunk(rows).expect("chunk") {
+    while let Some(c) = run.next_chunk(rows).expect("chunk") {
         assert!(c.steps.len() <= rows);
         let Some(a) = all.as_mut() else {
             all = Some(c);
             continue;
         };
         let offset = a.steps.len();
-        c.contacts.iter_mut().for_each(|r| r.step += offset);
         a.t.extend(c.t);
         a.q.extend(c.q);
         a.v.extend(c.v);
@@ -68,7 +67,7 @@ fn joined(scene: &Scene, settings: &StepSettings, every: usize, rows: usize) -> 
         a.min_gap.extend(c.min_gap);
         a.negative_gaps.extend(c.negative_gaps);
         a.steps.extend(c.steps);
-        a.contacts.extend(c.contacts);
+        a.contacts.append(&c.contacts, offset);
         a.stopped = c.stopped;
     }
     all.expect("one chunk at least")

@@ -56,7 +56,8 @@ fn settled_generalized_steps_allocate_nothing() {
     let settings = StepSettings::new(1e-3, steps);
     let mut st =
         GeneralizedStepper::new(RestingBox, &[0.0, B, 0.0], &[0.0; 3], &settings).expect("valid");
-    let mut contacts = Vec::with_capacity(4 * steps);
+    let mut contacts = st.records();
+    contacts.reserve(4 * steps);
     let (mut settled, mut quiet) = (0, 0);
     for k in 0..steps {
         let before = count();

@@ -246,16 +246,16 @@ fn run(scene: &Scene, h: f64, steps: usize) -> Trajectory {
 /// the first record of the first contact that pushed, and the rebound record that followed
 /// it (the same contact, with the impact law).
 fn impact_pair(tr: &Trajectory) -> (ContactRecord, ContactRecord) {
-    let land = *tr
+    let land = tr
         .contacts
         .iter()
         .find(|c| c.impulse[0] > 0.0)
         .expect("an impact");
-    let rebound = *tr
+    let rebound = tr
         .contacts
         .iter()
         .find(|c| c.id == land.id && c.step > land.step && c.closed)
-        .unwrap_or(&land);
+        .unwrap_or(land);
     (land, rebound)
 }
 
@@ -446,7 +446,10 @@ fn rod_sweep(law: Restitution) -> (f64, usize) {
                     for omega in [-2.0, 0.0, 2.0] {
                         let scene = rod_on_floor(deg.to_radians(), 0.0, vt, omega, mu, e);
                         let tr = simulate(&scene, &with_law(law, 1e-3, 1)).expect("valid");
-                        assert!(tr.contacts[0].impulse[0] > 0.0, "{deg} {vt} {omega}");
+                        assert!(
+                            tr.contacts.first().expect("a contact record").impulse[0] > 0.0,
+                            "{deg} {vt} {omega}"
+                        );
                         let gain = total_energy(&tr, 1) / total_energy(&tr, 0) - 1.0;
                         worst = worst.max(gain);
                         if gain > 1e-12 {
@@ -488,7 +491,7 @@ fn newton_with_friction_gains_the_known_energy_on_the_sticking_rod() {
     let th = 45f64.to_radians();
     let scene = rod_on_floor(th, 0.0, 0.6, 0.0, 2.0, 1.0);
     let tr = simulate(&scene, &with_law(Restitution::Newton, 1e-3, 1)).expect("valid");
-    let c = tr.contacts[0];
+    let c = tr.contacts.first().expect("a contact record");
     assert!((c.impulse[0] - 1.025).abs() < 1e-12 && (c.impulse[1] - 0.375).abs() < 1e-12);
     let gain = total_energy(&tr, 1) - total_energy(&tr, 0);
     assert!((gain - 0.1125).abs() < 1e-12, "{gain}");

@@ -10,7 +10,9 @@
 mod scenes;
 
 use coulomb::geometry::{Shape2, Shape3};
-use coulomb::step::{simulate, ContactRecord, Pair, Scene, SolidShape, StepSettings};
+use coulomb::step::{
+    simulate, ContactRecord, ContactRecords, Pair, Scene, SolidShape, StepSettings,
+};
 use nalgebra::{Point3, UnitQuaternion, Vector3};
 use scenes::*;
 
@@ -148,9 +150,9 @@ fn scene(f: &Faller, on_box: bool, drop: f64) -> Scene {
 }
 
 /// the first record that pushed, and the later closed record of the same contact.
-fn impact_pair(records: &[ContactRecord]) -> Option<(ContactRecord, ContactRecord)> {
-    let land = *records.iter().find(|c| c.impulse[0] > 0.0)?;
-    let rebound = *records
+fn impact_pair(records: &ContactRecords) -> Option<(ContactRecord, ContactRecord)> {
+    let land = records.iter().find(|c| c.impulse[0] > 0.0)?;
+    let rebound = records
         .iter()
         .find(|c| c.id == land.id && c.step > land.step && c.closed)?;
     Some((land, rebound))

@@ -71,7 +71,8 @@ fn steps_with_joints_allocate_nothing_once_sized() {
     let steps = 3000;
     let mut st =
         Stepper::with_joints(&scene, &joints, &StepSettings::new(1e-3, steps)).expect("valid");
-    let mut contacts = Vec::with_capacity(10 * steps);
+    let mut contacts = st.records();
+    contacts.reserve(10 * steps);
     let (mut settled, mut quiet, mut struck) = (0, 0, None);
     for k in 0..steps {
         let before = count();

@@ -135,7 +135,7 @@ fn drop_and_check(
 ) {
     let (sc, joints, r) = dropped_chain(dim, n, 0.4);
     let mut st = Stepper::with_joints(&sc, &joints, settings).unwrap();
-    let mut contacts = Vec::new();
+    let mut contacts = st.records();
     let tol = settings.gap_tolerance;
     let (mut touched, mut lowest) = (false, f64::INFINITY);
     let mut pushed: Vec<(usize, f64)> = Vec::new();
@@ -244,7 +244,7 @@ fn chain_in_units(dim: usize, u: f64, steps: usize) -> (Vec<f64>, Vec<Option<&'s
     let mut settings = StepSettings::new(1e-3, 0);
     settings.gap_tolerance *= u;
     let mut st = Stepper::with_joints(&sc, &joints, &settings).unwrap();
-    let mut contacts = Vec::new();
+    let mut contacts = st.records();
     let (mut turns, mut statuses) = (Vec::new(), Vec::new());
     for _ in 0..steps {
         let rec = st.step(&mut contacts).unwrap();

@@ -71,7 +71,7 @@ fn a_group_falling_together_touches_nothing_at_any_speed() {
             9.81,
         );
         let mut st = Stepper::new(&scene, &StepSettings::new(1e-3, 200)).expect("valid");
-        let mut contacts = Vec::new();
+        let mut contacts = st.records();
         for k in 0..200 {
             // 0.2 radii apart, moving together: no pair can close
             let rec = st.step(&mut contacts).expect("steps");

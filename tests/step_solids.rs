@@ -340,7 +340,7 @@ fn the_solid_broad_phase_finds_the_candidates_of_every_declared_pair() {
             let mut sa = coulomb::step::Stepper::new(&auto, &settings).expect("valid");
             let mut sb = coulomb::step::Stepper::new(&brute, &settings).expect("valid");
             for k in 0..30 {
-                let (mut ca, mut cb) = (vec![], vec![]);
+                let (mut ca, mut cb) = (sa.records(), sb.records());
                 let ra = sa.step(&mut ca).expect("step");
                 let rb = sb.step(&mut cb).expect("step");
                 let case = format!("dim {dim}, seed {seed}, step {k}");

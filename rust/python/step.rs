@@ -145,10 +145,10 @@ const CHECKS: [(&str, Check); 9] = [
 /// the columns of `tr` (see [`TrajectoryColumns`]).
 pub(super) fn columns(tr: Trajectory) -> TrajectoryColumns {
     let s = &tr.steps;
-    let c = &tr.contacts;
-    let dim = tr.dim;
+    let records = tr.contacts.len();
+    let c = tr.contacts.into_columns();
     TrajectoryColumns {
-        dim,
+        dim: tr.dim,
         states: tr.t.len(),
         nq: tr.nq,
         nv: tr.nv,
@@ -162,20 +162,15 @@ pub(super) fn columns(tr: Trajectory) -> TrajectoryColumns {
             .collect(),
         resumed: s.iter().map(|r| r.resumed).collect(),
         fallback: s.iter().map(|r| r.fallback).collect(),
-        records: c.len(),
-        contact_step: c.iter().map(|r| r.step as i64).collect(),
-        contact_id: c.iter().map(|r| r.id as i64).collect(),
-        contact_impulse: c
-            .iter()
-            .flat_map(|r| r.impulse.into_iter().take(dim))
-            .collect(),
-        contact_velocity: c
-            .iter()
-            .flat_map(|r| r.velocity.into_iter().take(dim))
-            .collect(),
-        contact_approach: c.iter().map(|r| r.approach).collect(),
-        contact_gap: c.iter().map(|r| r.gap).collect(),
-        contact_closed: c.iter().map(|r| r.closed).collect(),
+        records,
+        // usize to i64 collected in place (same size and alignment: no new allocation)
+        contact_step: c.step.into_iter().map(|x| x as i64).collect(),
+        contact_id: c.id.into_iter().map(|x| x as i64).collect(),
+        contact_impulse: c.impulse,
+        contact_velocity: c.velocity,
+        contact_approach: c.approach,
+        contact_gap: c.gap,
+        contact_closed: c.closed,
         t: tr.t,
         q: tr.q,
         v: tr.v,

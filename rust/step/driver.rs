@@ -29,7 +29,7 @@ use super::event::Located;
 use super::law::{curvature_term, normal_term};
 use super::persistence::CandState;
 use super::solve::SolveBuffers;
-use super::{Active, ContactRecord, Drift, StepRecord, StepSettings, Stepper};
+use super::{Active, ContactRecord, ContactRecords, Drift, StepRecord, StepSettings, Stepper};
 use crate::error::Result;
 
 /// The stages a driver supplies to [`step`].
@@ -41,7 +41,7 @@ pub(super) trait Driver {
     fn search(&mut self);
     fn active_len(&self) -> usize;
     /// the located step of an isolated impact (only with `locate_impacts`).
-    fn locate(&mut self, contacts: &mut Vec<ContactRecord>) -> Result<Located>;
+    fn locate(&mut self, contacts: &mut ContactRecords) -> Result<Located>;
     /// zero impulses for a free step (no true gap closes within it).
     fn free_answer(&mut self, record: &mut StepRecord);
     /// the impact law, W and the contact solve into the step's impulses.
@@ -58,7 +58,7 @@ pub(super) trait Driver {
     }
     fn momentum(&self, v_next: &[f64]) -> f64;
     /// the contacts' memory, and their records appended to `contacts`.
-    fn remember(&mut self, v_next: &[f64], contacts: &mut Vec<ContactRecord>);
+    fn remember(&mut self, v_next: &[f64], contacts: &mut ContactRecords);
     /// the total energy `T + V` at the current state.
     fn energy(&mut self) -> Result<f64>;
     /// `v = v_{k+1}` (its buffer kept), `q_{k+1}`, and the clock to `t_{k+1}`.
@@ -70,7 +70,7 @@ pub(super) trait Driver {
 
 /// One impulse time step from `(t_k, q_k, v_k)` to `(t_{k+1}, q_{k+1}, v_{k+1})` (module
 /// docs); appends the active contacts to `contacts` and returns the step's checks.
-pub(super) fn step<D: Driver>(d: &mut D, contacts: &mut Vec<ContactRecord>) -> Result<StepRecord> {
+pub(super) fn step<D: Driver>(d: &mut D, contacts: &mut ContactRecords) -> Result<StepRecord> {
     d.prepare_state()?;
     d.search();
     let mut free = false;
@@ -168,7 +168,7 @@ pub(super) fn remember_contacts(
     active: &[Active],
     state: &mut [CandState],
     sol: &SolveBuffers,
-    contacts: &mut Vec<ContactRecord>,
+    contacts: &mut ContactRecords,
     id_of: impl Fn(usize) -> usize,
     velocity_of: impl Fn(&Active) -> [f64; 3],
 ) {
@@ -247,7 +247,7 @@ impl Driver for Stepper {
     fn active_len(&self) -> usize {
         self.active.len()
     }
-    fn locate(&mut self, contacts: &mut Vec<ContactRecord>) -> Result<Located> {
+    fn locate(&mut self, contacts: &mut ContactRecords) -> Result<Located> {
         super::event::located_step(self, contacts)
     }
     fn free_answer(&mut self, record: &mut StepRecord) {
@@ -272,7 +272,7 @@ impl Driver for Stepper {
     fn momentum(&self, v_next: &[f64]) -> f64 {
         self.momentum_residual(v_next)
     }
-    fn remember(&mut self, v_next: &[f64], contacts: &mut Vec<ContactRecord>) {
+    fn remember(&mut self, v_next: &[f64], contacts: &mut ContactRecords) {
         Stepper::remember(self, v_next, contacts);
     }
     fn energy(&mut self) -> Result<f64> {

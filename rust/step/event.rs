@@ -38,7 +38,8 @@ use super::bodies::displace_body;
 use super::persistence::CandState;
 use super::solve::SolveBuffers;
 use super::{
-    frame, Active, ContactRecord, Geometry, Restitution, StepRecord, StepSettings, Stepper,
+    frame, Active, ContactRecord, ContactRecords, Geometry, Restitution, StepRecord, StepSettings,
+    Stepper,
 };
 use crate::contact::{solve_nsgs, ContactMeasures, ContactProblem, NsgsSettings};
 use crate::error::Result;
@@ -232,7 +233,7 @@ pub(super) trait Locating {
     /// the state velocity taken back by `-a h / 2` (module docs), M at the end.
     fn rest_of_step(&mut self, rest: f64);
     /// the records of a located step, the contacts' states ([`finish_memory`]), the clock.
-    fn finish_located(&mut self, hit: Hit, contacts: &mut Vec<ContactRecord>) -> StepRecord;
+    fn finish_located(&mut self, hit: Hit, contacts: &mut ContactRecords) -> StepRecord;
     /// whether the current q and v are finite.
     fn path_finite(&self) -> bool;
 }
@@ -241,7 +242,7 @@ pub(super) trait Locating {
 /// [`Located::Free`] the state (and M) is left as it was.
 pub(super) fn located_step<D: Locating>(
     d: &mut D,
-    contacts: &mut Vec<ContactRecord>,
+    contacts: &mut ContactRecords,
 ) -> Result<Located> {
     if d.active().is_empty() || d.active().iter().any(|a| a.closed) {
         return Ok(Located::Plain);
@@ -255,7 +256,7 @@ pub(super) fn located_step<D: Locating>(
 }
 
 /// see [`located_step`]; may leave the state on the path.
-fn locate<D: Locating>(d: &mut D, contacts: &mut Vec<ContactRecord>) -> Result<Located> {
+fn locate<D: Locating>(d: &mut D, contacts: &mut ContactRecords) -> Result<Located> {
     let h = d.settings().h;
     let tol_gap = d.settings().gap_tolerance;
     let found = first_touch(h, |s| {
@@ -291,7 +292,7 @@ pub(super) fn finish_memory(
     state: &mut [CandState],
     hit: &Hit,
     id: usize,
-    contacts: &mut Vec<ContactRecord>,
+    contacts: &mut ContactRecords,
 ) {
     let a = active[hit.active];
     for act in active {
@@ -490,7 +491,7 @@ impl Locating for Stepper {
         self.freeze();
     }
 
-    fn finish_located(&mut self, hit: Hit, contacts: &mut Vec<ContactRecord>) -> StepRecord {
+    fn finish_located(&mut self, hit: Hit, contacts: &mut ContactRecords) -> StepRecord {
         let cand = self.candidates[self.active[hit.active].cand];
         let step = (self.dim, self.step_index);
         finish_memory(step, &self.active, &mut self.state, &hit, cand.id, contacts);

@@ -30,7 +30,7 @@ use super::law::SolveWork;
 use super::persistence::CandState;
 use super::record::{run_recorded, Recorded};
 use super::solve::{SolveBuffers, SPARSE_FROM};
-use super::{Active, ContactRecord, StepRecord, Trajectory};
+use super::{Active, ContactRecords, StepRecord, Trajectory};
 use crate::contact::assembly::{cholesky_in_place, solve_cholesky, WAssembly};
 use crate::error::{check_finite, CoulombError, Result};
 use crate::step::StepSettings;
@@ -115,7 +115,7 @@ impl<S: GeneralizedSystem> Driver for GeneralizedStepper<S> {
     fn active_len(&self) -> usize {
         self.active.len()
     }
-    fn locate(&mut self, contacts: &mut Vec<ContactRecord>) -> Result<Located> {
+    fn locate(&mut self, contacts: &mut ContactRecords) -> Result<Located> {
         super::event::located_step(self, contacts)
     }
     fn free_answer(&mut self, record: &mut StepRecord) {
@@ -134,7 +134,7 @@ impl<S: GeneralizedSystem> Driver for GeneralizedStepper<S> {
     fn momentum(&self, v_next: &[f64]) -> f64 {
         self.momentum_residual(v_next)
     }
-    fn remember(&mut self, v_next: &[f64], contacts: &mut Vec<ContactRecord>) {
+    fn remember(&mut self, v_next: &[f64], contacts: &mut ContactRecords) {
         GeneralizedStepper::remember(self, v_next, contacts);
     }
     fn energy(&mut self) -> Result<f64> {
@@ -154,7 +154,7 @@ impl<S: GeneralizedSystem> Driver for GeneralizedStepper<S> {
 }
 
 impl<S: GeneralizedSystem> Recorded for GeneralizedStepper<S> {
-    fn step(&mut self, contacts: &mut Vec<ContactRecord>) -> Result<StepRecord> {
+    fn step(&mut self, contacts: &mut ContactRecords) -> Result<StepRecord> {
         GeneralizedStepper::step(self, contacts)
     }
     fn record_state(&mut self, out: &mut Trajectory) -> Result<()> {
@@ -306,8 +306,13 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
 
     /// One impulse time step from `(t_k, q_k, v_k)`; appends the active contacts to
     /// `contacts` and returns the step's checks.
-    pub fn step(&mut self, contacts: &mut Vec<ContactRecord>) -> Result<StepRecord> {
+    pub fn step(&mut self, contacts: &mut ContactRecords) -> Result<StepRecord> {
         driver::step(self, contacts)
+    }
+
+    /// empty contact records of this system's dimension, for [`GeneralizedStepper::step`].
+    pub fn records(&self) -> ContactRecords {
+        ContactRecords::new(self.dim)
     }
 
     /// The contact search: a contact closed (`g <= gap_tolerance`), owed a rebound, or open
@@ -423,7 +428,7 @@ impl<S: GeneralizedSystem> GeneralizedStepper<S> {
 
     /// The contacts' memory and records ([`driver::remember_contacts`], as the scenes'):
     /// a contact's identity is its index, its velocity `J v_{k+1}` from its rows.
-    fn remember(&mut self, v_next: &[f64], contacts: &mut Vec<ContactRecord>) {
+    fn remember(&mut self, v_next: &[f64], contacts: &mut ContactRecords) {
         let (dim, nv, rows) = (self.dim, self.nv, &self.rows);
         let slack = self.settings.gap_tolerance / self.settings.h;
         driver::remember_contacts(

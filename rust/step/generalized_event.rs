@@ -16,7 +16,7 @@ use super::super::event::{finish_memory, free_answer, impact_law, located_record
 use super::{dot, Active, GeneralizedStepper, GeneralizedSystem};
 use crate::contact::assembly::solve_cholesky;
 use crate::error::{check_finite, Result};
-use crate::step::{ContactRecord, StepRecord, StepSettings};
+use crate::step::{ContactRecords, StepRecord, StepSettings};
 
 impl<S: GeneralizedSystem> GeneralizedStepper<S> {
     /// the free acceleration of velocity component k over the step.
@@ -158,7 +158,7 @@ impl<S: GeneralizedSystem> Locating for GeneralizedStepper<S> {
         }
     }
 
-    fn finish_located(&mut self, hit: Hit, contacts: &mut Vec<ContactRecord>) -> StepRecord {
+    fn finish_located(&mut self, hit: Hit, contacts: &mut ContactRecords) -> StepRecord {
         let c = self.active[hit.active].cand;
         let (mu, e) = self.laws[c];
         let step = (self.dim, self.step_index);

@@ -97,8 +97,9 @@ pub use stepper::generalized::{
     simulate_generalized, GeneralizedStepper, GeneralizedSystem, GeneralizedTrajectory,
 };
 pub use stepper::{
-    simulate, simulate_joints, simulate_recorded, with_threads, ChunkedRun, ContactRecord, Joint,
-    JointKind, JointSystemInfo, StepRecord, Stepper, Trajectory,
+    simulate, simulate_joints, simulate_recorded, with_threads, ChunkedRun, ContactColumns,
+    ContactRecord, ContactRecords, Joint, JointKind, JointSystemInfo, Records, StepRecord, Stepper,
+    Trajectory,
 };
 
 use crate::error::{check_finite, CoulombError, Result};

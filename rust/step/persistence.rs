@@ -6,7 +6,7 @@
 use super::super::impact::ImpactMemory;
 use super::bodies::norm3;
 use super::narrow::{pad, Candidate, Turn};
-use super::{dot_v, ContactRecord, Pair, Scene, Stepper};
+use super::{dot_v, ContactRecords, Pair, Scene, Stepper};
 
 /// What a candidate carries from one step to the next (reset when it is far).
 #[derive(Clone, Copy, Debug, Default)]
@@ -81,7 +81,7 @@ impl Stepper {
     /// record, an open one that the step stopped at its gap records its impact, any other
     /// has none),
     /// and its record of the step is appended to `contacts`.
-    pub(super) fn remember(&mut self, v_next: &[f64], contacts: &mut Vec<ContactRecord>) {
+    pub(super) fn remember(&mut self, v_next: &[f64], contacts: &mut ContactRecords) {
         let (dim, bodies, candidates) = (self.dim, &self.bodies, &self.candidates);
         let slack = self.settings.gap_tolerance / self.settings.h;
         super::driver::remember_contacts(

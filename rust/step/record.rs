@@ -4,7 +4,7 @@
 //! ([`ContactRecord`]) in a [`Trajectory`], folding the records of unrecorded steps into the
 //! next recorded one.
 
-use super::Stepper;
+use super::{ContactRecords, Stepper};
 use crate::contact::ContactStatus;
 use crate::error::Result;
 use crate::step::{Joint, Scene, StepSettings};
@@ -105,7 +105,7 @@ pub struct Trajectory {
     /// the checks of every step, `N`.
     pub steps: Vec<StepRecord>,
     /// every active contact of every step.
-    pub contacts: Vec<ContactRecord>,
+    pub contacts: ContactRecords,
     /// `None` when all steps ran; otherwise why the run stopped early.
     pub stopped: Option<String>,
 }
@@ -249,7 +249,7 @@ impl Trajectory {
             min_gap: Vec::with_capacity(reserve),
             negative_gaps: Vec::with_capacity(reserve),
             steps: Vec::with_capacity(reserve),
-            contacts: Vec::new(),
+            contacts: ContactRecords::new(dim),
             stopped: None,
         }
     }
@@ -259,7 +259,7 @@ impl Trajectory {
 /// model's [`super::generalized::GeneralizedStepper`]).
 pub(super) trait Recorded {
     /// one step, its active contacts appended to `contacts`.
-    fn step(&mut self, contacts: &mut Vec<ContactRecord>) -> Result<StepRecord>;
+    fn step(&mut self, contacts: &mut ContactRecords) -> Result<StepRecord>;
     /// appends the current state (time, q, v, energies, gaps) to `out`.
     fn record_state(&mut self, out: &mut Trajectory) -> Result<()>;
     /// whether the current q and v are finite.
@@ -303,7 +303,7 @@ fn run_steps<D: Recorded>(
             rec.fold(&p);
         }
         let row = out.steps.len();
-        out.contacts[kept..].iter_mut().for_each(|c| c.step = row);
+        out.contacts.set_step_from(kept, row);
         if !d.state_finite() {
             out.stopped = Some(format!(
                 "step {k} produced a non-finite state (contact solver: {})",
@@ -317,7 +317,7 @@ fn run_steps<D: Recorded>(
             pending = Some(rec);
             continue;
         }
-        check_contact_records(out.contacts.len())?;
+        check_contact_records(&out.contacts)?;
         out.steps.push(rec);
         d.record_state(out)?;
     }
@@ -325,7 +325,7 @@ fn run_steps<D: Recorded>(
 }
 
 impl Recorded for Stepper {
-    fn step(&mut self, contacts: &mut Vec<ContactRecord>) -> Result<StepRecord> {
+    fn step(&mut self, contacts: &mut ContactRecords) -> Result<StepRecord> {
         Stepper::step(self, contacts)
     }
     fn record_state(&mut self, out: &mut Trajectory) -> Result<()> {
@@ -342,8 +342,8 @@ impl Recorded for Stepper {
 
 /// the contact records' size against the memory budget ([`crate::limits::check_bytes`]), its
 /// message formed only when refused (the check runs after every recorded step).
-fn check_contact_records(count: usize) -> Result<()> {
-    let item = std::mem::size_of::<ContactRecord>();
+fn check_contact_records(records: &ContactRecords) -> Result<()> {
+    let (count, item) = (records.len(), records.record_bytes());
     let within = count
         .checked_mul(item)
         .is_some_and(|b| b <= crate::limits::memory_budget());

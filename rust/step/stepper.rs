@@ -9,6 +9,8 @@
 
 #[path = "bodies.rs"]
 mod bodies;
+#[path = "contact_records.rs"]
+mod contact_records;
 #[path = "drift.rs"]
 mod drift;
 #[path = "driver.rs"]
@@ -46,6 +48,7 @@ mod solve;
 mod tiles;
 
 use self::bodies::{bodies_of, norm3, BodyInfo, Frozen};
+pub use self::contact_records::{ContactColumns, ContactRecords, Records};
 pub use self::joints::{Joint, JointKind, JointSystemInfo};
 use self::law::SolveWork;
 use self::narrow::{declared_candidates, frame, Candidate, Geometry};
@@ -393,8 +396,13 @@ impl Stepper {
     /// geometry), the contact search, the located impact when asked for and isolated, the
     /// contact solve (impact law, W, solver), `v_{k+1} = v_free + M^{-1} G P`, the momentum
     /// check, the contacts' memory and records, the positions, the drift projection.
-    pub fn step(&mut self, contacts: &mut Vec<ContactRecord>) -> Result<StepRecord> {
+    pub fn step(&mut self, contacts: &mut ContactRecords) -> Result<StepRecord> {
         driver::step(self, contacts)
+    }
+
+    /// empty contact records of this scene's dimension, for [`Stepper::step`] to append to.
+    pub fn records(&self) -> ContactRecords {
+        ContactRecords::new(self.dim)
     }
 
     /// The contact search, which must find the closed and the imminently closing contacts
