@@ -344,12 +344,24 @@ impl Stepper {
     pub(super) fn gap_summary(&self) -> (f64, usize) {
         let mut min_gap = f64::INFINITY;
         let mut negative = 0;
-        for geo in &self.geo_cache {
-            min_gap = min_gap.min(geo.gap);
-            if geo.gap < -self.settings.gap_tolerance {
-                negative += 1;
+        let tol = self.settings.gap_tolerance;
+        let mut scan = |geos: &[Geometry]| {
+            for geo in geos {
+                min_gap = min_gap.min(geo.gap);
+                if geo.gap < -tol {
+                    negative += 1;
+                }
+            }
+        };
+        // a far group's placeholders (gap +inf) change neither figure: skipped unread
+        let mut next = 0;
+        for (g, floor) in self.point_groups.iter().zip(&self.group_floors) {
+            if floor.is_some() {
+                scan(&self.geo_cache[next..g.start]);
+                next = g.end;
             }
         }
+        scan(&self.geo_cache[next..]);
         // a far group's gaps are above its floor, itself above the gap tolerance: its points
         // are measured only where they could hold the smallest gap
         for (g, floor) in self.point_groups.iter().zip(&self.group_floors) {
