@@ -30,7 +30,7 @@ use parry3d_f64::shape::{PolygonalFeature, Shape};
 use super::clip::face_contacts;
 use super::contact::Reference;
 use super::shape2::Shape2;
-use super::shape3::{Shape3, ShapeKind3};
+use super::shape3::Shape3;
 
 /// Cross products of edge directions shorter than this are skipped: two edges parallel to
 /// within it span no axis of their own (their axis is, to within it, a face axis), and the
@@ -158,22 +158,22 @@ pub(super) fn box_pair(
     BoxPair::Exact
 }
 
-/// Whether both shapes are boxes.
-pub(super) fn boxes3(a: &Shape3, b: &Shape3) -> bool {
-    a.kind() == ShapeKind3::Cuboid && b.kind() == ShapeKind3::Cuboid
+/// Both shapes' half extents when both are boxes.
+pub(super) fn boxes3(a: &Shape3, b: &Shape3) -> Option<([f64; 3], [f64; 3])> {
+    Some((a.box_half_extents()?, b.box_half_extents()?))
 }
 
 /// 2D has no box kind (a rectangle is a convex polygon).
-pub(super) fn boxes2(_: &Shape2, _: &Shape2) -> bool {
-    false
+pub(super) fn boxes2(_: &Shape2, _: &Shape2) -> Option<([f64; 3], [f64; 3])> {
+    None
 }
 
 /// Two boxes' manifold by their separating axes into `manifolds` (one
 /// manifold), `true` when it decided the pair.
 pub(super) fn box_pair3(
     pos12: &Isometry3<f64>,
-    a: &dyn Shape,
-    b: &dyn Shape,
+    (a, ha): (&dyn Shape, [f64; 3]),
+    (b, hb): (&dyn Shape, [f64; 3]),
     prediction: (f64, f64),
     manifolds: &mut Vec<ContactManifold<Reference, ()>>,
 ) -> bool {
@@ -181,17 +181,15 @@ pub(super) fn box_pair3(
         manifolds.clear();
         manifolds.push(ContactManifold::new());
     }
-    // a box's polyhedron has its corners at exactly +-half extents
-    let half = |s: &dyn Shape| s.compute_local_aabb().maxs.coords;
-    let (ha, hb) = (half(a), half(b));
+    let (ha, hb) = (Vector3::from(ha), Vector3::from(hb));
     box_pair(pos12, (a, ha), (b, hb), prediction, &mut manifolds[0]) == BoxPair::Exact
 }
 
 /// In 2D rectangles go through GJK (a polygon clip is already exact there).
 pub(super) fn box_pair2(
     _: &nalgebra::Isometry2<f64>,
-    _: &dyn parry2d_f64::shape::Shape,
-    _: &dyn parry2d_f64::shape::Shape,
+    _: (&dyn parry2d_f64::shape::Shape, [f64; 3]),
+    _: (&dyn parry2d_f64::shape::Shape, [f64; 3]),
     _: (f64, f64),
     _: &mut Vec<parry2d_f64::query::ContactManifold<Reference, ()>>,
 ) -> bool {

@@ -283,13 +283,14 @@ macro_rules! contacts_impl {
      $convex_ws:ty, $pair:ident, $boxes:ident, $bound:ident) => {
         /// parry's manifolds of `a` at `pose_a` and `b` at `pose_b` translated by `shift`,
         /// converted; gaps taken back to the unshifted poses (`g - n · shift`, exact while the
-        /// same features touch), kept when `<= prediction`. `boxes`: both shapes are boxes,
+        /// same features touch), kept when `<= prediction`. `boxes`: both shapes are boxes
+        /// (their half extents, in the caller's unit),
         /// whose manifold module `box_pair` may give exactly; the return value says whether
         /// it did (no second query is then needed).
         #[allow(clippy::too_many_arguments)]
         fn $raw(
             (a, b): (&$dynshape, &$dynshape),
-            boxes: bool,
+            boxes: Option<([f64; 3], [f64; 3])>,
             (unit, size): (f64, f64),
             pose_a: &$iso<f64>,
             pose_b: &$iso<f64>,
@@ -319,7 +320,10 @@ macro_rules! contacts_impl {
             );
             let pos12 = at.inv_mul(&bt);
             let query = (prediction + shift.norm()) * inv;
-            let exact = boxes && $pair(&pos12, a, b, (query, near), manifolds);
+            let exact = boxes.is_some_and(|(ha, hb)| {
+                let scaled = |h: [f64; 3]| h.map(|x| x * inv);
+                $pair(&pos12, (a, scaled(ha)), (b, scaled(hb)), (query, near), manifolds)
+            });
             if !exact && !$convex(&pos12, a, b, (query, near), manifolds, convex) {
                 $dispatcher
                     .contact_manifolds(&pos12, a, b, query, manifolds, workspace)
@@ -512,7 +516,7 @@ macro_rules! contacts_impl {
             };
             let shift = along * (PULL * size);
             let ws = (&mut *workspace, &mut *convex);
-            $raw(shapes, false, (unit, size_q), pose_a, pose_b, shift, prediction, manifolds, ws, retry)?;
+            $raw(shapes, None, (unit, size_q), pose_a, pose_b, shift, prediction, manifolds, ws, retry)?;
             let second = score(retry);
             if (empty && !retry.is_empty()) || first <= second + PREFER * size {
                 std::mem::swap(out, retry);

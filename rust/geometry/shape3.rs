@@ -34,7 +34,8 @@ pub enum ShapeKind3 {
 #[derive(Clone)]
 enum Repr3 {
     Sphere(Ball),
-    Cuboid(ConvexPolyhedron),
+    /// the polyhedron and its half extents (its corners are at exactly `+-half`).
+    Cuboid(ConvexPolyhedron, [f64; 3]),
     Capsule(Capsule),
     Cylinder(Cylinder),
     Cone(Cone),
@@ -67,6 +68,41 @@ fn hull(points: &[Point3<f64>]) -> Option<ConvexPolyhedron> {
     let unit = 2f64.powi(size.log2().round().clamp(-1000.0, 1000.0) as i32);
     let at_unit: Vec<Point3<f64>> = points.iter().map(|p| p / unit).collect();
     ConvexPolyhedron::from_convex_hull(&at_unit)?.scaled(&Vector3::repeat(unit))
+}
+
+/// The box `[-half, half]` as a polyhedron, from its 12 triangles (two per face, turned
+/// outwards), built at the unit `2^k` nearest its largest extent and scaled back (exact): a
+/// convex hull of its corners has tolerances relative to the largest extent, which made a
+/// 2 x 2e-4 x 2 plate a single face.
+fn box_polyhedron(half: [f64; 3]) -> Option<ConvexPolyhedron> {
+    let size = half.iter().fold(0.0f64, |m, &x| m.max(x));
+    let unit = 2f64.powi(size.log2().round().clamp(-1000.0, 1000.0) as i32);
+    // corner k has the sign of bit i of k along axis i
+    let corner = |k: u32| {
+        let s = |i: usize| if k & (1 << i) == 0 { -1.0 } else { 1.0 };
+        Point3::new(
+            s(0) * half[0] / unit,
+            s(1) * half[1] / unit,
+            s(2) * half[2] / unit,
+        )
+    };
+    let points: Vec<Point3<f64>> = (0..8).map(corner).collect();
+    let mut triangles = Vec::with_capacity(12);
+    for axis in 0..3 {
+        let (j, l) = ((axis + 1) % 3, (axis + 2) % 3);
+        for side in [0u32, 1] {
+            // the face's corners in order around it
+            let at = |bj: u32, bl: u32| (side << axis) | (bj << j) | (bl << l);
+            let quad = [at(0, 0), at(1, 0), at(1, 1), at(0, 1)];
+            for t in [[quad[0], quad[1], quad[2]], [quad[0], quad[2], quad[3]]] {
+                let [a, b, c] = t.map(|k| points[k as usize]);
+                // outwards: the normal points away from the centre (the origin)
+                let outward = (b - a).cross(&(c - a)).dot(&a.coords) > 0.0;
+                triangles.push(if outward { t } else { [t[0], t[2], t[1]] });
+            }
+        }
+    }
+    ConvexPolyhedron::from_convex_mesh(points, &triangles)?.scaled(&Vector3::repeat(unit))
 }
 
 fn check_pose(name: &str, pose: &Isometry3<f64>) -> Result<()> {
@@ -106,14 +142,22 @@ impl Shape3 {
             positive("box half extent y", y)?,
             positive("box half extent z", z)?,
         );
-        let mut corners = Vec::with_capacity(8);
-        for k in 0..8 {
-            let sign = |bit: usize| if k & bit == 0 { -1.0 } else { 1.0 };
-            corners.push(Point3::new(sign(1) * x, sign(2) * y, sign(4) * z));
+        let half = [x, y, z];
+        // a box far thinner than it is long loses corners to the hull's tolerance: refused
+        // rather than kept as another polyhedron (its half extents are read as its corners)
+        let exact = |h: &ConvexPolyhedron| {
+            let b = h.local_aabb();
+            h.points().len() == 8
+                && b.maxs.coords == Vector3::from(half)
+                && b.mins.coords == -Vector3::from(half)
+        };
+        match box_polyhedron(half) {
+            Some(h) if exact(&h) => Ok(Self::new(Repr3::Cuboid(h, half))),
+            _ => Err(CoulombError::InvalidParameter(format!(
+                "box half extents {half:?} span too many orders of magnitude for a polyhedron \
+                 (it loses corners); use extents within a factor 1e12 of each other"
+            ))),
         }
-        hull(&corners)
-            .map(|h| Self::new(Repr3::Cuboid(h)))
-            .ok_or_else(|| CoulombError::InvalidParameter("box could not be built".to_string()))
     }
 
     /// The points within `radius > 0` of the segment `[a, b]` (`a == b` gives a sphere).
@@ -286,11 +330,20 @@ impl Shape3 {
         self.parry().scale_dyn(&Vector3::repeat(k), 0)
     }
 
+    /// A box's half extents (its polyhedron's corners are at exactly `+-half`), `None` for
+    /// other shapes.
+    pub fn box_half_extents(&self) -> Option<[f64; 3]> {
+        match &self.repr {
+            Repr3::Cuboid(_, half) => Some(*half),
+            _ => None,
+        }
+    }
+
     /// Which shape this is.
     pub fn kind(&self) -> ShapeKind3 {
         match &self.repr {
             Repr3::Sphere(_) => ShapeKind3::Sphere,
-            Repr3::Cuboid(_) => ShapeKind3::Cuboid,
+            Repr3::Cuboid(..) => ShapeKind3::Cuboid,
             Repr3::Capsule(_) => ShapeKind3::Capsule,
             Repr3::Cylinder(_) => ShapeKind3::Cylinder,
             Repr3::Cone(_) => ShapeKind3::Cone,
@@ -324,7 +377,7 @@ impl Shape3 {
     pub(crate) fn parry(&self) -> &dyn ParryShape {
         match &self.repr {
             Repr3::Sphere(s) => s,
-            Repr3::Cuboid(s) => s,
+            Repr3::Cuboid(s, _) => s,
             Repr3::Capsule(s) => s,
             Repr3::Cylinder(s) => s,
             Repr3::Cone(s) => s,
@@ -342,8 +395,15 @@ impl Shape3 {
 
     /// The half diagonal of the shape's bounding box in its frame; `None` for a half-space.
     pub(crate) fn size(&self) -> Option<f64> {
-        let b = self.parry().compute_local_aabb();
-        let d = 0.5 * (b.maxs - b.mins).norm();
+        // a box's bounding box is `[-half, half]` (exactly: its corners), not searched for
+        let span = match &self.repr {
+            Repr3::Cuboid(_, h) => Vector3::from(*h) * 2.0,
+            _ => {
+                let b = self.parry().compute_local_aabb();
+                b.maxs - b.mins
+            }
+        };
+        let d = 0.5 * span.norm();
         (d.is_finite() && d > 0.0).then_some(d)
     }
 
@@ -418,6 +478,33 @@ mod tests {
             Shape3::triangle_mesh(&square, &[[0, 1, 2], [0, 3, 2]]),
             Err(CoulombError::InvalidParameter(_))
         ));
+    }
+
+    /// the box pair's separating-axis test reads the kept half extents instead of the
+    /// polyhedron's bounding box: they must be its corners to the bit, at every scale
+    #[test]
+    fn a_box_keeps_its_polyhedrons_corners_as_half_extents() {
+        let mut rng = crate::testing::SplitMix64::new(3);
+        for _ in 0..300 {
+            let h = [0, 1, 2]
+                .map(|_| (1.0 + 9.0 * rng.uniform()) * 10f64.powf(16.0 * rng.uniform() - 8.0));
+            let aspect =
+                h.iter().fold(0.0f64, |m, &x| m.max(x)) / h.iter().fold(f64::MAX, |m, &x| m.min(x));
+            let b = match Shape3::cuboid(h) {
+                Ok(b) => b,
+                // only a box too thin for its hull is refused
+                Err(CoulombError::InvalidParameter(_)) if aspect > 1e12 => continue,
+                Err(e) => panic!("box {h:?} (aspect {aspect:.1e}) refused: {e}"),
+            };
+            let hull = b.parry().compute_local_aabb();
+            assert_eq!(b.box_half_extents(), Some(h));
+            assert_eq!(hull.maxs.coords, Vector3::from(h), "{h:?}");
+            assert_eq!(hull.mins.coords, -Vector3::from(h), "{h:?}");
+        }
+        assert_eq!(
+            Shape3::sphere(1.0).ok().and_then(|s| s.box_half_extents()),
+            None
+        );
     }
 
     #[test]
