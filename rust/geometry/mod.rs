@@ -28,7 +28,9 @@
 //! power-of-two unit near the shapes' size (parry's absolute tolerances), GJK's redundant
 //! extra point dropped, and two faces in 3D clipped as polygons along the face's own normal
 //! (module `clip`: parry's separate corner and crossing tests could both refuse a corner that
-//! two equal faces share to rounding); boxes are polyhedra (see [`Shape3::cuboid`]), and two
+//! two equal faces share to rounding); convex hulls and polygons are searched in the point
+//! cloud's principal frame stretched to unit extents (module `hull`: parry's uniform scaling
+//! left points of a thin cloud outside its hull); boxes are polyhedra (see [`Shape3::cuboid`]), and two
 //! boxes touching face to face get their normal and gap from the separating axes, not GJK
 //! (module `box_pair`). With a cylinder or a
 //! cone, parry builds the manifold from polygonal features picked by a GJK normal of limited
@@ -47,6 +49,7 @@ mod clip;
 pub mod contact;
 mod convex;
 mod crossing;
+mod hull;
 mod parts;
 pub mod shape2;
 pub mod shape3;

@@ -86,8 +86,13 @@ impl Shape2 {
                 points.len()
             )));
         }
-        let pts: Vec<Point2<f64>> = points.iter().map(|&p| p.into()).collect();
-        ConvexPolygon::from_convex_hull(&pts)
+        // built at the unit 2^k nearest the largest coordinate and scaled back (exact):
+        // parry's edge normals need edges longer than an absolute epsilon
+        let size = points.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+        let unit = 2f64.powi(size.log2().round().clamp(-1000.0, 1000.0) as i32);
+        let pts: Vec<Point2<f64>> = points.iter().map(|&p| Point2::from(p) / unit).collect();
+        super::hull::convex_polygon(&pts)
+            .and_then(|p| p.scaled(&Vector2::repeat(unit)))
             .map(|p| Self::new(Repr2::ConvexPolygon(p)))
             .ok_or_else(|| {
                 CoulombError::InvalidParameter("convex polygon could not be built".to_string())

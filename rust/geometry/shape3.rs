@@ -60,14 +60,14 @@ impl std::fmt::Debug for Shape3 {
     }
 }
 
-/// The convex hull of `points`, built at the unit `2^k` nearest their largest coordinate and
-/// scaled back (exactly, a power of two): parry's hull construction has absolute tolerances,
-/// which at a few nanometres merged a box's corners.
+/// The convex hull of `points` (module `hull`), built at the unit `2^k` nearest their largest
+/// coordinate and scaled back (exactly, a power of two): parry's polyhedron drops edges
+/// shorter than an absolute epsilon.
 fn hull(points: &[Point3<f64>]) -> Option<ConvexPolyhedron> {
     let size = points.iter().map(|p| p.coords.amax()).fold(0.0, f64::max);
     let unit = 2f64.powi(size.log2().round().clamp(-1000.0, 1000.0) as i32);
     let at_unit: Vec<Point3<f64>> = points.iter().map(|p| p / unit).collect();
-    ConvexPolyhedron::from_convex_hull(&at_unit)?.scaled(&Vector3::repeat(unit))
+    super::hull::convex_hull(&at_unit)?.scaled(&Vector3::repeat(unit))
 }
 
 /// The box `[-half, half]` as a polyhedron, from its 12 triangles (two per face, turned
