@@ -26,32 +26,31 @@
 
 use std::collections::HashMap;
 
-use nalgebra::{Matrix2, Matrix3, Point2, Point3, SymmetricEigen, Vector2, Vector3};
+use nalgebra::{
+    Matrix2, Matrix3, Point2, Point3, SMatrix, SVector, SymmetricEigen, Vector2, Vector3,
+};
 use parry2d_f64::shape::ConvexPolygon;
 use parry2d_f64::transformation::convex_hull_idx;
 use parry3d_f64::shape::ConvexPolyhedron;
 use parry3d_f64::transformation::try_convex_hull;
 
-/// The convex hull of `points` (finite, spanning 3D), in the points' own coordinates; `None`
-/// when parry cannot build it.
-pub(crate) fn convex_hull(points: &[Point3<f64>]) -> Option<ConvexPolyhedron> {
-    let n = points.len();
-    if n < 4 {
-        return None;
-    }
-    let c = points.iter().fold(Vector3::zeros(), |a, p| a + p.coords) / n as f64;
-    let mut cov = Matrix3::zeros();
+/// `points` in their principal frame, each axis stretched to unit extent (see the module
+/// doc): `frame` gives the covariance's eigenvectors as a rotation (det +1). `None` when the
+/// cloud has no extent along an axis.
+fn stretched<const D: usize>(
+    points: &[SVector<f64, D>],
+    frame: impl Fn(SMatrix<f64, D, D>) -> SMatrix<f64, D, D>,
+) -> Option<Vec<SVector<f64, D>>> {
+    let c = points.iter().fold(SVector::zeros(), |a, p| a + p) / points.len() as f64;
+    let mut cov = SMatrix::<f64, D, D>::zeros();
     for p in points {
-        let d = p.coords - c;
+        let d = p - c;
         cov += d * d.transpose();
     }
-    let mut r = SymmetricEigen::new(cov).eigenvectors;
-    if r.determinant() < 0.0 {
-        r.column_mut(2).neg_mut();
-    }
-    let along: Vec<Vector3<f64>> = points.iter().map(|p| r.tr_mul(&(p.coords - c))).collect();
-    let mut extent = Vector3::zeros();
-    for i in 0..3 {
+    let r = frame(cov);
+    let along: Vec<SVector<f64, D>> = points.iter().map(|p| r.tr_mul(&(p - c))).collect();
+    let mut extent = SVector::<f64, D>::zeros();
+    for i in 0..D {
         let (lo, hi) = along
             .iter()
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
@@ -62,10 +61,26 @@ pub(crate) fn convex_hull(points: &[Point3<f64>]) -> Option<ConvexPolyhedron> {
             return None;
         }
     }
-    let round: Vec<Point3<f64>> = along
-        .iter()
-        .map(|v| Point3::from(v.component_div(&extent)))
-        .collect();
+    Some(along.iter().map(|v| v.component_div(&extent)).collect())
+}
+
+/// The convex hull of `points` (finite, spanning 3D), in the points' own coordinates; `None`
+/// when parry cannot build it.
+pub(crate) fn convex_hull(points: &[Point3<f64>]) -> Option<ConvexPolyhedron> {
+    if points.len() < 4 {
+        return None;
+    }
+    let coords: Vec<Vector3<f64>> = points.iter().map(|p| p.coords).collect();
+    let round: Vec<Point3<f64>> = stretched(&coords, |cov: Matrix3<f64>| {
+        let mut r = SymmetricEigen::new(cov).eigenvectors;
+        if r.determinant() < 0.0 {
+            r.column_mut(2).neg_mut();
+        }
+        r
+    })?
+    .into_iter()
+    .map(Point3::from)
+    .collect();
     let (vertices, triangles) = try_convex_hull(&round).ok()?;
     // parry returns a subset of its input points, unchanged: find each one's input index
     let bits = |p: &Point3<f64>| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
@@ -84,37 +99,20 @@ pub(crate) fn convex_hull(points: &[Point3<f64>]) -> Option<ConvexPolyhedron> {
 /// The convex hull of `points` (finite, spanning 2D) as a counter-clockwise polygon of input
 /// points, every hull vertex kept; `None` when an edge is too short for a normal.
 pub(crate) fn convex_polygon(points: &[Point2<f64>]) -> Option<ConvexPolygon> {
-    let n = points.len();
-    if n < 3 {
+    if points.len() < 3 {
         return None;
     }
-    let c = points.iter().fold(Vector2::zeros(), |a, p| a + p.coords) / n as f64;
-    let mut cov = Matrix2::zeros();
-    for p in points {
-        let d = p.coords - c;
-        cov += d * d.transpose();
-    }
-    let mut r = SymmetricEigen::new(cov).eigenvectors;
-    if r.determinant() < 0.0 {
-        r.column_mut(1).neg_mut();
-    }
-    let along: Vec<Vector2<f64>> = points.iter().map(|p| r.tr_mul(&(p.coords - c))).collect();
-    let mut extent = Vector2::zeros();
-    for i in 0..2 {
-        let (lo, hi) = along
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
-                (lo.min(v[i]), hi.max(v[i]))
-            });
-        extent[i] = hi - lo;
-        if !(extent[i] > 0.0 && extent[i].is_finite()) {
-            return None;
+    let coords: Vec<Vector2<f64>> = points.iter().map(|p| p.coords).collect();
+    let round: Vec<Point2<f64>> = stretched(&coords, |cov: Matrix2<f64>| {
+        let mut r = SymmetricEigen::new(cov).eigenvectors;
+        if r.determinant() < 0.0 {
+            r.column_mut(1).neg_mut();
         }
-    }
-    let round: Vec<Point2<f64>> = along
-        .iter()
-        .map(|v| Point2::from(v.component_div(&extent)))
-        .collect();
+        r
+    })?
+    .into_iter()
+    .map(Point2::from)
+    .collect();
     let order = convex_hull_idx(&round);
     ConvexPolygon::from_convex_polyline_unmodified(order.iter().map(|&i| points[i]).collect())
 }
