@@ -1,8 +1,9 @@
 """Type stub of the Rust extension ``coulomb._core`` (the bindings in ``rust/python/``).
 
-Checked against the built extension by ``python -m mypy.stubtest coulomb._core``. The functions
-return plain dicts; their keys and value types are the ``TypedDict`` classes below (stub-only,
-hence private names).
+Checked against the built extension by ``python -m mypy.stubtest coulomb._core``. ``lcp_solve``
+and ``contact_solve`` return the package's result objects, filled by the core; the other
+functions return plain dicts, whose keys and value types are the ``TypedDict`` classes below
+(stub-only, hence private names).
 """
 
 import os
@@ -11,6 +12,9 @@ from typing import Any, Literal, TypedDict
 
 import numpy as np
 from numpy.typing import NDArray
+
+from coulomb.contact import ContactResult
+from coulomb.lcp import LcpResult
 
 __all__ = [
     "__version__",
@@ -54,42 +58,6 @@ class _LcpMeasuresDict(TypedDict):
     min_z: float
     min_w: float
     max_complementarity: float
-
-class _LcpSolveDict(_LcpMeasuresDict):
-    """``lcp_solve``: the answer, how the solve ended and its error measures."""
-
-    success: bool
-    status: _LcpStatusName
-    message: str
-    z: _F64
-    pivots: int
-    iterations: int
-    basis: _I64
-    warm_start: Literal["none", "accepted", "rejected"]
-    pivots_saved: int
-    polished: bool
-    restarts: int
-    solutions: _F64
-    solve_time: float
-
-class _ContactSolveDict(TypedDict):
-    """``contact_solve``: impulses and velocities as (nc, dim) arrays and the error measures."""
-
-    impulse: _F64
-    velocity: _F64
-    success: bool
-    status: _ContactStatusName
-    message: str
-    iterations: int
-    error: float
-    error_q: float
-    error_q_floor: float
-    scaled_error: float
-    min_normal_impulse: float
-    max_complementarity: float
-    cone_violation: float
-    dissipation_violation: float
-    solve_time: float
 
 class _LcpBatchDict(TypedDict):
     """``lcp_solve_batch``: the answers column by column; ``z``, ``w`` flat, problem i at
@@ -233,7 +201,7 @@ def lcp_solve(
     relaxation: float = 1.0,
     initial: _F64 | None = None,
     engine: str = "auto",
-) -> _LcpSolveDict: ...
+) -> LcpResult: ...
 def lcp_measures(m: _F64, q: _F64, z: _F64) -> _LcpMeasuresDict: ...
 def read_siconos_lcp(path: _Path) -> tuple[_F64, _F64]: ...
 def contact_solve(
@@ -254,7 +222,7 @@ def contact_solve(
     order: str = "forward",
     permutation: list[int] | None = None,
     sticking: bool = True,
-) -> _ContactSolveDict: ...
+) -> ContactResult: ...
 def lcp_solve_batch(
     ms: _F64 | list[_F64],
     qs: _F64 | list[_F64],

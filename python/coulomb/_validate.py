@@ -219,6 +219,21 @@ def contact_options(
 ) -> tuple[int, float, int | None, float, int | None, float | None]:
     """The options of :func:`coulomb.contact.solve` (and of a simulation's contact solver),
     type- and range-checked: ``(dim, tol, max_iter, relaxation, facets, eta)``."""
+    # the common call (defaults but dim and tol, plain Python numbers) costs a few
+    # comparisons: the general checks below take about 1 us, a small solve's third
+    if (
+        type(dim) is int
+        and (dim == 3 or dim == 2)
+        and (method == "nsgs" or method == "prox" or method == "lemke")
+        and type(tol) is float
+        and 0.0 < tol < 1.0
+        and max_iter is None
+        and type(relaxation) is float
+        and relaxation == 1.0
+        and facets is None
+        and eta is None
+    ):
+        return dim, tol, None, 1.0, None, None
     if isinstance(dim, (bool, np.bool_)) or not isinstance(dim, (int, np.integer)) or int(
         dim
     ) not in (2, 3):

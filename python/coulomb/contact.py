@@ -140,6 +140,7 @@ theirs too, down to its rounding level ``error_q_floor``.
 
 from __future__ import annotations
 
+import math
 from typing import Any, Literal
 
 import numpy as np
@@ -172,9 +173,10 @@ class ContactResult(Result):
     success : bool
         True exactly when ``scaled_error <= tol`` and ``error_q <= max(tol, error_q_floor)``
         (for ``"lemke"`` in 3D: when the polyhedral LCP was solved).
-    status : str
-        ``"solved"``, ``"iteration_limit"`` (the budget was spent: ``max_iter`` sweeps, or
-        every restart of ``"prox"`` stalled) or ``"numerical_failure"``.
+    status : Status
+        ``Status.SOLVED``, ``ITERATION_LIMIT`` (the budget was spent: ``max_iter`` sweeps, or
+        every restart of ``"prox"`` stalled) or ``NUMERICAL_FAILURE``; each equals its
+        string (``r.status == "solved"``).
     message : str
         One line for a person.
     iterations : int
@@ -198,7 +200,7 @@ class ContactResult(Result):
     impulse: NDArray[np.float64]
     velocity: NDArray[np.float64]
     success: bool
-    status: str
+    status: Status
     message: str
     iterations: int
     error: float
@@ -340,7 +342,8 @@ def solve(
         if not np.isfinite(init).all():
             raise NonFiniteError("initial contains NaN or infinity")
     order_name, permutation = _order(order, nc, method)
-    out = _core.contact_solve(
+    # the core fills a ContactResult itself (its status a Status member)
+    return _core.contact_solve(
         Wa,
         qa,
         mua,
@@ -358,7 +361,6 @@ def solve(
         permutation=permutation,
         sticking=sticks,
     )
-    return ContactResult(out, status=Status(out["status"]))
 
 
 def _order(order: object, nc: int, method: str) -> tuple[str, list[int] | None]:
@@ -422,6 +424,16 @@ def _friction(
 ) -> tuple[NDArray[np.float64], NDArray[np.float64] | None]:
     """mu as ``nc`` coefficients, and for an (nc, 2) array the flat anisotropic pairs (the
     coefficients then hold ``max(mu_1, mu_2)``)."""
+    if type(mu) is float:
+        # one coefficient as a Python number: checked here (the numpy route below costs
+        # about 4 us, more than a small solve)
+        if not math.isfinite(mu):
+            raise NonFiniteError("mu contains NaN or infinity")
+        if mu < 0:
+            raise InvalidParameterError(f"friction coefficients must be >= 0, mu[0] = {mu}")
+        mua = np.empty(nc)
+        mua.fill(mu)
+        return mua, None
     mu_in = np.asarray(mu) if not isinstance(mu, np.ndarray) else mu
     pairs = None
     if mu_in.ndim == 0:

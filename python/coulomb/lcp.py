@@ -256,9 +256,9 @@ def solve(
         cover = (None if covering_vector is None
                  else _as_array(covering_vector, "covering_vector", 1))
         basis = None if warm_start is None else _basis_indices(warm_start, n)
-        out = _core.lcp_solve(Ma, qa, method, tol, max_piv, cover, basis, do_polish,
-                              n_restarts, 10_000, 1.0, None, eng)
-        return LcpResult(out, status=Status(out["status"]))
+        # the core fills an LcpResult itself (its status a Status member)
+        return _core.lcp_solve(Ma, qa, method, tol, max_piv, cover, basis, do_polish,
+                               n_restarts, 10_000, 1.0, None, eng)
     _validate.choice("method", method, _METHODS)
     _validate.unused("method", method, max_pivots=max_pivots, covering_vector=covering_vector,
                      warm_start=warm_start, polish=polish, restarts=restarts, engine=engine)
@@ -269,9 +269,8 @@ def solve(
     omega = 1.0 if relaxation is None else _validate.real(
         "relaxation", relaxation, low=0.0, high=2.0, low_open=True, high_open=True)
     init = None if initial is None else _validate.finite_array(initial, "initial", 1)
-    out = _core.lcp_solve(Ma, qa, method, tol, None, None, None, True, 2, sweeps, omega,
-                          init, "auto")
-    return LcpResult(out, status=Status(out["status"]))
+    return _core.lcp_solve(Ma, qa, method, tol, None, None, None, True, 2, sweeps, omega,
+                           init, "auto")
 
 
 def check(M: ArrayLike, q: ArrayLike, z: ArrayLike) -> Result:

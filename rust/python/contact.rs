@@ -10,6 +10,7 @@ use pyo3::intern;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+use super::results::{empty_result, status_member, ResultKind};
 use super::{guarded, settings, slice1, slice2, to_py};
 use crate::contact::assembly::{self, FreeMotion, MassFactor, Triplets};
 use crate::contact::prox::ProxSettings;
@@ -30,13 +31,13 @@ fn contact_dict<'py>(
         PyRuntimeError::new_err(format!("internal shape error: {e}"))
     };
     let success = s.success();
-    let d = PyDict::new(py);
+    let d = empty_result(py, ResultKind::Contact)?;
     let impulse = Array2::from_shape_vec((nc, dim), s.impulse).map_err(shape_err)?;
     let velocity = Array2::from_shape_vec((nc, dim), s.velocity).map_err(shape_err)?;
     d.set_item(intern!(py, "impulse"), impulse.into_pyarray(py))?;
     d.set_item(intern!(py, "velocity"), velocity.into_pyarray(py))?;
     d.set_item(intern!(py, "success"), success)?;
-    d.set_item(intern!(py, "status"), s.status.as_str())?;
+    d.set_item(intern!(py, "status"), status_member(py, s.status.as_str())?)?;
     d.set_item(intern!(py, "message"), s.message)?;
     d.set_item(intern!(py, "iterations"), s.iterations)?;
     let m = s.measures;

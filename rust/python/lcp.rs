@@ -8,6 +8,7 @@ use pyo3::intern;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+use super::results::{empty_result, status_member, ResultKind};
 use super::{guarded, slice1, slice2, to_py};
 use crate::error::CoulombError;
 use crate::lcp::{
@@ -21,9 +22,9 @@ fn solution_dict<'py>(
     seconds: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
     let n = s.z.len();
-    let d = PyDict::new(py);
+    let d = empty_result(py, ResultKind::Lcp)?;
     d.set_item(intern!(py, "success"), s.success())?;
-    d.set_item(intern!(py, "status"), s.status.as_str())?;
+    d.set_item(intern!(py, "status"), status_member(py, s.status.as_str())?)?;
     d.set_item(intern!(py, "message"), s.message)?;
     d.set_item(intern!(py, "z"), PyArray1::from_vec(py, s.z))?;
     d.set_item(intern!(py, "w"), PyArray1::from_vec(py, s.w))?;

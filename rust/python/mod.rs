@@ -17,6 +17,7 @@ mod errors;
 mod io;
 mod lcp;
 mod model;
+mod results;
 mod settings;
 mod step;
 
