@@ -2,7 +2,7 @@
 //! (Lemke, PGS, enumeration) and `lcp_measures` (the error measures of any z).
 
 use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::intern;
 use pyo3::prelude::*;
@@ -26,8 +26,10 @@ fn solution_dict<'py>(
     d.set_item(intern!(py, "success"), s.success())?;
     d.set_item(intern!(py, "status"), status_member(py, s.status.as_str())?)?;
     d.set_item(intern!(py, "message"), s.message)?;
-    d.set_item(intern!(py, "z"), PyArray1::from_vec(py, s.z))?;
-    d.set_item(intern!(py, "w"), PyArray1::from_vec(py, s.w))?;
+    // copied into NumPy's own memory: an array over a Rust Vec also allocates the Python
+    // object that owns the Vec, which costs more than copying a small answer
+    d.set_item(intern!(py, "z"), PyArray1::from_slice(py, &s.z))?;
+    d.set_item(intern!(py, "w"), PyArray1::from_slice(py, &s.w))?;
     d.set_item(intern!(py, "error"), s.measures.error)?;
     d.set_item(intern!(py, "scaled_error"), s.measures.scaled_error)?;
     d.set_item(intern!(py, "min_z"), s.measures.min_z)?;
@@ -39,16 +41,20 @@ fn solution_dict<'py>(
     d.set_item(intern!(py, "pivots"), s.pivots)?;
     d.set_item(intern!(py, "iterations"), s.iterations)?;
     let basis: Vec<i64> = s.basis.iter().map(|&k| k as i64).collect();
-    d.set_item(intern!(py, "basis"), PyArray1::from_vec(py, basis))?;
+    d.set_item(intern!(py, "basis"), PyArray1::from_slice(py, &basis))?;
     d.set_item(intern!(py, "warm_start"), s.warm_start.as_str())?;
     d.set_item(intern!(py, "pivots_saved"), s.pivots_saved)?;
     d.set_item(intern!(py, "polished"), s.polished)?;
     d.set_item(intern!(py, "restarts"), s.restarts)?;
     let k = s.solutions.len();
-    let flat: Vec<f64> = s.solutions.into_iter().flatten().collect();
-    let solutions = Array2::from_shape_vec((k, n), flat)
-        .map_err(|e| PyRuntimeError::new_err(format!("internal shape error: {e}")))?;
-    d.set_item(intern!(py, "solutions"), solutions.into_pyarray(py))?;
+    if k == 0 {
+        d.set_item(intern!(py, "solutions"), PyArray2::<f64>::zeros(py, [0, n], false))?;
+    } else {
+        let flat: Vec<f64> = s.solutions.into_iter().flatten().collect();
+        let solutions = Array2::from_shape_vec((k, n), flat)
+            .map_err(|e| PyRuntimeError::new_err(format!("internal shape error: {e}")))?;
+        d.set_item(intern!(py, "solutions"), solutions.into_pyarray(py))?;
+    }
     d.set_item(intern!(py, "solve_time"), seconds)?;
     Ok(d)
 }
