@@ -30,7 +30,9 @@
 //! (module `clip`: parry's separate corner and crossing tests could both refuse a corner that
 //! two equal faces share to rounding); convex hulls and polygons are searched in the point
 //! cloud's principal frame stretched to unit extents (module `hull`: parry's uniform scaling
-//! left points of a thin cloud outside its hull); boxes are polyhedra (see [`Shape3::cuboid`]), and two
+//! left points of a thin cloud outside its hull), a polyhedron against a half-space is measured
+//! at every vertex (parry's support face of a polyhedron need not hold its lowest corner:
+//! some hulls just above a floor had no contact at all); boxes are polyhedra (see [`Shape3::cuboid`]), and two
 //! boxes touching face to face get their normal and gap from the separating axes, not GJK
 //! (module `box_pair`). With a cylinder or a
 //! cone, parry builds the manifold from polygonal features picked by a GJK normal of limited

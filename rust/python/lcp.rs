@@ -2,7 +2,9 @@
 //! (Lemke, PGS, enumeration) and `lcp_measures` (the error measures of any z).
 
 use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::{
+    IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods,
+};
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::intern;
 use pyo3::prelude::*;
@@ -48,7 +50,10 @@ fn solution_dict<'py>(
     d.set_item(intern!(py, "restarts"), s.restarts)?;
     let k = s.solutions.len();
     if k == 0 {
-        d.set_item(intern!(py, "solutions"), PyArray2::<f64>::zeros(py, [0, n], false))?;
+        d.set_item(
+            intern!(py, "solutions"),
+            PyArray2::<f64>::zeros(py, [0, n], false),
+        )?;
     } else {
         let flat: Vec<f64> = s.solutions.into_iter().flatten().collect();
         let solutions = Array2::from_shape_vec((k, n), flat)
