@@ -329,6 +329,14 @@ def test_a_polygon_of_collinear_points_attaches_and_contact_all_leaves_it_out() 
         scene.contact(feet, scene.shapes[1][1])
 
 
+def _tilted(rng: np.random.Generator) -> np.ndarray:
+    """A unit quaternion (w, x, y, z) turning by at most about 0.04 rad, about a random axis."""
+    axis = rng.normal(size=4)
+    axis /= np.linalg.norm(axis)
+    quat = np.array([1.0, *(0.02 * axis[1:])])
+    return quat / np.linalg.norm(quat)
+
+
 def _rotate(quat: np.ndarray, points: np.ndarray) -> np.ndarray:
     """points turned by the unit quaternion (w, x, y, z)."""
     w, v = quat[0], quat[1:]
@@ -347,11 +355,8 @@ def test_a_thin_cloud_s_hull_lands_on_the_floor_without_sinking(seed: int) -> No
     rng = np.random.default_rng(100 + seed)
     thin = 0.2 * 10.0 ** rng.uniform(-6, -4)
     local = rng.uniform(-0.1, 0.1, (12, 3)) * np.array([1.0, 1.0, thin / 0.2])
-    quat = rng.normal(size=4)
-    quat /= np.linalg.norm(quat)
     # a small tilt only: the plate lands on a few corners, nearly flat
-    quat = np.array([1.0, *(0.02 * quat[1:])])
-    quat /= np.linalg.norm(quat)
+    quat = _tilted(rng)
     low = float(np.min(_rotate(quat, local)[:, 2]))
     scene = coulomb.Scene(dim=3, gravity=(0.0, 0.0, -9.81))
     floor = scene.add(coulomb.HalfSpace(normal=(0, 0, 1), point=(0, 0, 0)))
@@ -401,10 +406,7 @@ def test_a_box_dropped_nearly_flat_lands_with_every_step_solved(seed: int,
     the polygon's answer solves them in 57 to 192 steps, and stopped at 50 it left one step in
     three of these runs at iteration_limit (scaled_error 2.7e-5)."""
     rng = np.random.default_rng(100 + seed)
-    quat = rng.normal(size=4)
-    quat /= np.linalg.norm(quat)
-    quat = np.array([1.0, *(0.02 * quat[1:])])
-    quat /= np.linalg.norm(quat)
+    quat = _tilted(rng)
     corners = np.array([[sx * 0.1, sy * 0.1, sz * thickness / 2]
                         for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
     low = float(np.min(_rotate(quat, corners)[:, 2]))
