@@ -196,6 +196,16 @@ impl Shape2 {
         self.parry().scale_dyn(&Vector2::repeat(k), 0)
     }
 
+    /// The radius a disk or a capsule rounds its core by, 0 for other shapes (see
+    /// `Shape3::rounding`).
+    pub(crate) fn rounding(&self) -> f64 {
+        match &self.repr {
+            Repr2::Disk(s) => s.radius,
+            Repr2::Capsule(c) => c.radius,
+            _ => 0.0,
+        }
+    }
+
     /// Which shape this is.
     pub fn kind(&self) -> ShapeKind2 {
         match &self.repr {

@@ -339,6 +339,17 @@ impl Shape3 {
         }
     }
 
+    /// The radius a sphere or a capsule rounds its core by (a point, a segment), 0 for other
+    /// shapes: a contact of such a shape is its core point's, moved out by this radius along
+    /// the normal (what the stepper's gap curvature follows, module `step::narrow`).
+    pub(crate) fn rounding(&self) -> f64 {
+        match &self.repr {
+            Repr3::Sphere(s) => s.radius,
+            Repr3::Capsule(c) => c.radius,
+            _ => 0.0,
+        }
+    }
+
     /// Which shape this is.
     pub fn kind(&self) -> ShapeKind3 {
         match &self.repr {
