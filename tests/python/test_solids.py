@@ -337,6 +337,18 @@ def _tilted(rng: np.random.Generator) -> np.ndarray:
     return quat / np.linalg.norm(quat)
 
 
+def _dropped(shape: object, quat: np.ndarray, height: float, t_end: float,
+             inertia: tuple[float, float, float] = (2.5e-3, 2.5e-3, 5e-3)) -> coulomb.Trajectory:
+    """`shape` on a 1 kg body at `height` with orientation `quat`, falling onto the floor
+    z = 0 (mu 0.5) for `t_end` s at h = 1 ms."""
+    scene = coulomb.Scene(dim=3, gravity=(0.0, 0.0, -9.81))
+    floor = scene.add(coulomb.HalfSpace(normal=(0, 0, 1), point=(0, 0, 0)))
+    body = scene.add(coulomb.RigidBody3D(mass=1.0, inertia=inertia, position=(0.0, 0.0, height),
+                                         orientation=tuple(quat)))
+    scene.contact(scene.attach(body, shape), floor, mu=0.5)
+    return scene.simulate(t_end=t_end, h=1e-3)
+
+
 def _rotate(quat: np.ndarray, points: np.ndarray) -> np.ndarray:
     """points turned by the unit quaternion (w, x, y, z)."""
     w, v = quat[0], quat[1:]
@@ -358,14 +370,7 @@ def test_a_thin_cloud_s_hull_lands_on_the_floor_without_sinking(seed: int) -> No
     # a small tilt only: the plate lands on a few corners, nearly flat
     quat = _tilted(rng)
     low = float(np.min(_rotate(quat, local)[:, 2]))
-    scene = coulomb.Scene(dim=3, gravity=(0.0, 0.0, -9.81))
-    floor = scene.add(coulomb.HalfSpace(normal=(0, 0, 1), point=(0, 0, 0)))
-    body = scene.add(coulomb.RigidBody3D(mass=1.0, inertia=(2.5e-3, 2.5e-3, 5e-3),
-                                         position=(0.0, 0.0, 1e-3 - low),
-                                         orientation=tuple(quat)))
-    scene.contact(scene.attach(body, coulomb.ConvexHull(points=local.tolist())), floor,
-                  mu=0.5)
-    tr = scene.simulate(t_end=0.1, h=1e-3)
+    tr = _dropped(coulomb.ConvexHull(points=local.tolist()), quat, 1e-3 - low, 0.1)
     deepest = min(float(np.min(_rotate(q[3:7], local)[:, 2] + q[2])) for q in tr.q)
     assert deepest > -1e-9, deepest
     # the trajectory's own record of its deepest gap is the cloud's
@@ -410,14 +415,7 @@ def test_a_box_dropped_nearly_flat_lands_with_every_step_solved(seed: int,
     corners = np.array([[sx * 0.1, sy * 0.1, sz * thickness / 2]
                         for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
     low = float(np.min(_rotate(quat, corners)[:, 2]))
-    scene = coulomb.Scene(dim=3, gravity=(0.0, 0.0, -9.81))
-    floor = scene.add(coulomb.HalfSpace(normal=(0, 0, 1), point=(0, 0, 0)))
-    body = scene.add(coulomb.RigidBody3D(mass=1.0, inertia=(2.5e-3, 2.5e-3, 5e-3),
-                                         position=(0.0, 0.0, 1e-3 - low),
-                                         orientation=tuple(quat)))
-    box = coulomb.Box(half_extents=(0.1, 0.1, thickness / 2))
-    scene.contact(scene.attach(body, box), floor, mu=0.5)
-    tr = scene.simulate(t_end=0.1, h=1e-3)
+    tr = _dropped(coulomb.Box(half_extents=(0.1, 0.1, thickness / 2)), quat, 1e-3 - low, 0.1)
     assert tr.success, tr.message
     assert tr.check().ok
     deepest = min(float(np.min(_rotate(q[3:7], corners)[:, 2] + q[2])) for q in tr.q)
@@ -434,12 +432,7 @@ def test_a_capsule_dropped_on_the_floor_rolls_without_sinking(seed: int) -> None
     rng = np.random.default_rng(seed)
     axis = rng.normal(size=4)
     quat = axis / np.linalg.norm(axis) if seed % 2 else _tilted(rng)
-    scene = coulomb.Scene(dim=3, gravity=(0.0, 0.0, -9.81))
-    floor = scene.add(coulomb.HalfSpace(normal=(0, 0, 1), point=(0, 0, 0)))
-    body = scene.add(coulomb.RigidBody3D(mass=1.0, inertia=(2e-3, 3e-3, 4e-3),
-                                         position=(0.0, 0.0, 0.3), orientation=tuple(quat)))
     capsule = coulomb.Capsule(a=(-0.1, 0, 0), b=(0.1, 0, 0), radius=0.03)
-    scene.contact(scene.attach(body, capsule), floor, mu=0.5)
-    tr = scene.simulate(t_end=0.6, h=1e-3)
+    tr = _dropped(capsule, quat, 0.3, 0.6, inertia=(2e-3, 3e-3, 4e-3))
     assert tr.success
     assert float(np.min(tr.min_gap)) > -2e-8
